@@ -1,0 +1,148 @@
+// Typed, validated machine configuration built from a LinuxCNC-style INI file.
+// A MachineConfig is immutable once loaded; every thread may read it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cncd::config {
+
+// Axis letters in LinuxCNC's canonical order; an axis index is a position in this string.
+inline constexpr std::string_view kAxisLetters = "XYZABCUVW";
+inline constexpr int kMaxAxes = 9;
+inline constexpr int kMaxJoints = 16;
+
+// Index of an axis letter (either case) in kAxisLetters, or -1.
+int axis_index(char letter);
+
+enum class LinearUnits { mm, inch };
+enum class AngularUnits { degree, radian, grad };
+enum class JointType { linear, angular };
+
+// Where a value came from, for messages in the form FILE:LINE.
+struct SourceRef {
+  std::string file;
+  int line = 0;
+};
+
+struct AxisConfig {
+  bool present = false;           // letter appears in [TRAJ] COORDINATES
+  double min_limit = -1e99;       // machine units (mm, inch or degrees)
+  double max_limit = 1e99;
+  double max_velocity = 0;        // units/s
+  double max_acceleration = 0;    // units/s^2
+  double max_jerk = 0;            // units/s^3, 0 = unlimited
+  SourceRef source;
+};
+
+struct JointConfig {
+  JointType type = JointType::linear;
+  char axis = 'X';                // the axis this joint drives (trivkins, from COORDINATES)
+  double min_limit = -1e99;       // joint units
+  double max_limit = 1e99;
+  double max_velocity = 0;        // units/s
+  double max_acceleration = 0;    // units/s^2
+  double ferror = 1;              // following error limit at max velocity
+  double min_ferror = 0.25;       // following error limit at standstill
+  double backlash = 0;
+  // Homing, LinuxCNC semantics: HOME_SEARCH_VEL = 0 homes immediately at the current position.
+  double home = 0;
+  double home_offset = 0;
+  double home_search_vel = 0;
+  double home_latch_vel = 0;
+  double home_final_vel = -1;     // < 0: move to HOME at max velocity
+  int home_sequence = -1;         // < 0: not part of a "home all"
+  bool home_use_index = false;
+  bool home_ignore_limits = false;
+  bool home_is_shared = false;
+  bool home_absolute_encoder = false;
+  bool volatile_home = false;
+  // Scaling: steps or counts per unit. SCALE is the stepgen/driver key, INPUT/OUTPUT_SCALE the
+  // encoder/DAC keys of servo configs; 0 = not given.
+  double scale = 0;
+  double input_scale = 0;
+  double output_scale = 0;
+  std::string driver = "sim";     // DRIVER: sim | gpio | modbus
+  SourceRef source;               // the [JOINT_n] header
+};
+
+struct CncdConfig {
+  std::string socket_path = "/run/cncd/cncd.sock";
+  std::string read_group;          // empty: only root and the control group may connect
+  std::string control_group;       // empty: only root may command
+  int rt_priority = 80;            // SCHED_FIFO priority of the servo thread
+  int rt_cpu = -1;                 // CPU to pin the servo thread to, -1 = any
+  std::string log_level = "info";  // trace|debug|info|warn|error|critical|off
+};
+
+struct MachineConfig {
+  std::filesystem::path path;     // the INI file as given
+  std::string machine_name;       // [EMC] MACHINE
+  // [EMCMOT]
+  std::int64_t servo_period_ns = 1'000'000;
+  std::int64_t base_period_ns = 0;  // 0 = no base thread
+  // [TASK]
+  double task_cycle_time_s = 0.001;
+  // [RS274NGC]; paths are resolved relative to the INI file's directory.
+  std::filesystem::path parameter_file;
+  std::string startup_code;
+  std::vector<std::filesystem::path> subroutine_path;
+  // [EMCIO]
+  std::filesystem::path tool_table;
+  // [TRAJ]
+  std::string coordinates = "XYZ";  // one letter a joint, e.g. "XYYZ" for a gantry
+  LinearUnits linear_units = LinearUnits::mm;
+  AngularUnits angular_units = AngularUnits::degree;
+  double default_linear_velocity = 0;  // units/s
+  double max_linear_velocity = 0;      // units/s
+  double default_linear_acceleration = 0;
+  double max_linear_acceleration = 0;
+  double max_linear_jerk = 0;          // units/s^3, 0 = unlimited
+  std::filesystem::path position_file;
+  bool no_force_homing = false;
+  // [KINS]
+  std::string kinematics = "trivkins";
+  int joint_count = 0;
+  // [DISPLAY]
+  double max_feed_override = 1.0;      // 1.0 = 100 %
+  std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
+  std::vector<JointConfig> joints;        // joint_count entries
+  CncdConfig cncd;
+
+  const AxisConfig& axis(char letter) const { return axes[static_cast<std::size_t>(axis_index(letter))]; }
+  // Millimetres per machine linear unit (1 or 25.4).
+  double mm_per_unit() const { return linear_units == LinearUnits::inch ? 25.4 : 1.0; }
+};
+
+// One problem found while reading or validating; printed as "FILE:LINE: [SECTION] KEY: message".
+struct Problem {
+  std::string file;
+  int line = 0;          // 0 = no line (e.g. missing file)
+  std::string section;   // without brackets, may be empty
+  std::string key;       // may be empty
+  std::string message;
+  std::string to_string() const;
+};
+
+struct LoadResult {
+  std::optional<MachineConfig> config;  // set only when problems is empty
+  std::vector<Problem> problems;        // every problem found, in file order
+  bool ok() const { return config.has_value(); }
+};
+
+// Reads, validates and types an INI file. Never throws on bad input; collects all problems.
+LoadResult load_machine_config(const std::filesystem::path& ini_path);
+
+// A readable multi-line summary (axes, joints, limits, units, period, drivers) for
+// `cncd --check-config`.
+std::string describe(const MachineConfig& config);
+
+// Exit status for an invalid configuration (sysexits EX_CONFIG).
+inline constexpr int kExitConfig = 78;
+
+}  // namespace cncd::config

@@ -1,0 +1,73 @@
+// The small interface every joint driver implements (sim, gpio step/dir, modbus).
+//
+// Lifecycle: configure() (non-RT, may allocate, may fail with a message) -> enable() ->
+// write()/read() once per servo period (RT) -> disable() -> destructor (non-RT).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cncd/config/machine_config.hpp"
+
+namespace cncd::drivers {
+
+inline constexpr int kMaxJoints = config::kMaxJoints;
+
+// What the servo thread hands a driver each period, one entry per joint it owns.
+struct JointCommand {
+  double position = 0;  // joint units (mm, inch or degrees)
+  double velocity = 0;  // joint units/s, feed-forward
+  bool enable = false;
+};
+
+// What a driver reports each period.
+struct JointFeedback {
+  double position = 0;         // joint units
+  bool home_switch = false;
+  bool min_limit = false;
+  bool max_limit = false;
+  bool fault = false;          // drive reports a fault
+  bool stale = false;          // no fresh feedback within the driver's deadline
+};
+
+struct MachineInputs {
+  bool estop = false;          // external estop input asserted
+  bool probe = false;
+};
+
+enum Capability : std::uint32_t {
+  kCapPositionFeedback = 1u << 0,  // feedback comes from the drive, not an echo
+  kCapHomeSwitch = 1u << 1,
+  kCapLimitSwitches = 1u << 2,
+  kCapEstopInput = 1u << 3,
+};
+
+class Driver {
+ public:
+  virtual ~Driver() = default;
+  Driver() = default;
+  Driver(const Driver&) = delete;
+  Driver& operator=(const Driver&) = delete;
+
+  // Non-RT. Prepares hardware for the given joints; returns an error message or "" on success.
+  virtual std::string configure(const config::MachineConfig& machine,
+                                const std::vector<int>& joints) = 0;
+  // Non-RT. Called before the servo thread starts / after it stops.
+  virtual void enable() = 0;
+  virtual void disable() = 0;
+  // RT, servo thread: hand over this period's commands (indexed like configure()'s joints).
+  virtual void write(const JointCommand* commands, int count) noexcept = 0;
+  // RT, servo thread: fill this period's feedback (indexed like configure()'s joints).
+  virtual void read(JointFeedback* feedback, int count) noexcept = 0;
+  // RT, servo thread: machine-wide inputs; drivers without inputs leave them alone.
+  virtual void read_inputs(MachineInputs& /*inputs*/) noexcept {}
+  virtual std::uint32_t capabilities() const noexcept = 0;
+  virtual const char* name() const noexcept = 0;
+};
+
+// Non-RT. Creates the driver named by a joint's DRIVER key, or returns nullptr and sets error.
+std::unique_ptr<Driver> make_driver(const std::string& name, std::string& error);
+
+}  // namespace cncd::drivers

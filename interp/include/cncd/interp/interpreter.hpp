@@ -1,0 +1,65 @@
+// The RS274NGC interpreter. Single-threaded: one thread owns an Interpreter. Reads the program
+// incrementally (memory does not grow with program length) and emits canonical commands to a
+// CanonSink block by block.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cncd/interp/canon.hpp"
+
+namespace cncd::interp {
+
+struct InterpError {
+  std::string file;
+  int line = 0;     // 1-based, 0 = not tied to a line
+  int column = 0;   // 1-based, 0 = unknown
+  std::string message;
+  // "FILE:LINE:COLUMN: message" (column left out when 0)
+  std::string to_string() const;
+};
+
+struct InterpOptions {
+  Units machine_units = Units::mm;          // units of the machine (INI LINEAR_UNITS)
+  std::filesystem::path parameter_file;     // empty = none
+  std::filesystem::path tool_table;         // empty = none
+  std::vector<std::filesystem::path> subroutine_path;
+  std::string startup_code;                 // RS274NGC_STARTUP_CODE, run before the program
+};
+
+class Interpreter {
+ public:
+  explicit Interpreter(InterpOptions options = {});
+  ~Interpreter();
+  Interpreter(const Interpreter&) = delete;
+  Interpreter& operator=(const Interpreter&) = delete;
+
+  // Tells the interpreter where the machine is, in the machine's units and program
+  // coordinates of the current coordinate system (what a machinist sees on the DRO).
+  void set_position(const Pose& position);
+
+  // Opens a program file and resets to the start-of-program modal state.
+  std::optional<InterpError> open(const std::filesystem::path& program);
+  // Opens a program held in memory (MDI, tests); `name` is used in messages.
+  std::optional<InterpError> open_string(std::string text, std::string name = "<mdi>");
+
+  enum class Step { block, end, error };
+  // Executes the next block, emitting its canonical commands to `sink`. Returns `end` after
+  // M2/M30/% or end of file, `error` when the block is rejected (see error()).
+  Step step(CanonSink& sink);
+  const std::optional<InterpError>& error() const;
+  // Line number of the block last executed.
+  int current_line() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Convenience: runs a whole program into `sink`. Returns the first error, if any.
+std::optional<InterpError> run_program(Interpreter& interp, CanonSink& sink);
+
+}  // namespace cncd::interp

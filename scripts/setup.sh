@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages cncd builds and tests with. Idempotent: packages already
+# present are left alone and apt is not touched at all when nothing is missing.
+set -euo pipefail
+
+packages=(cmake ninja-build g++ pkg-config libmodbus-dev libgpiod-dev libspdlog-dev
+          nlohmann-json3-dev libsystemd-dev libgtest-dev)
+if [[ "${1:-}" == "--with-oracle" ]]; then
+  # LinuxCNC's standalone interpreter, used by the differential tests when present.
+  packages+=(linuxcnc-uspace)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+if ((EUID == 0)); then
+  as_root=()
+elif command -v sudo >/dev/null; then
+  as_root=(sudo)
+else
+  echo "setup: need root or sudo to install: ${missing[*]}" >&2
+  exit 1
+fi
+echo "setup: installing ${missing[*]}" >&2
+"${as_root[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -qq --no-install-recommends \
+  "${missing[@]}"
