@@ -15,19 +15,20 @@ namespace cncd::interp {
 
 struct InterpError {
   std::string file;
-  int line = 0;     // 1-based, 0 = not tied to a line
-  int column = 0;   // 1-based, 0 = unknown
+  int line = 0;    // 1-based, 0 = not tied to a line
+  int column = 0;  // 1-based, 0 = unknown
   std::string message;
   // "FILE:LINE:COLUMN: message" (column left out when 0)
   std::string to_string() const;
 };
 
 struct InterpOptions {
-  Units machine_units = Units::mm;          // units of the machine (INI LINEAR_UNITS)
-  std::filesystem::path parameter_file;     // empty = none
-  std::filesystem::path tool_table;         // empty = none
+  Units machine_units = Units::mm;       // units of the machine (INI LINEAR_UNITS)
+  std::filesystem::path parameter_file;  // empty = none
+  std::filesystem::path tool_table;      // empty = none
   std::vector<std::filesystem::path> subroutine_path;
-  std::string startup_code;                 // RS274NGC_STARTUP_CODE, run before the program
+  std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
+  bool block_delete = false;  // skip lines starting with '/'
 };
 
 class Interpreter {

@@ -1,0 +1,90 @@
+// One parsed line: its words, codes, comments, parameter assignments and O-word. A Block is
+// reused from line to line so that parsing a simple line allocates nothing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "codes.hpp"
+
+namespace cncd::interp {
+
+enum class OKind : std::uint8_t {
+  none,
+  sub,
+  endsub,
+  call,
+  do_,
+  while_,
+  endwhile,
+  if_,
+  elseif,
+  else_,
+  endif,
+  break_,
+  continue_,
+  return_,
+  repeat,
+  endrepeat,
+};
+
+struct Block {
+  // Letter words other than G, M and N, indexed by letter - 'a'.
+  std::array<double, 26> value{};
+  std::array<int, 26> column{};
+  std::uint32_t present = 0;
+
+  // At most one G code per modal group; -1 = none.
+  std::array<int, kGGroups> g{};
+  std::array<int, kGGroups> g_column{};
+  // At most one M code per modal group; -1 = none.
+  std::array<int, kMGroups> m{};
+  std::array<int, kMGroups> m_column{};
+  int m_count = 0;
+
+  bool block_delete = false;
+  bool has_line_number = false;
+  double line_number = 0;
+
+  // Comments in order; `comment_count` of them are valid (the strings keep their capacity).
+  std::vector<std::string> comments;
+  int comment_count = 0;
+
+  OKind o_kind = OKind::none;
+  std::string o_name;  // "100" or "<name>" lowercased, as written after O
+  int o_column = 0;
+  bool has_o_value = false;  // if/while/elseif/repeat/return condition or value
+  double o_value = 0;
+  std::vector<double> call_args;
+
+  std::vector<std::pair<int, double>> numbered_assignments;
+  std::vector<std::pair<std::string, double>> named_assignments;
+  int named_assignment_count = 0;
+
+  bool has(char letter) const { return (present >> (letter - 'a')) & 1U; }
+  double get(char letter) const { return value[static_cast<std::size_t>(letter - 'a')]; }
+  int col(char letter) const { return column[static_cast<std::size_t>(letter - 'a')]; }
+  int g_code(GGroup group) const { return g[static_cast<std::size_t>(group)]; }
+  int m_code(MGroup group) const { return m[static_cast<std::size_t>(group)]; }
+
+  void clear() {
+    present = 0;
+    g.fill(-1);
+    m.fill(-1);
+    m_count = 0;
+    block_delete = false;
+    has_line_number = false;
+    comment_count = 0;
+    o_kind = OKind::none;
+    o_name.clear();
+    has_o_value = false;
+    call_args.clear();
+    numbered_assignments.clear();
+    named_assignment_count = 0;
+  }
+};
+
+}  // namespace cncd::interp

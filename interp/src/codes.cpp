@@ -1,0 +1,131 @@
+#include "codes.hpp"
+
+#include <array>
+
+namespace cncd::interp {
+namespace {
+
+struct GEntry {
+  int code;
+  GGroup group;
+  bool supported;
+};
+
+// Every G code LinuxCNC 2.9 knows. Unsupported ones are listed so that they are reported as
+// "not supported" rather than as unknown.
+constexpr std::array kGCodes{
+    GEntry{0, GGroup::motion, true},           GEntry{10, GGroup::motion, true},
+    GEntry{20, GGroup::motion, true},          GEntry{30, GGroup::motion, true},
+    GEntry{40, GGroup::non_modal, true},       GEntry{50, GGroup::motion, false},
+    GEntry{51, GGroup::motion, false},         GEntry{52, GGroup::motion, false},
+    GEntry{53, GGroup::motion, false},         GEntry{70, GGroup::lathe_diameter, false},
+    GEntry{80, GGroup::lathe_diameter, false}, GEntry{100, GGroup::non_modal, true},
+    GEntry{170, GGroup::plane, true},          GEntry{171, GGroup::plane, false},
+    GEntry{180, GGroup::plane, true},          GEntry{181, GGroup::plane, false},
+    GEntry{190, GGroup::plane, true},          GEntry{191, GGroup::plane, false},
+    GEntry{200, GGroup::units, true},          GEntry{210, GGroup::units, true},
+    GEntry{280, GGroup::non_modal, true},      GEntry{281, GGroup::non_modal, true},
+    GEntry{300, GGroup::non_modal, true},      GEntry{301, GGroup::non_modal, true},
+    GEntry{330, GGroup::motion, false},        GEntry{331, GGroup::motion, false},
+    GEntry{382, GGroup::motion, false},        GEntry{383, GGroup::motion, false},
+    GEntry{384, GGroup::motion, false},        GEntry{385, GGroup::motion, false},
+    GEntry{400, GGroup::cutter_comp, true},    GEntry{410, GGroup::cutter_comp, false},
+    GEntry{411, GGroup::cutter_comp, false},   GEntry{420, GGroup::cutter_comp, false},
+    GEntry{421, GGroup::cutter_comp, false},   GEntry{430, GGroup::tool_length, true},
+    GEntry{431, GGroup::tool_length, true},    GEntry{432, GGroup::tool_length, false},
+    GEntry{490, GGroup::tool_length, true},    GEntry{520, GGroup::non_modal, true},
+    GEntry{530, GGroup::non_modal, true},      GEntry{540, GGroup::coord_system, true},
+    GEntry{550, GGroup::coord_system, true},   GEntry{560, GGroup::coord_system, true},
+    GEntry{570, GGroup::coord_system, true},   GEntry{580, GGroup::coord_system, true},
+    GEntry{590, GGroup::coord_system, true},   GEntry{591, GGroup::coord_system, true},
+    GEntry{592, GGroup::coord_system, true},   GEntry{593, GGroup::coord_system, true},
+    GEntry{610, GGroup::path_control, true},   GEntry{611, GGroup::path_control, true},
+    GEntry{640, GGroup::path_control, true},   GEntry{700, GGroup::motion, false},
+    GEntry{710, GGroup::motion, false},        GEntry{711, GGroup::motion, false},
+    GEntry{712, GGroup::motion, false},        GEntry{720, GGroup::motion, false},
+    GEntry{721, GGroup::motion, false},        GEntry{722, GGroup::motion, false},
+    GEntry{730, GGroup::motion, true},         GEntry{740, GGroup::motion, true},
+    GEntry{760, GGroup::motion, false},        GEntry{800, GGroup::motion, true},
+    GEntry{810, GGroup::motion, true},         GEntry{820, GGroup::motion, true},
+    GEntry{830, GGroup::motion, true},         GEntry{840, GGroup::motion, true},
+    GEntry{850, GGroup::motion, true},         GEntry{860, GGroup::motion, true},
+    GEntry{870, GGroup::motion, true},         GEntry{880, GGroup::motion, true},
+    GEntry{890, GGroup::motion, true},         GEntry{900, GGroup::distance, true},
+    GEntry{901, GGroup::arc_distance, true},   GEntry{910, GGroup::distance, true},
+    GEntry{911, GGroup::arc_distance, true},   GEntry{920, GGroup::non_modal, true},
+    GEntry{921, GGroup::non_modal, true},      GEntry{922, GGroup::non_modal, true},
+    GEntry{923, GGroup::non_modal, true},      GEntry{930, GGroup::feed_mode, true},
+    GEntry{940, GGroup::feed_mode, true},      GEntry{950, GGroup::feed_mode, true},
+    GEntry{960, GGroup::spindle_mode, false},  GEntry{970, GGroup::spindle_mode, true},
+    GEntry{980, GGroup::retract, true},        GEntry{990, GGroup::retract, true},
+};
+
+// Direct lookup: G codes run from 0 to 99.9, so an array indexed by code covers them all.
+constexpr std::array<CodeInfo, 1000> make_g_index() {
+  std::array<CodeInfo, 1000> index{};
+  for (const auto& entry : kGCodes) {
+    index[static_cast<std::size_t>(entry.code)] =
+        CodeInfo{static_cast<std::int8_t>(entry.group), entry.supported};
+  }
+  return index;
+}
+constexpr auto kGIndex = make_g_index();
+
+}  // namespace
+
+CodeInfo g_code_info(int code) {
+  if (code < 0 || code >= static_cast<int>(kGIndex.size())) return {};
+  return kGIndex[static_cast<std::size_t>(code)];
+}
+
+CodeInfo m_code_info(int code) {
+  auto make = [](MGroup group, bool supported) {
+    return CodeInfo{static_cast<std::int8_t>(group), supported};
+  };
+  switch (code) {
+    case 0:
+    case 1:
+    case 2:
+    case 30:
+    case 60:
+      return make(MGroup::stopping, true);
+    case 3:
+    case 4:
+    case 5:
+      return make(MGroup::spindle, true);
+    case 19:
+      return make(MGroup::spindle, false);
+    case 6:
+    case 61:
+      return make(MGroup::tool_change, true);
+    case 7:
+    case 8:
+    case 9:
+      return make(MGroup::coolant, true);
+    case 48:
+    case 49:
+    case 50:
+    case 51:
+    case 52:
+    case 53:
+      return make(MGroup::overrides, true);
+    case 62:
+    case 63:
+    case 64:
+    case 65:
+    case 66:
+    case 67:
+    case 68:
+      return make(MGroup::io, false);
+    case 70:
+    case 71:
+    case 72:
+    case 73:
+      return make(MGroup::io, false);
+    default:
+      if (code >= 100 && code <= 199) return make(MGroup::user, false);
+      return {};
+  }
+}
+
+}  // namespace cncd::interp

@@ -1,0 +1,368 @@
+// One block in LinuxCNC's order of execution: comment, feed mode, feed, speed, tool, spindle,
+// coolant, overrides, dwell, plane, units, cutter compensation, tool length, coordinate system,
+// path control, distance modes, retract mode, non-modal codes, motion, stop.
+#include <cctype>
+
+#include "failure.hpp"
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+namespace {
+
+bool uses_axes_non_modal(int code) {
+  return code == 100 || code == 280 || code == 300 || code == 520 || code == 920;
+}
+
+bool starts_with_word(const std::string& text, const char* word, std::size_t& rest) {
+  std::size_t i = 0;
+  for (; word[i] != '\0'; ++i) {
+    if (i >= text.size()) return false;
+    if (std::tolower(static_cast<unsigned char>(text[i])) != word[i]) return false;
+  }
+  rest = i;
+  return true;
+}
+
+}  // namespace
+
+void Interpreter::Impl::check_block() const {
+  const Block& b = block_;
+  for (int group = 0; group < kGGroups; ++group) {
+    const int code = b.g[static_cast<std::size_t>(group)];
+    if (code >= 0 && !g_code_info(code).supported) {
+      fail("G" + std::to_string(code / 10) +
+               (code % 10 != 0 ? "." + std::to_string(code % 10) : "") + " is not supported",
+           b.g_column[static_cast<std::size_t>(group)]);
+    }
+  }
+  for (int group = 0; group < kMGroups; ++group) {
+    const int code = b.m[static_cast<std::size_t>(group)];
+    if (code >= 0 && !m_code_info(code).supported) {
+      fail("M" + std::to_string(code) + " is not supported",
+           b.m_column[static_cast<std::size_t>(group)]);
+    }
+  }
+  bool axis_words = false;
+  for (const char letter : kAxisLetters) {
+    if (letter != '\0' && b.has(letter)) axis_words = true;
+  }
+  const int non_modal = b.g_code(GGroup::non_modal);
+  const int motion = b.g_code(GGroup::motion);
+  if (non_modal >= 0 && uses_axes_non_modal(non_modal) && motion >= 0 && motion != 800) {
+    fail("Cannot use two g codes that both use axis values", b.g_column[0]);
+  }
+  if (motion == 800 && axis_words && !(non_modal >= 0 && uses_axes_non_modal(non_modal))) {
+    fail("Cannot use axis values with g80", b.g_column[static_cast<std::size_t>(GGroup::motion)]);
+  }
+  if (axis_words && motion < 0 && !(non_modal >= 0 && uses_axes_non_modal(non_modal)) &&
+      (modal_.motion < 0 || modal_.motion == 800)) {
+    fail("Cannot use axis values without a g code that uses them");
+  }
+  if (b.has('e')) fail("E word with no G70, G76, M66, M67 or M68 to use it", b.col('e'));
+  if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
+  if (b.has('s') && b.get('s') < 0) fail("Negative s word used", b.col('s'));
+  if (b.has('t') && b.get('t') < 0) fail("Negative t word used", b.col('t'));
+}
+
+void Interpreter::Impl::execute_block() {
+  check_block();
+  do_comment();
+  do_feed_mode();
+  do_tool_and_spindle();
+  do_coolant_and_overrides();
+  do_dwell();
+  do_modes();
+  do_non_modal();
+  do_motion();
+  do_stop();
+}
+
+void Interpreter::Impl::do_comment() {
+  if (block_.comment_count == 0) return;
+  // LinuxCNC acts on the last comment of a line only.
+  const std::string& text = block_.comments[static_cast<std::size_t>(block_.comment_count - 1)];
+  std::size_t rest = 0;
+  if (starts_with_word(text, "msg,", rest)) {
+    CanonCommand& command = make(CanonKind::message);
+    command.text = text.substr(rest);
+    emit(command);
+    return;
+  }
+  emit_comment(text);
+}
+
+void Interpreter::Impl::do_feed_mode() {
+  const int code = block_.g_code(GGroup::feed_mode);
+  if (code >= 0) {
+    if (code == 930) {
+      emit_comment("interpreter: feed mode set to inverse time");
+      emit_simple(CanonKind::set_feed_mode, 0);
+      modal_.feed_mode = FeedMode::inverse_time;
+      modal_.feed_rate = 0;
+    } else if (code == 940) {
+      emit_comment("interpreter: feed mode set to units per minute");
+      emit_simple(CanonKind::set_feed_mode, 0);
+      modal_.feed_mode = FeedMode::units_per_minute;
+      modal_.feed_rate = 0;
+      emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+    } else {
+      emit_comment("interpreter: feed mode set to units per revolution");
+      emit_simple(CanonKind::set_feed_mode, 1);
+      modal_.feed_mode = FeedMode::units_per_rev;
+      modal_.feed_rate = 0;
+      emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+    }
+  }
+  if (block_.has('f')) {
+    modal_.feed_rate = block_.get('f');
+    if (modal_.feed_mode != FeedMode::inverse_time) {
+      emit_simple(CanonKind::set_feed_rate, 0, modal_.feed_rate);
+    }
+  }
+}
+
+void Interpreter::Impl::do_tool_and_spindle() {
+  if (block_.has('s')) {
+    modal_.speed = block_.get('s');
+    emit_simple(CanonKind::set_spindle_speed, 0, modal_.speed);
+  }
+  if (block_.has('t')) {
+    const int tool = static_cast<int>(block_.get('t'));
+    if (tool != 0 && tools_.find(tool) == nullptr && !options_.tool_table.empty()) {
+      fail("Selected tool slot number too large", block_.col('t'));
+    }
+    tool_prepped_ = tool;
+    emit_simple(CanonKind::select_tool, tool);
+  }
+  const int change = block_.m_code(MGroup::tool_change);
+  if (change == 6) {
+    const int tool = tool_prepped_ < 0 ? tool_in_spindle_ : tool_prepped_;
+    emit_simple(CanonKind::start_change);
+    emit_simple(CanonKind::stop_spindle_turning);
+    emit_simple(CanonKind::change_tool, tool);
+    tool_in_spindle_ = tool;
+    modal_.spindle = SpindleDir::stopped;
+  } else if (change == 61) {
+    if (!block_.has('q')) fail("Q word missing with M61", block_.m_column[6]);
+    const int tool = static_cast<int>(block_.get('q'));
+    if (tool < 0) fail("Need non-negative Q value with M61", block_.col('q'));
+    tool_in_spindle_ = tool;
+    emit_simple(CanonKind::change_tool_number, tool);
+  }
+  switch (block_.m_code(MGroup::spindle)) {
+    case 3:
+      modal_.spindle = SpindleDir::clockwise;
+      emit_simple(CanonKind::start_spindle_clockwise);
+      break;
+    case 4:
+      modal_.spindle = SpindleDir::counterclockwise;
+      emit_simple(CanonKind::start_spindle_counterclockwise);
+      break;
+    case 5:
+      modal_.spindle = SpindleDir::stopped;
+      emit_simple(CanonKind::stop_spindle_turning);
+      break;
+    default:
+      break;
+  }
+}
+
+void Interpreter::Impl::do_coolant_and_overrides() {
+  switch (block_.m_code(MGroup::coolant)) {
+    case 7:
+      modal_.mist = true;
+      emit_simple(CanonKind::mist_on);
+      break;
+    case 8:
+      modal_.flood = true;
+      emit_simple(CanonKind::flood_on);
+      break;
+    case 9:
+      modal_.mist = modal_.flood = false;
+      emit_simple(CanonKind::mist_off);
+      emit_simple(CanonKind::flood_off);
+      break;
+    default:
+      break;
+  }
+  const int code = block_.m_code(MGroup::overrides);
+  if (code < 0) return;
+  const bool has_p = block_.has('p');
+  const bool on = !has_p || block_.get('p') != 0.0;
+  switch (code) {
+    case 48:
+      modal_.feed_override = modal_.speed_override = true;
+      emit_simple(CanonKind::set_feed_override_enable, 1);
+      emit_simple(CanonKind::set_spindle_override_enable, 1);
+      break;
+    case 49:
+      modal_.feed_override = modal_.speed_override = false;
+      emit_simple(CanonKind::set_feed_override_enable, 0);
+      emit_simple(CanonKind::set_spindle_override_enable, 0);
+      break;
+    case 50:
+      modal_.feed_override = on;
+      emit_simple(CanonKind::set_feed_override_enable, on ? 1 : 0);
+      break;
+    case 51:
+      modal_.speed_override = on;
+      emit_simple(CanonKind::set_spindle_override_enable, on ? 1 : 0);
+      break;
+    case 52:
+      modal_.adaptive_feed = on;
+      emit_simple(CanonKind::set_adaptive_feed_enable, on ? 1 : 0);
+      break;
+    default:
+      modal_.feed_hold = on;
+      emit_simple(CanonKind::set_feed_hold_enable, on ? 1 : 0);
+      break;
+  }
+}
+
+void Interpreter::Impl::do_dwell() {
+  if (block_.g_code(GGroup::non_modal) != 40) return;
+  if (!block_.has('p')) fail("Dwell time missing with g4", block_.g_column[0]);
+  if (block_.get('p') < 0) fail("Negative dwell time", block_.col('p'));
+  emit_simple(CanonKind::dwell, 0, block_.get('p'));
+}
+
+void Interpreter::Impl::do_modes() {
+  const int plane = block_.g_code(GGroup::plane);
+  if (plane >= 0) {
+    modal_.plane = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
+    CanonCommand& command = make(CanonKind::select_plane);
+    command.plane = modal_.plane;
+    command.ivalue = static_cast<int>(modal_.plane);
+    emit(command);
+  }
+  const int units = block_.g_code(GGroup::units);
+  if (units >= 0) change_units(units == 200 ? Units::inches : Units::mm);
+  const int comp = block_.g_code(GGroup::cutter_comp);
+  if (comp == 400) emit_comment("interpreter: cutter radius compensation off");
+  const int length = block_.g_code(GGroup::tool_length);
+  if (length >= 0) apply_tool_length(length);
+  const int system = block_.g_code(GGroup::coord_system);
+  if (system >= 0) {
+    static constexpr int kSystems[] = {540, 550, 560, 570, 580, 590, 591, 592, 593};
+    for (int i = 0; i < 9; ++i) {
+      if (kSystems[i] == system) select_coord_system(i + 1);
+    }
+  }
+  const int path = block_.g_code(GGroup::path_control);
+  if (path >= 0) {
+    CanonCommand& command = make(CanonKind::set_motion_control_mode);
+    if (path == 610) {
+      modal_.control = MotionMode::exact_path;
+    } else if (path == 611) {
+      modal_.control = MotionMode::exact_stop;
+    } else {
+      modal_.control = MotionMode::continuous;
+      modal_.tolerance = block_.has('p') ? block_.get('p') : 0.0;
+      modal_.naive_tolerance = block_.has('q') ? block_.get('q') : modal_.tolerance;
+    }
+    command.ivalue = static_cast<int>(modal_.control);
+    command.value = modal_.tolerance;
+    emit(command);
+    if (path == 640) emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
+  }
+  const int distance = block_.g_code(GGroup::distance);
+  if (distance == 900 && modal_.incremental) {
+    modal_.incremental = false;
+    emit_comment("interpreter: distance mode changed to absolute");
+  } else if (distance == 910 && !modal_.incremental) {
+    modal_.incremental = true;
+    emit_comment("interpreter: distance mode changed to incremental");
+  }
+  const int arc_distance = block_.g_code(GGroup::arc_distance);
+  if (arc_distance == 901) modal_.arc_incremental = false;
+  if (arc_distance == 911) modal_.arc_incremental = true;
+  const int retract = block_.g_code(GGroup::retract);
+  if (retract == 980) {
+    modal_.retract_r_plane = false;
+    emit_comment("interpreter: retract mode set to old_z");
+  } else if (retract == 990) {
+    modal_.retract_r_plane = true;
+    emit_comment("interpreter: retract mode set to r_plane");
+  }
+}
+
+void Interpreter::Impl::do_non_modal() {
+  switch (block_.g_code(GGroup::non_modal)) {
+    case 100:
+      do_g10();
+      break;
+    case 280:
+    case 281:
+    case 300:
+    case 301:
+      do_home(block_.g_code(GGroup::non_modal));
+      break;
+    case 520:
+    case 920:
+    case 921:
+    case 922:
+    case 923:
+      do_g92(block_.g_code(GGroup::non_modal));
+      break;
+    default:
+      break;
+  }
+}
+
+bool Interpreter::Impl::do_stop() {
+  switch (block_.m_code(MGroup::stopping)) {
+    case 0:
+      emit_simple(CanonKind::program_stop);
+      return true;
+    case 1:
+      emit_simple(CanonKind::optional_program_stop);
+      return true;
+    case 60:
+      emit_simple(CanonKind::pallet_shuttle);
+      emit_simple(CanonKind::program_stop);
+      return true;
+    case 2:
+    case 30:
+      program_end_reset();
+      ended_ = true;
+      return true;
+    default:
+      return false;
+  }
+}
+
+// What M2/M30 reset, in the order LinuxCNC emits it.
+void Interpreter::Impl::program_end_reset() {
+  select_coord_system_quiet(1);
+  emit_g5x();
+  rotation_deg_ = 0;
+  emit_simple(CanonKind::set_xy_rotation, 0, 0.0);
+  if (modal_.plane != Plane::xy) {
+    modal_.plane = Plane::xy;
+    CanonCommand& command = make(CanonKind::select_plane);
+    command.plane = Plane::xy;
+    command.ivalue = static_cast<int>(Plane::xy);
+    emit(command);
+  }
+  modal_.incremental = false;
+  modal_.feed_mode = FeedMode::units_per_minute;
+  emit_simple(CanonKind::set_feed_mode, 0);
+  modal_.feed_rate = 0;
+  emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+  modal_.spindle = SpindleDir::stopped;
+  emit_simple(CanonKind::stop_spindle_turning);
+  emit_simple(CanonKind::set_spindle_mode, 0, 0.0);
+  if (modal_.mist) emit_simple(CanonKind::mist_off);
+  if (modal_.flood) emit_simple(CanonKind::flood_off);
+  modal_.mist = modal_.flood = false;
+  if (!modal_.feed_override || !modal_.speed_override) {
+    modal_.feed_override = modal_.speed_override = true;
+    emit_simple(CanonKind::set_feed_override_enable, 1);
+    emit_simple(CanonKind::set_spindle_override_enable, 1);
+  }
+  modal_.motion = 10;
+  if (block_.m_code(MGroup::stopping) == 30) emit_simple(CanonKind::pallet_shuttle);
+  emit_simple(CanonKind::program_end);
+}
+
+}  // namespace cncd::interp

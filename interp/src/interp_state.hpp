@@ -1,0 +1,176 @@
+// The interpreter's private state and the helpers shared by its translation units (block
+// execution, motion, canned cycles, control flow).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "block.hpp"
+#include "cncd/interp/interpreter.hpp"
+#include "parameters.hpp"
+#include "parser.hpp"
+#include "source.hpp"
+#include "tool_table.hpp"
+
+namespace cncd::interp {
+
+// Axis indexes into a Pose.
+enum Axis : int { kX = 0, kY, kZ, kA, kB, kC, kU, kV, kW };
+inline constexpr char kAxisLetters[kAxes + 1] = "xyzabcuvw";
+
+enum class FeedMode : int { units_per_minute = 0, inverse_time = 1, units_per_rev = 2 };
+enum class SpindleDir : int { stopped = 0, clockwise = 1, counterclockwise = -1 };
+
+// Modal state LinuxCNC keeps between blocks.
+struct ModalState {
+  int motion = -1;  // motion G code * 10, -1 before any motion code (LinuxCNC starts without one)
+  Plane plane = Plane::xy;
+  bool incremental = false;
+  bool arc_incremental = true;  // G91.1 is LinuxCNC's default
+  FeedMode feed_mode = FeedMode::units_per_minute;
+  Units units = Units::mm;
+  bool retract_r_plane = false;  // G99
+  int coord_system = 1;          // 1..9 = G54..G59.3
+  MotionMode control = MotionMode::continuous;
+  double tolerance = 0;        // G64 P
+  double naive_tolerance = 0;  // G64 Q
+  double feed_rate = 0;
+  double speed = 0;
+  SpindleDir spindle = SpindleDir::stopped;
+  bool mist = false;
+  bool flood = false;
+  bool feed_override = true;
+  bool speed_override = true;
+  bool adaptive_feed = false;
+  bool feed_hold = true;
+  int tool_length_code = 490;  // 430, 431 or 490
+};
+
+// Values canned cycles remember between blocks while the cycle stays the motion mode.
+struct CycleState {
+  double r = 0;
+  double z = 0;  // the plane's normal-axis value
+  double p = 0;
+  double q = 0;
+  double i = 0;
+  double j = 0;
+  double k = 0;
+  bool has_r = false;
+  bool has_z = false;
+  bool has_p = false;
+  bool has_q = false;
+  // The "old Z" cycles start from: the drilling-axis position of the last programmed move.
+  // The cycles' own retracts do not change it (observed LinuxCNC behaviour).
+  double old_normal = 0;
+};
+
+// Control flow: an open O-word block (if/while/do/repeat) or a subroutine call frame.
+struct ControlFrame {
+  OKind kind = OKind::none;
+  std::string name;
+  std::int64_t offset = 0;  // offset of the line after the opening o-line (loops)
+  int line_before = 0;      // line number before that offset
+  int remaining = 0;        // repeat count left
+  bool taken = false;       // an if/elseif branch already ran
+};
+
+struct CallFrame {
+  std::string name;
+  std::int64_t return_offset = 0;
+  int return_line = 0;
+  std::size_t control_depth = 0;
+  std::size_t source_index = 0;
+};
+
+class CanonSink;
+
+struct Interpreter::Impl {
+  explicit Impl(InterpOptions opts);
+
+  // interpreter.cpp
+  void reset_modal_state();
+  Step step(CanonSink& sink);
+  void emit_preamble();
+  void run_line();
+  InterpError make_error(const Failure& failure) const;
+
+  // execute.cpp: one block in LinuxCNC's order of execution.
+  void execute_block();
+  void check_block() const;
+  void do_comment();
+  void do_feed_mode();
+  void do_tool_and_spindle();
+  void do_coolant_and_overrides();
+  void do_dwell();
+  void do_modes();
+  void do_non_modal();
+  bool do_stop();
+  void program_end_reset();
+
+  // motion.cpp
+  void do_motion();
+  Pose target_from_words() const;
+  void straight(CanonKind kind, const Pose& end);
+  void arc(bool clockwise, const Pose& end);
+  void set_inverse_time_rate(double length);
+  void emit_straight(CanonKind kind, const Pose& end);
+
+  // offsets.cpp
+  void do_g10();
+  void do_g92(int code);
+  void do_home(int code);
+  void select_coord_system(int index);
+  void select_coord_system_quiet(int index);
+  void emit_g5x();
+  void emit_g92();
+  void load_coord_system(int index);
+  void change_units(Units units);
+  void apply_tool_length(int code);
+  Pose machine_to_program(const Pose& machine) const;
+  Pose program_to_machine(const Pose& program) const;
+
+  // cycles.cpp
+  void do_canned_cycle(int code);
+
+  // emit helpers
+  CanonCommand& make(CanonKind kind);
+  void emit(const CanonCommand& command) { sink_->emit(command); }
+  void emit_comment(const std::string& text);
+  void emit_simple(CanonKind kind, int ivalue = 0, double value = 0);
+
+  double to_program_units(double mm) const;
+
+  InterpOptions options_;
+  Parameters parameters_;
+  BlockParser parser_{parameters_};
+  ToolTable tools_;
+  Block block_;
+  std::string line_;
+  std::vector<LineSource> sources_;  // back() is being read; subroutine files are pushed
+  std::string program_name_;
+  CanonSink* sink_ = nullptr;
+  CanonCommand command_;
+  std::optional<InterpError> error_;
+  int current_line_ = 0;
+  bool preamble_done_ = false;
+  bool ended_ = false;
+  bool opened_ = false;
+  bool skipping_percent_ = false;
+  bool seen_percent_ = false;
+
+  ModalState modal_;
+  int previous_motion_ = -1;  // the motion mode before the current block
+  CycleState cycle_;
+  Pose pos_{};         // current position: program coordinates, program units
+  Pose g5x_offset_{};  // active coordinate system origin, program units
+  Pose g92_offset_{};
+  double rotation_deg_ = 0;
+  Pose tool_offset_{};  // tool length offset, program units
+  int tool_in_spindle_ = 0;
+  int tool_prepped_ = -1;
+  std::vector<ControlFrame> control_;
+  std::vector<CallFrame> calls_;
+};
+
+}  // namespace cncd::interp

@@ -1,0 +1,209 @@
+#include "cncd/interp/interpreter.hpp"
+
+#include "failure.hpp"
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+
+std::string InterpError::to_string() const {
+  std::string text = file;
+  if (line > 0) {
+    text += ":" + std::to_string(line);
+    if (column > 0) text += ":" + std::to_string(column);
+  }
+  text += ": " + message;
+  return text;
+}
+
+Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
+  if (!options_.parameter_file.empty()) {
+    if (auto problem = parameters_.load(options_.parameter_file)) {
+      error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
+    }
+  }
+  if (!options_.tool_table.empty()) {
+    if (auto problem = tools_.load(options_.tool_table)) {
+      error_ = InterpError{options_.tool_table.string(), 0, 0, *problem};
+    }
+  }
+  reset_modal_state();
+}
+
+void Interpreter::Impl::reset_modal_state() {
+  modal_ = ModalState{};
+  modal_.units = options_.machine_units;
+  cycle_ = CycleState{};
+  cycle_.old_normal = pos_[kZ];
+  const int system = static_cast<int>(parameters_.get(5220));
+  modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
+  load_coord_system(modal_.coord_system);
+  control_.clear();
+  calls_.clear();
+  preamble_done_ = false;
+  ended_ = false;
+  seen_percent_ = false;
+}
+
+CanonCommand& Interpreter::Impl::make(CanonKind kind) {
+  command_.kind = kind;
+  command_.line = current_line_;
+  command_.ivalue = 0;
+  command_.value = 0;
+  command_.value2 = 0;
+  command_.text.clear();
+  return command_;
+}
+
+void Interpreter::Impl::emit_simple(CanonKind kind, int ivalue, double value) {
+  CanonCommand& command = make(kind);
+  command.ivalue = ivalue;
+  command.value = value;
+  emit(command);
+}
+
+void Interpreter::Impl::emit_comment(const std::string& text) {
+  CanonCommand& command = make(CanonKind::comment);
+  command.text = text;
+  emit(command);
+}
+
+void Interpreter::Impl::emit_preamble() {
+  emit_simple(CanonKind::use_length_units, static_cast<int>(modal_.units));
+  emit_g5x();
+  emit_g92();
+  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
+  emit_simple(CanonKind::set_feed_reference);
+  emit_simple(CanonKind::on_reset);
+  preamble_done_ = true;
+}
+
+InterpError Interpreter::Impl::make_error(const Failure& failure) const {
+  InterpError error;
+  error.file = sources_.empty() ? program_name_ : sources_.back().name();
+  error.line = current_line_;
+  error.column = failure.column;
+  error.message = failure.message;
+  return error;
+}
+
+namespace {
+bool is_percent_line(const std::string& line) {
+  bool percent = false;
+  for (const char c : line) {
+    if (c == ' ' || c == '\t') continue;
+    if (c == '%' && !percent) {
+      percent = true;
+      continue;
+    }
+    return false;
+  }
+  return percent;
+}
+}  // namespace
+
+Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
+  if (error_) return Step::error;
+  if (ended_) return Step::end;
+  sink_ = &sink;
+  try {
+    if (sources_.empty()) fail("No program open");
+    if (!preamble_done_) emit_preamble();
+    LineSource& source = sources_.back();
+    if (!source.read_line(line_)) {
+      current_line_ = source.line_number();
+      fail("File ended with no percent sign or program end");
+    }
+    current_line_ = source.line_number();
+    if (is_percent_line(line_)) {
+      if (current_line_ == 1 && calls_.empty()) {
+        seen_percent_ = true;
+        return Step::block;
+      }
+      if (seen_percent_) {
+        emit_simple(CanonKind::finish);
+        ended_ = true;
+        return Step::end;
+      }
+    }
+    run_line();
+    return ended_ ? Step::end : Step::block;
+  } catch (const Failure& failure) {
+    error_ = make_error(failure);
+    return Step::error;
+  }
+}
+
+void Interpreter::Impl::run_line() {
+  parser_.parse(line_, block_);
+  if (block_.block_delete && options_.block_delete) return;
+  for (const auto& [number, value] : block_.numbered_assignments)
+    parameters_.set(number, value);
+  for (int i = 0; i < block_.named_assignment_count; ++i) {
+    const auto& [name, value] = block_.named_assignments[static_cast<std::size_t>(i)];
+    parameters_.set_named(name, value);
+  }
+  if (block_.o_kind != OKind::none) fail("O-word control flow is not supported");
+  execute_block();
+}
+
+Interpreter::Interpreter(InterpOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {}
+
+Interpreter::~Interpreter() = default;
+
+void Interpreter::set_position(const Pose& position) {
+  impl_->pos_ = position;
+  impl_->cycle_.old_normal = position[kZ];
+}
+
+std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
+  impl_->sources_.clear();
+  impl_->program_name_ = program.string();
+  LineSource source;
+  if (!source.open_file(program)) {
+    impl_->error_ = InterpError{program.string(), 0, 0, "Unable to open file"};
+    return impl_->error_;
+  }
+  impl_->sources_.push_back(std::move(source));
+  if (impl_->error_) return impl_->error_;
+  impl_->reset_modal_state();
+  return std::nullopt;
+}
+
+std::optional<InterpError> Interpreter::open_string(std::string text, std::string name) {
+  impl_->sources_.clear();
+  impl_->program_name_ = name;
+  LineSource source;
+  source.open_text(std::move(text), std::move(name));
+  impl_->sources_.push_back(std::move(source));
+  if (impl_->error_) return impl_->error_;
+  impl_->reset_modal_state();
+  return std::nullopt;
+}
+
+Interpreter::Step Interpreter::step(CanonSink& sink) {
+  return impl_->step(sink);
+}
+
+const std::optional<InterpError>& Interpreter::error() const {
+  return impl_->error_;
+}
+
+int Interpreter::current_line() const {
+  return impl_->current_line_;
+}
+
+std::optional<InterpError> run_program(Interpreter& interp, CanonSink& sink) {
+  for (;;) {
+    switch (interp.step(sink)) {
+      case Interpreter::Step::block:
+        continue;
+      case Interpreter::Step::end:
+        return std::nullopt;
+      case Interpreter::Step::error:
+        return interp.error();
+    }
+  }
+}
+
+}  // namespace cncd::interp

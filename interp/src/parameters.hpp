@@ -1,0 +1,54 @@
+// Numbered and named parameters (#1..#5601, #<local>, #<_global>) with LinuxCNC's scoping:
+// names without a leading underscore are local to the current subroutine call.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace cncd::interp {
+
+inline constexpr int kMaxParameter = 5602;  // valid numbers are 1..5601
+
+// LinuxCNC's persistent parameters: the ones it saves to and loads from the .var file.
+bool is_persistent_parameter(int number);
+
+class Parameters {
+ public:
+  Parameters();
+
+  double get(int number) const { return numbered_[static_cast<std::size_t>(number)]; }
+  void set(int number, double value) { numbered_[static_cast<std::size_t>(number)] = value; }
+
+  // Named parameters. Read-only predefined names (_x, _metric ...) come from `predefined_`.
+  std::optional<double> get_named(std::string_view name) const;
+  bool exists_named(std::string_view name) const;
+  void set_named(std::string_view name, double value);
+
+  // Subroutine scopes: locals of the callee are invisible to the caller.
+  void push_scope();
+  void pop_scope();
+  std::size_t depth() const { return scopes_.size(); }
+
+  using Predefined = std::function<std::optional<double>(std::string_view)>;
+  void set_predefined(Predefined lookup) { predefined_ = std::move(lookup); }
+
+  // Reads a LinuxCNC .var file ("number value" per line). Returns an error text on failure.
+  std::optional<std::string> load(const std::filesystem::path& path);
+  // Writes the persistent parameters: temp file, flush, rename, so a crash never loses them.
+  std::optional<std::string> save(const std::filesystem::path& path) const;
+
+ private:
+  using Scope = std::unordered_map<std::string, double>;
+  std::vector<double> numbered_;
+  Scope globals_;
+  std::vector<Scope> scopes_;  // back() = current subroutine's locals; front() = main program
+  Predefined predefined_;
+};
+
+}  // namespace cncd::interp

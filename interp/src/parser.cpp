@@ -1,0 +1,565 @@
+#include "parser.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <numbers>
+
+#include "failure.hpp"
+
+namespace cncd::interp {
+namespace {
+
+enum class Op : int {
+  none,
+  power,
+  times,
+  divide,
+  mod,
+  plus,
+  minus,
+  eq,
+  ne,
+  gt,
+  ge,
+  lt,
+  le,
+  and_,
+  or_,
+  xor_
+};
+
+// LinuxCNC's precedence: ** > * / MOD > + - > comparisons > AND OR XOR; all left-associative.
+int precedence(Op op) {
+  switch (op) {
+    case Op::power:
+      return 5;
+    case Op::times:
+    case Op::divide:
+    case Op::mod:
+      return 4;
+    case Op::plus:
+    case Op::minus:
+      return 3;
+    case Op::eq:
+    case Op::ne:
+    case Op::gt:
+    case Op::ge:
+    case Op::lt:
+    case Op::le:
+      return 2;
+    case Op::and_:
+    case Op::or_:
+    case Op::xor_:
+      return 1;
+    case Op::none:
+      break;
+  }
+  return 0;
+}
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+// LinuxCNC compares with this tolerance in EQ/NE/.. and when a real must be an integer.
+constexpr double kTolerance = 0.0001;
+
+bool is_alpha(char c) {
+  return c >= 'a' && c <= 'z';
+}
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
+
+}  // namespace
+
+int BlockParser::column() const {
+  if (pos_ < columns_.size()) return columns_[pos_];
+  return columns_.empty() ? 1 : columns_.back() + 1;
+}
+
+void BlockParser::error(std::string message) const {
+  fail(std::move(message), column());
+}
+
+void BlockParser::normalize(std::string_view line) {
+  text_.clear();
+  columns_.clear();
+  bool in_comment = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    char c = line[i];
+    const int col = static_cast<int>(i) + 1;
+    if (in_comment) {
+      if (c == ')') in_comment = false;
+      text_.push_back(c);
+      columns_.push_back(col);
+      continue;
+    }
+    if (c == ';') {
+      // The rest of the line is a comment; keep it verbatim behind a marker.
+      text_.append(line.substr(i));
+      for (std::size_t k = i; k < line.size(); ++k)
+        columns_.push_back(static_cast<int>(k) + 1);
+      return;
+    }
+    if (c == ' ' || c == '\t') continue;
+    if (c == '(') in_comment = true;
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    text_.push_back(c);
+    columns_.push_back(col);
+  }
+}
+
+void BlockParser::parse(std::string_view line, Block& block) {
+  block.clear();
+  normalize(line);
+  pos_ = 0;
+  if (peek() == '/') {
+    block.block_delete = true;
+    ++pos_;
+  }
+  while (pos_ < text_.size())
+    read_word(block);
+}
+
+void BlockParser::read_comment(Block& block) {
+  const bool semicolon = peek() == ';';
+  const int start_column = column();
+  ++pos_;
+  comment_raw_.clear();
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (!semicolon && c == ')') break;
+    if (!semicolon && c == '(') error("Nested comment found");
+    comment_raw_.push_back(c);
+    ++pos_;
+  }
+  if (!semicolon) {
+    if (pos_ >= text_.size()) fail("Unclosed comment found", start_column);
+    ++pos_;
+  }
+  const auto index = static_cast<std::size_t>(block.comment_count++);
+  if (block.comments.size() <= index) block.comments.emplace_back();
+  block.comments[index] = comment_raw_;
+}
+
+void BlockParser::read_word(Block& block) {
+  const char c = peek();
+  const int col = column();
+  if (c == '(' || c == ';') {
+    read_comment(block);
+    return;
+  }
+  if (c == '#') {
+    read_assignment(block);
+    return;
+  }
+  if (!is_alpha(c)) {
+    error(std::string("Bad character '") + c + "' used");
+  }
+  ++pos_;
+  switch (c) {
+    case 'g':
+      read_g(block, col);
+      return;
+    case 'm':
+      read_m(block, col);
+      return;
+    case 'o':
+      read_o(block, col);
+      return;
+    case 'n': {
+      if (block.has_line_number) fail("Multiple n words on one line", col);
+      block.has_line_number = true;
+      block.line_number = read_real_value();
+      return;
+    }
+    case 'e':
+      fail("Unknown word starting with e", col);
+    default:
+      break;
+  }
+  const auto index = static_cast<std::size_t>(c - 'a');
+  if (block.present & (1U << index)) {
+    fail(std::string("Multiple ") + c + " words on one line", col);
+  }
+  const double value = read_real_value();
+  block.present |= 1U << index;
+  block.value[index] = value;
+  block.column[index] = col;
+}
+
+void BlockParser::read_g(Block& block, int col) {
+  const double value = read_real_value();
+  const double scaled = value * 10.0;
+  const double code = std::nearbyint(scaled);
+  if (std::fabs(scaled - code) > kTolerance * 10.0 || code < 0 || code > 999) {
+    fail("Unknown g code used", col);
+  }
+  const int number = static_cast<int>(code);
+  const CodeInfo info = g_code_info(number);
+  if (info.group < 0) fail("Unknown g code used", col);
+  const auto group = static_cast<std::size_t>(info.group);
+  if (block.g[group] != -1) fail("Two g codes used from same modal group", col);
+  block.g[group] = number;
+  block.g_column[group] = col;
+}
+
+void BlockParser::read_m(Block& block, int col) {
+  const int number = read_integer_value();
+  const CodeInfo info = m_code_info(number);
+  if (info.group < 0) fail("Unknown m code used", col);
+  const auto group = static_cast<std::size_t>(info.group);
+  if (block.m[group] != -1) fail("Two m codes used from same modal group", col);
+  if (++block.m_count > 4) fail("Too many m codes on line", col);
+  block.m[group] = number;
+  block.m_column[group] = col;
+}
+
+void BlockParser::read_o(Block& block, int col) {
+  block.o_column = col;
+  block.o_name.clear();
+  if (peek() == '<') {
+    ++pos_;
+    while (pos_ < text_.size() && text_[pos_] != '>')
+      block.o_name.push_back(text_[pos_++]);
+    if (peek() != '>') error("Named parameter not terminated");
+    ++pos_;
+  } else {
+    if (!is_digit(peek())) error("Bad format of o-word");
+    while (is_digit(peek()))
+      block.o_name.push_back(text_[pos_++]);
+  }
+  std::string keyword;
+  while (is_alpha(peek()))
+    keyword.push_back(text_[pos_++]);
+  struct Entry {
+    const char* word;
+    OKind kind;
+  };
+  static constexpr Entry kWords[] = {
+      {"sub", OKind::sub},        {"endsub", OKind::endsub}, {"call", OKind::call},
+      {"do", OKind::do_},         {"while", OKind::while_},  {"endwhile", OKind::endwhile},
+      {"if", OKind::if_},         {"elseif", OKind::elseif}, {"else", OKind::else_},
+      {"endif", OKind::endif},    {"break", OKind::break_},  {"continue", OKind::continue_},
+      {"return", OKind::return_}, {"repeat", OKind::repeat}, {"endrepeat", OKind::endrepeat},
+  };
+  block.o_kind = OKind::none;
+  for (const auto& entry : kWords) {
+    if (keyword == entry.word) block.o_kind = entry.kind;
+  }
+  if (block.o_kind == OKind::none) fail("Unknown word where unary operation could be", col);
+  switch (block.o_kind) {
+    case OKind::call:
+      while (peek() == '[')
+        block.call_args.push_back(read_expression());
+      break;
+    case OKind::while_:
+    case OKind::if_:
+    case OKind::elseif:
+    case OKind::repeat:
+      if (peek() != '[') error("Left bracket missing after o-word keyword");
+      block.o_value = read_expression();
+      block.has_o_value = true;
+      break;
+    case OKind::return_:
+    case OKind::endsub:
+      if (peek() == '[') {
+        block.o_value = read_expression();
+        block.has_o_value = true;
+      }
+      break;
+    default:
+      break;
+  }
+}
+
+void BlockParser::read_assignment(Block& block) {
+  ++pos_;  // '#'
+  if (peek() == '<') {
+    read_name(name_);
+    if (peek() != '=') error("Equal sign missing in parameter setting");
+    ++pos_;
+    const double value = read_real_value();
+    const auto index = static_cast<std::size_t>(block.named_assignment_count++);
+    if (block.named_assignments.size() <= index) block.named_assignments.emplace_back();
+    block.named_assignments[index].first = name_;
+    block.named_assignments[index].second = value;
+    return;
+  }
+  const int number = read_parameter_index();
+  if (peek() != '=') error("Equal sign missing in parameter setting");
+  ++pos_;
+  const double value = read_real_value();
+  block.numbered_assignments.emplace_back(number, value);
+}
+
+void BlockParser::read_name(std::string& name) {
+  ++pos_;  // '<'
+  name.clear();
+  while (pos_ < text_.size() && text_[pos_] != '>')
+    name.push_back(text_[pos_++]);
+  if (peek() != '>') error("Named parameter not terminated");
+  ++pos_;
+}
+
+int BlockParser::read_parameter_index() {
+  const int col = column();
+  const int number = read_integer_value();
+  if (number < 1 || number >= kMaxParameter) fail("Parameter number out of range", col);
+  return number;
+}
+
+double BlockParser::read_parameter_value() {
+  ++pos_;  // '#'
+  if (peek() == '<') {
+    const int col = column();
+    read_name(name_);
+    const auto value = parameters_.get_named(name_);
+    if (!value) fail("Named parameter #<" + name_ + "> not defined", col);
+    return *value;
+  }
+  return parameters_.get(read_parameter_index());
+}
+
+int BlockParser::read_integer_value() {
+  const int col = column();
+  const double value = read_real_value();
+  const double rounded = std::nearbyint(value);
+  if (std::fabs(value - rounded) > kTolerance || std::fabs(rounded) > 2e9) {
+    fail("Non-integer value for integer", col);
+  }
+  return static_cast<int>(rounded);
+}
+
+double BlockParser::read_real_value() {
+  const char c = peek();
+  if (c == '[') return read_expression();
+  if (c == '#') return read_parameter_value();
+  if (is_alpha(c)) return read_unary(column());
+  if ((c == '-' || c == '+') && (peek_at(1) == '[' || peek_at(1) == '#' || is_alpha(peek_at(1)))) {
+    ++pos_;
+    const double value = read_real_value();
+    return c == '-' ? -value : value;
+  }
+  return read_number();
+}
+
+double BlockParser::read_number() {
+  const std::size_t start = pos_;
+  bool negative = false;
+  if (peek() == '-' || peek() == '+') {
+    negative = peek() == '-';
+    ++pos_;
+  }
+  const std::size_t digits_start = pos_;
+  bool seen_digit = false;
+  bool seen_point = false;
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (is_digit(c)) {
+      seen_digit = true;
+    } else if (c == '.' && !seen_point) {
+      seen_point = true;
+    } else {
+      break;
+    }
+    ++pos_;
+  }
+  if (!seen_digit) {
+    pos_ = start;
+    error("Bad number format");
+  }
+  double value = 0;
+  const char* first = text_.data() + digits_start;
+  const char* last = text_.data() + pos_;
+  if (*first == '.') {
+    // from_chars needs a digit before the point: ".5" is parsed as the fraction alone.
+    const auto result = std::from_chars(first, last, value);
+    if (result.ec != std::errc()) {
+      std::string padded = "0";
+      padded.append(first, last);
+      std::from_chars(padded.data(), padded.data() + padded.size(), value);
+    }
+  } else {
+    std::from_chars(first, last, value);
+  }
+  return negative ? -value : value;
+}
+
+int BlockParser::read_binary_operator() {
+  auto match = [this](const char* word) {
+    std::size_t n = 0;
+    while (word[n] != '\0') {
+      if (peek_at(n) != word[n]) return false;
+      ++n;
+    }
+    pos_ += n;
+    return true;
+  };
+  const char c = peek();
+  switch (c) {
+    case '*':
+      ++pos_;
+      if (peek() == '*') {
+        ++pos_;
+        return static_cast<int>(Op::power);
+      }
+      return static_cast<int>(Op::times);
+    case '/':
+      ++pos_;
+      return static_cast<int>(Op::divide);
+    case '+':
+      ++pos_;
+      return static_cast<int>(Op::plus);
+    case '-':
+      ++pos_;
+      return static_cast<int>(Op::minus);
+    default:
+      break;
+  }
+  static constexpr std::pair<const char*, Op> kWords[] = {
+      {"mod", Op::mod}, {"eq", Op::eq}, {"ne", Op::ne},    {"gt", Op::gt},  {"ge", Op::ge},
+      {"lt", Op::lt},   {"le", Op::le}, {"and", Op::and_}, {"or", Op::or_}, {"xor", Op::xor_},
+  };
+  for (const auto& [word, op] : kWords) {
+    if (match(word)) return static_cast<int>(op);
+  }
+  if (c == '\0') error("Unclosed expression");
+  error("Unknown operation");
+}
+
+namespace {
+double apply(Op op, double left, double right, int column) {
+  switch (op) {
+    case Op::power:
+      if (left < 0.0 && std::floor(right) != right) {
+        fail("Attempt to raise negative to non-integer power", column);
+      }
+      return std::pow(left, right);
+    case Op::times:
+      return left * right;
+    case Op::divide:
+      if (right == 0.0) fail("Attempt to divide by zero", column);
+      return left / right;
+    case Op::mod: {
+      if (right == 0.0) fail("Attempt to divide by zero", column);
+      double result = std::fmod(left, right);
+      if (result < 0.0) result += std::fabs(right);
+      return result;
+    }
+    case Op::plus:
+      return left + right;
+    case Op::minus:
+      return left - right;
+    case Op::eq:
+      return std::fabs(left - right) < kTolerance ? 1.0 : 0.0;
+    case Op::ne:
+      return std::fabs(left - right) >= kTolerance ? 1.0 : 0.0;
+    case Op::gt:
+      return left > right ? 1.0 : 0.0;
+    case Op::ge:
+      return left >= right ? 1.0 : 0.0;
+    case Op::lt:
+      return left < right ? 1.0 : 0.0;
+    case Op::le:
+      return left <= right ? 1.0 : 0.0;
+    case Op::and_:
+      return (left == 0.0 || right == 0.0) ? 0.0 : 1.0;
+    case Op::or_:
+      return (left != 0.0 || right != 0.0) ? 1.0 : 0.0;
+    case Op::xor_:
+      return ((left == 0.0) != (right == 0.0)) ? 1.0 : 0.0;
+    case Op::none:
+      break;
+  }
+  return 0.0;
+}
+}  // namespace
+
+double BlockParser::read_expression() {
+  ++pos_;  // '['
+  // Operator-precedence evaluation with explicit stacks (expressions nest via read_real_value).
+  constexpr int kMaxDepth = 16;
+  double values[kMaxDepth];
+  Op ops[kMaxDepth];
+  int op_columns[kMaxDepth];
+  int top = 0;
+  values[0] = read_real_value();
+  for (;;) {
+    if (peek() == ']') {
+      ++pos_;
+      while (top > 0) {
+        values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+        --top;
+      }
+      return values[0];
+    }
+    const int col = column();
+    const Op op = static_cast<Op>(read_binary_operator());
+    while (top > 0 && precedence(ops[top - 1]) >= precedence(op)) {
+      values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+      --top;
+    }
+    if (top + 1 >= kMaxDepth) error("Expression too complex");
+    ops[top] = op;
+    op_columns[top] = col;
+    values[++top] = read_real_value();
+  }
+}
+
+double BlockParser::read_unary(int col) {
+  std::string_view rest(text_.data() + pos_, text_.size() - pos_);
+  static constexpr const char* kNames[] = {"abs", "acos", "asin",  "atan", "cos",  "exp", "fix",
+                                           "fup", "ln",   "round", "sin",  "sqrt", "tan", "exists"};
+  std::string_view name;
+  for (const char* candidate : kNames) {
+    const std::string_view word(candidate);
+    if (rest.substr(0, word.size()) == word && rest.size() > word.size() &&
+        rest[word.size()] == '[') {
+      if (word.size() > name.size()) name = word;
+    }
+  }
+  if (name.empty()) fail("Unknown word where unary operation could be", col);
+  pos_ += name.size();
+  if (name == "exists") {
+    ++pos_;  // '['
+    if (peek() != '#' || peek_at(1) != '<') error("Named parameter expected in EXISTS");
+    ++pos_;
+    read_name(name_);
+    if (peek() != ']') error("Right bracket missing after EXISTS argument");
+    ++pos_;
+    return parameters_.exists_named(name_) ? 1.0 : 0.0;
+  }
+  const double arg = read_expression();
+  if (name == "atan") {
+    if (peek() != '/') error("Slash missing after first atan argument");
+    ++pos_;
+    if (peek() != '[') error("Left bracket missing after slash with atan");
+    const double x = read_expression();
+    return std::atan2(arg, x) / kDegree;
+  }
+  if (name == "abs") return std::fabs(arg);
+  if (name == "acos") {
+    if (arg < -1.0 || arg > 1.0) fail("Argument to acos out of range", col);
+    return std::acos(arg) / kDegree;
+  }
+  if (name == "asin") {
+    if (arg < -1.0 || arg > 1.0) fail("Argument to asin out of range", col);
+    return std::asin(arg) / kDegree;
+  }
+  if (name == "cos") return std::cos(arg * kDegree);
+  if (name == "exp") return std::exp(arg);
+  if (name == "fix") return std::floor(arg);
+  if (name == "fup") return std::ceil(arg);
+  if (name == "ln") {
+    if (arg <= 0.0) fail("Zero or negative argument to ln", col);
+    return std::log(arg);
+  }
+  if (name == "round") return std::round(arg);
+  if (name == "sin") return std::sin(arg * kDegree);
+  if (name == "sqrt") {
+    if (arg < 0.0) fail("Negative argument to sqrt", col);
+    return std::sqrt(arg);
+  }
+  return std::tan(arg * kDegree);
+}
+
+}  // namespace cncd::interp

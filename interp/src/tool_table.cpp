@@ -1,0 +1,77 @@
+#include "tool_table.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <fstream>
+
+namespace cncd::interp {
+
+std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return "Unable to open tool table: " + path.string();
+  std::string text;
+  int line_number = 0;
+  while (std::getline(in, text)) {
+    ++line_number;
+    const auto semicolon = text.find(';');
+    if (semicolon != std::string::npos) text.resize(semicolon);
+    ToolEntry entry;
+    bool has_tool = false;
+    std::size_t i = 0;
+    while (i < text.size()) {
+      const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
+      if (std::isspace(static_cast<unsigned char>(text[i]))) {
+        ++i;
+        continue;
+      }
+      std::size_t end = i + 1;
+      while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end])))
+        ++end;
+      double value = 0;
+      const char* first = text.data() + i + 1;
+      if (first < text.data() + end && *first == '+') ++first;
+      const auto result = std::from_chars(first, text.data() + end, value);
+      if (result.ec != std::errc() || result.ptr != text.data() + end) {
+        return path.string() + ":" + std::to_string(line_number) + ": bad value '" +
+               text.substr(i, end - i) + "'";
+      }
+      const char* axes = "XYZABCUVW";
+      for (int axis = 0; axis < kAxes; ++axis) {
+        if (letter == axes[axis]) entry.offset[static_cast<std::size_t>(axis)] = value;
+      }
+      switch (letter) {
+        case 'T':
+          entry.number = static_cast<int>(value);
+          has_tool = true;
+          break;
+        case 'P':
+          entry.pocket = static_cast<int>(value);
+          break;
+        case 'D':
+          entry.diameter = value;
+          break;
+        case 'I':
+          entry.front_angle = value;
+          break;
+        case 'J':
+          entry.back_angle = value;
+          break;
+        case 'Q':
+          entry.orientation = static_cast<int>(value);
+          break;
+        default:
+          break;
+      }
+      i = end;
+    }
+    if (has_tool) tools_[entry.number] = entry;
+  }
+  return std::nullopt;
+}
+
+const ToolEntry* ToolTable::find(int number) const {
+  const auto it = tools_.find(number);
+  return it == tools_.end() ? nullptr : &it->second;
+}
+
+}  // namespace cncd::interp

@@ -1,0 +1,108 @@
+// Expressions, parameters and line syntax, checked through the canonical output.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/interp/rs274_printer.hpp"
+
+namespace cncd::interp {
+namespace {
+
+// Runs `line` after G0 and returns the X of the traverse it makes.
+double x_of(const std::string& expression) {
+  Interpreter interp;
+  EXPECT_FALSE(interp.open_string("G0 X" + expression + "\nM2\n", "expr.ngc"));
+  struct Sink final : CanonSink {
+    void emit(const CanonCommand& command) override {
+      if (command.kind == CanonKind::straight_traverse) x = command.pos[0];
+    }
+    double x = -999;
+  } sink;
+  const auto error = run_program(interp, sink);
+  EXPECT_FALSE(error) << (error ? error->to_string() : "");
+  return sink.x;
+}
+
+std::string error_of(const std::string& program) {
+  Interpreter interp;
+  EXPECT_FALSE(interp.open_string(program, "e.ngc"));
+  NullSink sink;
+  const auto error = run_program(interp, sink);
+  return error ? error->message : std::string();
+}
+
+TEST(Expressions, PrecedenceIsLinuxCncs) {
+  EXPECT_DOUBLE_EQ(x_of("[2**3+1*2 EQ 10]"), 1.0);
+  EXPECT_DOUBLE_EQ(x_of("[2**3**2]"), 64.0);  // left-associative
+  EXPECT_DOUBLE_EQ(x_of("[2 - 3 - 4]"), -5.0);
+  EXPECT_DOUBLE_EQ(x_of("[1 + 2 EQ 3]"), 1.0);
+  EXPECT_DOUBLE_EQ(x_of("[1 EQ 1.00001]"), 1.0);  // EQ compares with a tolerance
+}
+
+TEST(Expressions, ModTakesTheSignOfNothing) {
+  EXPECT_DOUBLE_EQ(x_of("[-7 MOD 3]"), 2.0);
+  EXPECT_DOUBLE_EQ(x_of("[7 MOD -3]"), 1.0);
+}
+
+TEST(Expressions, FunctionsWorkInDegrees) {
+  EXPECT_NEAR(x_of("sin[30]"), 0.5, 1e-12);
+  EXPECT_NEAR(x_of("[atan[1]/[1]]"), 45.0, 1e-12);
+  EXPECT_DOUBLE_EQ(x_of("[fix[-1.5]]"), -2.0);
+  EXPECT_DOUBLE_EQ(x_of("[fup[1.2]]"), 2.0);
+  EXPECT_DOUBLE_EQ(x_of("[round[2.5]]"), 3.0);
+  EXPECT_DOUBLE_EQ(x_of("[abs[-2]]"), 2.0);
+  EXPECT_DOUBLE_EQ(x_of("[sqrt[16]]"), 4.0);
+}
+
+TEST(Expressions, UnaryMinusBeforeParameterOrBracket) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("#1=2\nG0 X-#1 Y-[1+2]\nM2\n"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(-2.0000, -3.0000, 0.0000"), std::string::npos);
+}
+
+TEST(Parameters, AssignmentTakesEffectAfterTheLine) {
+  EXPECT_DOUBLE_EQ(x_of("#1"), 0.0);
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("#1=5 G0 X#1\nG0 Y#1\nM2\n"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000"), std::string::npos);
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(0.0000, 5.0000, 0.0000"), std::string::npos);
+}
+
+TEST(Errors, Wording) {
+  EXPECT_EQ(error_of("G0 X[1/0]\nM2\n"), "Attempt to divide by zero");
+  EXPECT_EQ(error_of("G0 G1 X1\nM2\n"), "Two g codes used from same modal group");
+  EXPECT_EQ(error_of("M3 M4\nM2\n"), "Two m codes used from same modal group");
+  EXPECT_EQ(error_of("G7.5\nM2\n"), "Unknown g code used");
+  EXPECT_EQ(error_of("F-1\nM2\n"), "Negative f word used");
+  EXPECT_EQ(error_of("X1\nM2\n"), "Cannot use axis values without a g code that uses them");
+}
+
+TEST(Errors, UnsupportedFeaturesAreRejected) {
+  EXPECT_EQ(error_of("G41 D1\nM2\n"), "G41 is not supported");
+  EXPECT_EQ(error_of("G33 Z-1 K1\nM2\n"), "G33 is not supported");
+  EXPECT_EQ(error_of("G38.2 Z-1 F1\nM2\n"), "G38.2 is not supported");
+  EXPECT_EQ(error_of("G76 P1 Z-1\nM2\n"), "G76 is not supported");
+  EXPECT_EQ(error_of("G5.1 X1 I1\nM2\n"), "G5.1 is not supported");
+}
+
+TEST(Comments, LastCommentOfALineAndMessages) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("(first)(second)\n(MSG, Hello There)\nG0 X1 ; trailing\nM2\n"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("COMMENT(\"second\")"), std::string::npos);
+  EXPECT_EQ(out.str().find("COMMENT(\"first\")"), std::string::npos);
+  EXPECT_NE(out.str().find("MESSAGE(\" Hello There\")"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cncd::interp
