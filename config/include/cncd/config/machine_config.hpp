@@ -5,12 +5,15 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace cncd::config {
+
+class IniFile;
 
 // Axis letters in LinuxCNC's canonical order; an axis index is a position in this string.
 inline constexpr std::string_view kAxisLetters = "XYZABCUVW";
@@ -31,44 +34,51 @@ struct SourceRef {
 };
 
 struct AxisConfig {
-  bool present = false;           // letter appears in [TRAJ] COORDINATES
-  double min_limit = -1e99;       // machine units (mm, inch or degrees)
+  bool present = false;      // letter appears in [TRAJ] COORDINATES
+  double min_limit = -1e99;  // machine units (mm, inch or degrees)
   double max_limit = 1e99;
-  double max_velocity = 0;        // units/s
-  double max_acceleration = 0;    // units/s^2
-  double max_jerk = 0;            // units/s^3, 0 = unlimited
+  double max_velocity = 0;      // units/s
+  double max_acceleration = 0;  // units/s^2
+  double max_jerk = 0;          // units/s^3, 0 = unlimited
   SourceRef source;
 };
 
 struct JointConfig {
   JointType type = JointType::linear;
-  char axis = 'X';                // the axis this joint drives (trivkins, from COORDINATES)
-  double min_limit = -1e99;       // joint units
+  // The axis this joint drives (trivkins joint map); '\0' for an extra joint that no axis
+  // drives (LinuxCNC's num_extrajoints, or joints beyond the trivkins coordinates= letters).
+  char axis = 'X';
+  double min_limit = -1e99;  // joint units
   double max_limit = 1e99;
-  double max_velocity = 0;        // units/s
-  double max_acceleration = 0;    // units/s^2
-  double ferror = 1;              // following error limit at max velocity
-  double min_ferror = 0.25;       // following error limit at standstill
+  double max_velocity = 0;      // units/s
+  double max_acceleration = 0;  // units/s^2
+  double ferror = 1;            // following error limit at max velocity
+  double min_ferror = 0.25;     // following error limit at standstill (INI default: FERROR)
   double backlash = 0;
   // Homing, LinuxCNC semantics: HOME_SEARCH_VEL = 0 homes immediately at the current position.
   double home = 0;
   double home_offset = 0;
   double home_search_vel = 0;
   double home_latch_vel = 0;
-  double home_final_vel = -1;     // < 0: move to HOME at max velocity
-  int home_sequence = -1;         // < 0: not part of a "home all"
+  double home_final_vel = -1;  // < 0: move to HOME at max velocity
+  int home_sequence = -1;      // < 0: not part of a "home all"
+  // HOME_SEQUENCE was written negative: LinuxCNC's synchronised homing, all joints with the
+  // same |HOME_SEQUENCE| (home_sequence holds that absolute value) home and finish together.
+  bool home_sequence_sync = false;
+  bool home_index_no_encoder_reset = false;
+  bool locking_indexer = false;
   bool home_use_index = false;
   bool home_ignore_limits = false;
   bool home_is_shared = false;
-  bool home_absolute_encoder = false;
+  bool home_absolute_encoder = false;  // HOME_ABSOLUTE_ENCODER 1 or 2
   bool volatile_home = false;
   // Scaling: steps or counts per unit. SCALE is the stepgen/driver key, INPUT/OUTPUT_SCALE the
   // encoder/DAC keys of servo configs; 0 = not given.
   double scale = 0;
   double input_scale = 0;
   double output_scale = 0;
-  std::string driver = "sim";     // DRIVER: sim | gpio | modbus
-  SourceRef source;               // the [JOINT_n] header
+  std::string driver = "sim";  // DRIVER: sim | gpio | modbus
+  SourceRef source;            // the [JOINT_n] header
 };
 
 struct CncdConfig {
@@ -81,8 +91,8 @@ struct CncdConfig {
 };
 
 struct MachineConfig {
-  std::filesystem::path path;     // the INI file as given
-  std::string machine_name;       // [EMC] MACHINE
+  std::filesystem::path path;  // the INI file as given
+  std::string machine_name;    // [EMC] MACHINE
   // [EMCMOT]
   std::int64_t servo_period_ns = 1'000'000;
   std::int64_t base_period_ns = 0;  // 0 = no base thread
@@ -95,26 +105,35 @@ struct MachineConfig {
   // [EMCIO]
   std::filesystem::path tool_table;
   // [TRAJ]
-  std::string coordinates = "XYZ";  // one letter a joint, e.g. "XYYZ" for a gantry
+  // [TRAJ] COORDINATES without blanks, upper case: the axes the machine has, a letter repeated
+  // for every joint of a gantry ("XYYZ"). Which joint drives which axis is JointConfig::axis.
+  std::string coordinates = "XYZ";
   LinearUnits linear_units = LinearUnits::mm;
   AngularUnits angular_units = AngularUnits::degree;
   double default_linear_velocity = 0;  // units/s
   double max_linear_velocity = 0;      // units/s
   double default_linear_acceleration = 0;
   double max_linear_acceleration = 0;
-  double max_linear_jerk = 0;          // units/s^3, 0 = unlimited
+  double max_linear_jerk = 0;  // units/s^3, 0 = unlimited
   std::filesystem::path position_file;
   bool no_force_homing = false;
   // [KINS]
-  std::string kinematics = "trivkins";
+  std::string kinematics = "trivkins";  // module name only, e.g. "trivkins"
+  std::string kinematics_args;          // the rest, e.g. "coordinates=XYYZ kinstype=both"
   int joint_count = 0;
+  int extra_joints = 0;  // [EMCMOT] EMCMOT = motmod num_extrajoints=N
   // [DISPLAY]
-  double max_feed_override = 1.0;      // 1.0 = 100 %
+  double max_feed_override = 1.0;         // 1.0 = 100 %
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
+  // Every key of the file with its source, for lookups of keys this struct does not type
+  // (e.g. [DISPLAY] PROGRAM_PREFIX) and to list unused keys. Null when built by hand.
+  std::shared_ptr<const IniFile> ini;
 
-  const AxisConfig& axis(char letter) const { return axes[static_cast<std::size_t>(axis_index(letter))]; }
+  const AxisConfig& axis(char letter) const {
+    return axes[static_cast<std::size_t>(axis_index(letter))];
+  }
   // Millimetres per machine linear unit (1 or 25.4).
   double mm_per_unit() const { return linear_units == LinearUnits::inch ? 25.4 : 1.0; }
 };
@@ -122,9 +141,9 @@ struct MachineConfig {
 // One problem found while reading or validating; printed as "FILE:LINE: [SECTION] KEY: message".
 struct Problem {
   std::string file;
-  int line = 0;          // 0 = no line (e.g. missing file)
-  std::string section;   // without brackets, may be empty
-  std::string key;       // may be empty
+  int line = 0;         // 0 = no line (e.g. missing file)
+  std::string section;  // without brackets, may be empty
+  std::string key;      // may be empty
   std::string message;
   std::string to_string() const;
 };
@@ -132,6 +151,9 @@ struct Problem {
 struct LoadResult {
   std::optional<MachineConfig> config;  // set only when problems is empty
   std::vector<Problem> problems;        // every problem found, in file order
+  // Things LinuxCNC tolerates but a machinist should hear about (missing include, defaults
+  // used for unspecified velocities, ignored lines); never a reason to refuse the file.
+  std::vector<Problem> warnings;
   bool ok() const { return config.has_value(); }
 };
 

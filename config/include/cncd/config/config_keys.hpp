@@ -1,0 +1,40 @@
+// The one table of every INI key cncd interprets: its type, default, range, unit and meaning.
+// load_machine_config reads values only through this table, so the ranges enforced and the
+// help printed can never drift apart.
+#pragma once
+
+#include <span>
+#include <string_view>
+
+namespace cncd::config {
+
+enum class KeyType {
+  real,       // decimal number; nan/inf/out of double range are rejected
+  integer,    // whole number (1000000 or 1e6)
+  boolean,    // 1/0, TRUE/FALSE, YES/NO, ON/OFF, any case
+  text,       // free text, kept verbatim
+  path,       // file name, resolved relative to the INI file's directory
+  path_list,  // colon-separated list of paths
+  choice,     // one of `choices` (separated by '|'), any case
+};
+
+struct KeySpec {
+  std::string_view section;  // "TRAJ"; "JOINT_n" / "AXIS_L" stand for every joint / axis
+  std::string_view key;
+  KeyType type;
+  std::string_view default_value;  // as it would be written in the INI; empty: see help
+  double min;                      // inclusive unless min_exclusive (real and integer only)
+  double max;                      // inclusive
+  bool min_exclusive;
+  std::string_view unit;     // "ns", "s", "units/s" ... ("units" = LINEAR/ANGULAR_UNITS)
+  std::string_view choices;  // for KeyType::choice
+  std::string_view help;
+};
+
+std::span<const KeySpec> key_table();
+
+// The spec for a key, with [JOINT_3] matched by "JOINT_n" and [AXIS_Y] by "AXIS_L";
+// nullptr when cncd does not interpret the key.
+const KeySpec* find_key_spec(std::string_view section, std::string_view key);
+
+}  // namespace cncd::config

@@ -1,0 +1,124 @@
+#include <cstdio>
+#include <string>
+
+#include "cncd/config/machine_config.hpp"
+
+namespace cncd::config {
+namespace {
+
+std::string num(double value) {
+  if (value <= -1e99) return "-inf";
+  if (value >= 1e99) return "+inf";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", value);
+  return buffer;
+}
+
+std::string or_none(const std::filesystem::path& path) {
+  return path.empty() ? std::string("(none)") : path.string();
+}
+
+std::string or_none(const std::string& text) {
+  return text.empty() ? std::string("(none)") : text;
+}
+
+const char* linear_name(LinearUnits units) {
+  return units == LinearUnits::inch ? "inch" : "mm";
+}
+
+const char* angular_name(AngularUnits units) {
+  switch (units) {
+    case AngularUnits::radian:
+      return "radian";
+    case AngularUnits::grad:
+      return "grad";
+    case AngularUnits::degree:
+      break;
+  }
+  return "degree";
+}
+
+void line(std::string& out, const std::string& text) {
+  out += text + "\n";
+}
+
+}  // namespace
+
+std::string describe(const MachineConfig& c) {
+  std::string out;
+  const std::string lu = linear_name(c.linear_units);
+  const std::string au = angular_name(c.angular_units);
+  line(out, "Machine:      " + or_none(c.machine_name));
+  line(out, "File:         " + c.path.string());
+  line(out, "Units:        linear " + lu + ", angular " + au);
+  line(out, "Servo period: " + std::to_string(c.servo_period_ns) + " ns (" +
+                num(1e9 / static_cast<double>(c.servo_period_ns)) + " Hz)");
+  line(out, "Base period:  " +
+                (c.base_period_ns > 0 ? std::to_string(c.base_period_ns) + " ns" : "none"));
+  line(out, "Task cycle:   " + num(c.task_cycle_time_s) + " s");
+  line(out, "Kinematics:   " + c.kinematics +
+                (c.kinematics_args.empty() ? "" : " " + c.kinematics_args));
+  line(out, "Coordinates:  " + c.coordinates + " (" + std::to_string(c.joint_count) + " joints" +
+                (c.extra_joints > 0 ? ", " + std::to_string(c.extra_joints) + " extra" : "") + ")");
+  line(out, "Trajectory:   max velocity " + num(c.max_linear_velocity) + " " + lu +
+                "/s, max acceleration " + num(c.max_linear_acceleration) + " " + lu +
+                "/s^2, default velocity " + num(c.default_linear_velocity) + " " + lu + "/s" +
+                (c.max_linear_jerk > 0 ? ", max jerk " + num(c.max_linear_jerk) : ""));
+  line(out, "Homing:       " + std::string(c.no_force_homing ? "not required before programs"
+                                                             : "required before programs"));
+  line(out, "Feed override: up to " + num(c.max_feed_override * 100) + " %");
+  line(out, "Parameters:   " + or_none(c.parameter_file));
+  line(out, "Tool table:   " + or_none(c.tool_table));
+  line(out, "Positions:    " + or_none(c.position_file));
+  if (!c.startup_code.empty()) line(out, "Startup code: " + c.startup_code);
+  for (const auto& dir : c.subroutine_path)
+    line(out, "Subroutines:  " + dir.string());
+
+  line(out, "Axes:");
+  for (std::size_t i = 0; i < c.axes.size(); ++i) {
+    const AxisConfig& a = c.axes[i];
+    if (!a.present) continue;
+    const char letter = kAxisLetters[i];
+    const std::string u = std::string_view("ABC").find(letter) != std::string_view::npos ? au : lu;
+    line(out, std::string("  ") + letter + ": limits " + num(a.min_limit) + " .. " +
+                  num(a.max_limit) + " " + u + ", max velocity " + num(a.max_velocity) + " " + u +
+                  "/s, max acceleration " + num(a.max_acceleration) + " " + u + "/s^2" +
+                  (a.max_jerk > 0 ? ", max jerk " + num(a.max_jerk) + " " + u + "/s^3" : ""));
+  }
+  line(out, "Joints:");
+  for (std::size_t i = 0; i < c.joints.size(); ++i) {
+    const JointConfig& j = c.joints[i];
+    const bool angular = j.type == JointType::angular;
+    const std::string u = angular ? au : lu;
+    const std::string axis =
+        j.axis == '\0' ? std::string("none (extra joint)") : std::string(1, j.axis);
+    std::string home = "home " + num(j.home) + " " + u + ", ";
+    if (j.home_search_vel == 0) {
+      home += "homes where it stands";
+    } else {
+      home += "search " + num(j.home_search_vel) + " latch " + num(j.home_latch_vel) + " " + u +
+              "/s, offset " + num(j.home_offset);
+    }
+    home += ", sequence " + (j.home_sequence < 0 ? std::string("none")
+                                                 : (j.home_sequence_sync ? "-" : "") +
+                                                       std::to_string(j.home_sequence));
+    line(out, "  " + std::to_string(i) + ": axis " + axis + ", " +
+                  (angular ? "angular" : "linear") + ", driver " + j.driver);
+    line(out, "     limits " + num(j.min_limit) + " .. " + num(j.max_limit) + " " + u +
+                  ", max velocity " + num(j.max_velocity) + " " + u + "/s, max acceleration " +
+                  num(j.max_acceleration) + " " + u + "/s^2");
+    line(out, "     ferror " + num(j.ferror) + " (standstill " + num(j.min_ferror) + ") " + u +
+                  (j.backlash > 0 ? ", backlash " + num(j.backlash) : "") +
+                  (j.scale != 0 ? ", scale " + num(j.scale) : ""));
+    line(out, "     " + home);
+  }
+  line(out, "cncd:");
+  line(out, "  socket " + c.cncd.socket_path + ", read group " + or_none(c.cncd.read_group) +
+                ", control group " + or_none(c.cncd.control_group));
+  line(out, "  RT priority " + std::to_string(c.cncd.rt_priority) + ", RT CPU " +
+                (c.cncd.rt_cpu < 0 ? std::string("any") : std::to_string(c.cncd.rt_cpu)) +
+                ", log level " + c.cncd.log_level);
+  return out;
+}
+
+}  // namespace cncd::config

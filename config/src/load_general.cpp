@@ -1,0 +1,154 @@
+#include <cmath>
+#include <numbers>
+
+#include "loader.hpp"
+#include "text.hpp"
+
+namespace cncd::config {
+namespace {
+
+bool near(double value, double target) {
+  return std::fabs(value - target) <= 1e-6 * target;
+}
+
+// LINEAR_UNITS may also be written as LinuxCNC's factor (machine units per mm).
+void load_linear_units(TypedReader& r, MachineConfig& c) {
+  double factor = 0;
+  if (const IniEntry* e = r.entry("TRAJ", "LINEAR_UNITS");
+      e != nullptr && parse_number(strip_trailing_comment(e->value), factor) == NumberError::none) {
+    if (near(factor, 1.0)) {
+      c.linear_units = LinearUnits::mm;
+    } else if (near(factor, 1.0 / 25.4)) {
+      c.linear_units = LinearUnits::inch;
+    } else {
+      r.problem(
+          "TRAJ", "LINEAR_UNITS",
+          "factor " + e->value + " is neither mm (1) nor inch (" + format_number(1.0 / 25.4) + ")");
+    }
+    return;
+  }
+  const auto units = r.choice("TRAJ", "LINEAR_UNITS");
+  if (!units) return;
+  c.linear_units = (*units == "mm" || *units == "metric") ? LinearUnits::mm : LinearUnits::inch;
+}
+
+void load_angular_units(TypedReader& r, MachineConfig& c) {
+  double factor = 0;
+  if (const IniEntry* e = r.entry("TRAJ", "ANGULAR_UNITS");
+      e != nullptr && parse_number(strip_trailing_comment(e->value), factor) == NumberError::none) {
+    if (near(factor, 1.0)) {
+      c.angular_units = AngularUnits::degree;
+    } else if (near(factor, std::numbers::pi / 180.0)) {
+      c.angular_units = AngularUnits::radian;
+    } else if (near(factor, 0.9)) {
+      c.angular_units = AngularUnits::grad;
+    } else {
+      r.problem("TRAJ", "ANGULAR_UNITS",
+                "factor " + e->value + " is none of degree (1), radian, grad (0.9)");
+    }
+    return;
+  }
+  const auto units = r.choice("TRAJ", "ANGULAR_UNITS");
+  if (!units) return;
+  if (*units == "degree" || *units == "deg") {
+    c.angular_units = AngularUnits::degree;
+  } else if (*units == "radian" || *units == "rad") {
+    c.angular_units = AngularUnits::radian;
+  } else {
+    c.angular_units = AngularUnits::grad;
+  }
+}
+
+void load_coordinates(TypedReader& r, MachineConfig& c) {
+  if (!r.given("TRAJ", "COORDINATES")) {
+    r.warning("TRAJ", "COORDINATES", "not given; XYZ assumed");
+  }
+  const std::string written = r.text("TRAJ", "COORDINATES").value_or("XYZ");
+  std::string letters;
+  for (const char ch : strip_trailing_comment(written)) {
+    if (ch == ' ' || ch == '\t') continue;
+    if (axis_index(ch) < 0) {
+      r.problem("TRAJ", "COORDINATES",
+                "'" + printable(written) + "': '" + printable(std::string(1, ch)) +
+                    "' is not an axis letter (" + std::string(kAxisLetters) + ")");
+      return;
+    }
+    letters += static_cast<char>(kAxisLetters[static_cast<std::size_t>(axis_index(ch))]);
+  }
+  if (letters.empty()) {
+    r.problem("TRAJ", "COORDINATES", "no axis letters given");
+    return;
+  }
+  if (letters.size() > static_cast<std::size_t>(kMaxJoints)) {
+    r.problem("TRAJ", "COORDINATES", "more than " + std::to_string(kMaxJoints) + " letters");
+    return;
+  }
+  c.coordinates = letters;
+}
+
+// `EMCMOT = motmod num_extrajoints=1`: extra joints are the last ones, driven by no axis.
+void load_extra_joints(TypedReader& r, MachineConfig& c) {
+  const std::string motmod = r.text("EMCMOT", "EMCMOT").value_or("");
+  const std::string_view marker = "num_extrajoints=";
+  const std::size_t at = motmod.find(marker);
+  if (at == std::string::npos) return;
+  const std::string_view rest = std::string_view(motmod).substr(at + marker.size());
+  double count = 0;
+  if (parse_number(rest.substr(0, rest.find_first_of(" \t")), count) != NumberError::none ||
+      count < 0 || count > kMaxJoints || std::trunc(count) != count) {
+    r.problem("EMCMOT", "EMCMOT",
+              "num_extrajoints must be a whole number 0.." + std::to_string(kMaxJoints));
+    return;
+  }
+  c.extra_joints = static_cast<int>(count);
+}
+
+void load_cncd(TypedReader& r, CncdConfig& cncd) {
+  if (const auto v = r.path("CNCD", "SOCKET")) cncd.socket_path = v->string();
+  cncd.read_group = std::string(strip_trailing_comment(r.text("CNCD", "READ_GROUP").value_or("")));
+  cncd.control_group =
+      std::string(strip_trailing_comment(r.text("CNCD", "CONTROL_GROUP").value_or("")));
+  if (const auto v = r.integer("CNCD", "RT_PRIORITY")) cncd.rt_priority = static_cast<int>(*v);
+  if (const auto v = r.integer("CNCD", "RT_CPU")) cncd.rt_cpu = static_cast<int>(*v);
+  if (const auto v = r.choice("CNCD", "LOG_LEVEL")) {
+    cncd.log_level = *v == "warning" ? "warn" : *v;
+  }
+  for (const auto& entry : r.ini().entries()) {
+    if (entry.section == "CNCD" && entry.section_occurrence == 0 &&
+        find_key_spec("CNCD", entry.key) == nullptr) {
+      r.problem("CNCD", entry.key, "unknown key in cncd's own section");
+    }
+  }
+}
+
+}  // namespace
+
+void load_general(TypedReader& r, MachineConfig& c) {
+  c.machine_name = r.text("EMC", "MACHINE").value_or("");
+  if (const auto v = r.integer("EMCMOT", "SERVO_PERIOD")) c.servo_period_ns = *v;
+  if (const auto v = r.integer("EMCMOT", "BASE_PERIOD")) c.base_period_ns = *v;
+  load_extra_joints(r, c);
+  if (const auto v = r.real("TASK", "CYCLE_TIME")) c.task_cycle_time_s = *v;
+
+  c.parameter_file = r.path("RS274NGC", "PARAMETER_FILE").value_or("");
+  c.startup_code = r.text("RS274NGC", "RS274NGC_STARTUP_CODE").value_or("");
+  c.subroutine_path = r.path_list("RS274NGC", "SUBROUTINE_PATH");
+  c.tool_table = r.path("EMCIO", "TOOL_TABLE").value_or("");
+
+  load_coordinates(r, c);
+  load_linear_units(r, c);
+  load_angular_units(r, c);
+  // Zero marks "not given": load_motion derives these from the axes.
+  c.default_linear_velocity = r.real("TRAJ", "DEFAULT_LINEAR_VELOCITY").value_or(0);
+  c.max_linear_velocity = r.real("TRAJ", "MAX_LINEAR_VELOCITY").value_or(0);
+  c.default_linear_acceleration = r.real("TRAJ", "DEFAULT_LINEAR_ACCELERATION").value_or(0);
+  c.max_linear_acceleration = r.real("TRAJ", "MAX_LINEAR_ACCELERATION").value_or(0);
+  c.max_linear_jerk = r.real("TRAJ", "MAX_LINEAR_JERK").value_or(0);
+  c.position_file = r.path("TRAJ", "POSITION_FILE").value_or("");
+  c.no_force_homing = r.boolean("TRAJ", "NO_FORCE_HOMING").value_or(false);
+
+  if (const auto v = r.real("DISPLAY", "MAX_FEED_OVERRIDE")) c.max_feed_override = *v;
+  load_cncd(r, c.cncd);
+}
+
+}  // namespace cncd::config

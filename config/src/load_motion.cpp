@@ -1,0 +1,246 @@
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "loader.hpp"
+#include "text.hpp"
+
+namespace cncd::config {
+namespace {
+
+std::string axis_section(char letter) {
+  return std::string("AXIS_") + letter;
+}
+std::string joint_section(int joint) {
+  return "JOINT_" + std::to_string(joint);
+}
+bool is_linear_axis(char letter) {
+  return std::string_view("XYZUVW").find(letter) != std::string_view::npos;
+}
+
+struct Kinematics {
+  bool ok = false;
+  std::string module;
+  std::string args;
+  std::string coordinates;  // trivkins coordinates= letters, upper case; empty: not given
+};
+
+Kinematics load_kinematics(TypedReader& r) {
+  Kinematics k;
+  const auto written = r.text("KINS", "KINEMATICS");
+  if (!written) {
+    r.problem("KINS", "KINEMATICS", "missing; write KINEMATICS = trivkins");
+    return k;
+  }
+  std::istringstream words{std::string(strip_trailing_comment(*written))};
+  words >> k.module;
+  if (k.module != "trivkins") {
+    r.problem("KINS", "KINEMATICS",
+              "kinematics '" + printable(k.module) + "' is not supported; cncd supports trivkins");
+    return k;
+  }
+  k.ok = true;
+  std::string word;
+  while (words >> word) {
+    k.args += (k.args.empty() ? "" : " ") + word;
+    const std::size_t equal = word.find('=');
+    const std::string name = to_lower(word.substr(0, equal));
+    const std::string value = equal == std::string::npos ? "" : word.substr(equal + 1);
+    if (name == "coordinates") {
+      for (const char ch : value) {
+        if (axis_index(ch) < 0) {
+          r.problem("KINS", "KINEMATICS",
+                    "coordinates=" + printable(value) + ": '" + printable(std::string(1, ch)) +
+                        "' is not an axis letter");
+          k.ok = false;
+          return k;
+        }
+      }
+      k.coordinates = to_upper(value);
+    } else if (name != "kinstype") {
+      r.warning("KINS", "KINEMATICS",
+                "unknown trivkins argument '" + printable(word) + "' ignored");
+    }
+  }
+  return k;
+}
+
+// Which axis each joint drives, as trivkins assigns them: the letters of coordinates= in
+// joint order; without it joint n drives the n-th of XYZABCUVW. A gantry written only in
+// [TRAJ] COORDINATES (XYYZ) is taken as that joint list, since identity cannot mean it.
+std::string joint_map(TypedReader& r, const Kinematics& k, MachineConfig& c) {
+  const std::string jstr = "JOINTS = " + std::to_string(c.joint_count);
+  const int kinematic_joints = c.joint_count - c.extra_joints;
+  std::set<char> distinct(c.coordinates.begin(), c.coordinates.end());
+  std::string map;
+  if (!k.coordinates.empty()) {
+    map = k.coordinates;
+    if (static_cast<int>(map.size()) > kinematic_joints) {
+      r.problem("KINS", "JOINTS",
+                jstr + " is too few: trivkins coordinates=" + map + " needs " +
+                    std::to_string(map.size() + c.extra_joints) + " joints");
+    }
+  } else if (distinct.size() != c.coordinates.size()) {
+    map = c.coordinates;
+    if (static_cast<int>(map.size()) != kinematic_joints) {
+      r.problem("KINS", "JOINTS",
+                jstr + " does not match COORDINATES " + c.coordinates + ", which names " +
+                    std::to_string(map.size()) + " joints");
+    }
+  } else {
+    map = std::string(kAxisLetters);
+    if (static_cast<int>(distinct.size()) > kinematic_joints) {
+      r.problem("KINS", "JOINTS",
+                jstr + " is too few for the " + std::to_string(distinct.size()) +
+                    " axes of COORDINATES " + c.coordinates);
+    }
+  }
+  if (static_cast<int>(map.size()) > kinematic_joints) map.resize(std::max(0, kinematic_joints));
+  for (const char letter : distinct) {
+    if (map.find(letter) == std::string::npos) {
+      r.warning("KINS", "KINEMATICS",
+                std::string("axis ") + letter + " in [TRAJ] COORDINATES is driven by no joint");
+    }
+  }
+  return map;
+}
+
+void load_axis(TypedReader& r, MachineConfig& c, char letter) {
+  const std::string s = axis_section(letter);
+  AxisConfig& axis = c.axes[static_cast<std::size_t>(axis_index(letter))];
+  axis.present = c.coordinates.find(letter) != std::string::npos;
+  axis.source = r.where(s, "");
+  if (!r.ini().has_section(s)) {
+    if (axis.present) {
+      r.warning(s, "",
+                "section missing; LinuxCNC defaults used (no soft limits, "
+                "MAX_VELOCITY 1, MAX_ACCELERATION 1)");
+    }
+  } else {
+    for (const auto* key : {"MAX_VELOCITY", "MAX_ACCELERATION"}) {
+      if (!r.given(s, key)) r.warning(s, key, "not given; LinuxCNC default 1 used");
+    }
+  }
+  if (const auto v = r.real(s, "MIN_LIMIT")) axis.min_limit = *v;
+  if (const auto v = r.real(s, "MAX_LIMIT")) axis.max_limit = *v;
+  if (const auto v = r.real(s, "MAX_VELOCITY")) axis.max_velocity = *v;
+  if (const auto v = r.real(s, "MAX_ACCELERATION")) axis.max_acceleration = *v;
+  if (const auto v = r.real(s, "MAX_JERK")) axis.max_jerk = *v;
+}
+
+void load_homing(TypedReader& r, const std::string& s, JointConfig& j) {
+  if (const auto v = r.real(s, "HOME")) j.home = *v;
+  if (const auto v = r.real(s, "HOME_OFFSET")) j.home_offset = *v;
+  if (const auto v = r.real(s, "HOME_SEARCH_VEL")) j.home_search_vel = *v;
+  if (const auto v = r.real(s, "HOME_LATCH_VEL")) j.home_latch_vel = *v;
+  if (const auto v = r.real(s, "HOME_FINAL_VEL")) j.home_final_vel = *v;
+  j.home_use_index = r.boolean(s, "HOME_USE_INDEX").value_or(false);
+  j.home_index_no_encoder_reset = r.boolean(s, "HOME_INDEX_NO_ENCODER_RESET").value_or(false);
+  j.home_ignore_limits = r.boolean(s, "HOME_IGNORE_LIMITS").value_or(false);
+  j.home_is_shared = r.boolean(s, "HOME_IS_SHARED").value_or(false);
+  j.volatile_home = r.boolean(s, "VOLATILE_HOME").value_or(false);
+  j.locking_indexer = r.boolean(s, "LOCKING_INDEXER").value_or(false);
+  j.home_absolute_encoder = r.integer(s, "HOME_ABSOLUTE_ENCODER").value_or(0) != 0;
+  j.home_sequence = -1;
+  if (const auto v = r.integer(s, "HOME_SEQUENCE")) {
+    j.home_sequence = static_cast<int>(*v < 0 ? -*v : *v);
+    j.home_sequence_sync = *v < 0;
+  }
+}
+
+JointConfig load_joint(TypedReader& r, const MachineConfig& c, int index, char letter) {
+  const std::string s = joint_section(index);
+  JointConfig j;
+  j.axis = letter;
+  j.source = r.where(s, "");
+  if (!r.ini().has_section(s)) {
+    r.warning(s, "",
+              "section missing; LinuxCNC defaults used (MAX_VELOCITY 1, "
+              "MAX_ACCELERATION 1)");
+  } else {
+    for (const auto* key : {"MAX_VELOCITY", "MAX_ACCELERATION"}) {
+      if (!r.given(s, key)) r.warning(s, key, "not given; LinuxCNC default 1 used");
+    }
+  }
+  if (const auto v = r.choice(s, "TYPE")) {
+    j.type = *v == "ANGULAR" ? JointType::angular : JointType::linear;
+  }
+  const AxisConfig* axis = letter != '\0' ? &c.axis(letter) : nullptr;
+  j.min_limit = r.real(s, "MIN_LIMIT").value_or(axis != nullptr ? axis->min_limit : -1e99);
+  j.max_limit = r.real(s, "MAX_LIMIT").value_or(axis != nullptr ? axis->max_limit : 1e99);
+  if (const auto v = r.real(s, "MAX_VELOCITY")) j.max_velocity = *v;
+  if (const auto v = r.real(s, "MAX_ACCELERATION")) j.max_acceleration = *v;
+  if (const auto v = r.real(s, "FERROR")) j.ferror = *v;
+  j.min_ferror = r.real(s, "MIN_FERROR").value_or(j.ferror);
+  if (const auto v = r.real(s, "BACKLASH")) j.backlash = *v;
+  load_homing(r, s, j);
+  if (const auto v = r.real(s, "SCALE")) j.scale = *v;
+  if (const auto v = r.real(s, "INPUT_SCALE")) j.input_scale = *v;
+  if (const auto v = r.real(s, "OUTPUT_SCALE")) j.output_scale = *v;
+  if (const auto v = r.choice(s, "DRIVER")) j.driver = *v;
+  return j;
+}
+
+// Path limits not given in [TRAJ] follow the axes, as LinuxCNC lets the axis limits apply.
+void derive_traj_limits(TypedReader& r, MachineConfig& c) {
+  double fastest = 0;
+  double quickest = 0;
+  for (std::size_t i = 0; i < c.axes.size(); ++i) {
+    if (!c.axes[i].present || !is_linear_axis(kAxisLetters[i])) continue;
+    fastest = std::max(fastest, c.axes[i].max_velocity);
+    quickest = std::max(quickest, c.axes[i].max_acceleration);
+  }
+  if (c.max_linear_velocity == 0) c.max_linear_velocity = fastest > 0 ? fastest : 1.0;
+  if (c.max_linear_acceleration == 0) c.max_linear_acceleration = quickest > 0 ? quickest : 1.0;
+  if (c.default_linear_velocity == 0) c.default_linear_velocity = 1.0;
+  if (c.default_linear_acceleration == 0) c.default_linear_acceleration = c.max_linear_acceleration;
+  if (c.default_linear_velocity > c.max_linear_velocity) {
+    r.warning("TRAJ", "DEFAULT_LINEAR_VELOCITY",
+              "higher than MAX_LINEAR_VELOCITY " + format_number(c.max_linear_velocity) +
+                  "; that limit applies");
+  }
+}
+
+}  // namespace
+
+void load_motion(TypedReader& r, MachineConfig& c) {
+  const Kinematics k = load_kinematics(r);
+  c.kinematics = k.module.empty() ? c.kinematics : k.module;
+  c.kinematics_args = k.args;
+  const auto joints = r.integer("KINS", "JOINTS");
+  if (!joints) {
+    if (!r.given("KINS", "JOINTS")) r.problem("KINS", "JOINTS", "missing; the number of joints");
+    return;
+  }
+  c.joint_count = static_cast<int>(*joints);
+  if (c.extra_joints >= c.joint_count) {
+    r.problem("EMCMOT", "EMCMOT",
+              "num_extrajoints=" + std::to_string(c.extra_joints) +
+                  " leaves no joint for the axes (JOINTS = " + std::to_string(c.joint_count) + ")");
+    c.extra_joints = 0;
+  }
+  if (!k.ok) return;
+  const std::string map = joint_map(r, k, c);
+
+  for (const char letter : kAxisLetters) {
+    const bool driven = map.find(letter) != std::string::npos;
+    const bool present = c.coordinates.find(letter) != std::string::npos;
+    if (present || (driven && r.ini().has_section(axis_section(letter)))) load_axis(r, c, letter);
+  }
+  c.joints.clear();
+  for (int index = 0; index < c.joint_count; ++index) {
+    const char letter =
+        index < static_cast<int>(map.size()) ? map[static_cast<std::size_t>(index)] : '\0';
+    if (letter == '\0' && index < c.joint_count - c.extra_joints) {
+      r.warning(joint_section(index), "", "joint is driven by no axis");
+    } else if (letter != '\0' && c.coordinates.find(letter) == std::string::npos) {
+      r.warning(
+          joint_section(index), "",
+          std::string("joint drives axis ") + letter + ", which is not in [TRAJ] COORDINATES");
+    }
+    c.joints.push_back(load_joint(r, c, index, letter));
+  }
+  derive_traj_limits(r, c);
+}
+
+}  // namespace cncd::config

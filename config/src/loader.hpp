@@ -1,0 +1,20 @@
+// Steps of load_machine_config (not installed); each reads through the TypedReader and
+// collects problems instead of stopping.
+#pragma once
+
+#include "cncd/config/machine_config.hpp"
+#include "typed_reader.hpp"
+
+namespace cncd::config {
+
+// [EMC] [EMCMOT] [TASK] [RS274NGC] [EMCIO] [TRAJ] [DISPLAY] [CNCD]
+void load_general(TypedReader& reader, MachineConfig& config);
+// [KINS], the joint map, [AXIS_L] and [JOINT_n]; fills the [TRAJ] limits left unset.
+void load_motion(TypedReader& reader, MachineConfig& config);
+// Cross-checks between keys and sections.
+void validate(TypedReader& reader, const MachineConfig& config);
+// Section names: duplicates, bad [JOINT_n] / [AXIS_L] names. False for a LinuxCNC 2.7-style
+// file with numbered [AXIS_n] sections, which cannot be read as joints and axes.
+bool check_sections(TypedReader& reader);
+
+}  // namespace cncd::config

@@ -1,0 +1,85 @@
+#include "cncd/config/machine_config.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <exception>
+#include <map>
+#include <new>
+
+#include "cncd/config/ini_file.hpp"
+#include "loader.hpp"
+
+namespace cncd::config {
+
+int axis_index(char letter) {
+  const auto upper = static_cast<char>(std::toupper(static_cast<unsigned char>(letter)));
+  const std::size_t at = upper == '\0' ? std::string_view::npos : kAxisLetters.find(upper);
+  return at == std::string_view::npos ? -1 : static_cast<int>(at);
+}
+
+std::string Problem::to_string() const {
+  std::string out = file.empty() ? std::string("<config>") : file;
+  if (line > 0) out += ":" + std::to_string(line);
+  out += ": ";
+  if (!section.empty()) out += "[" + section + "] ";
+  if (!key.empty()) out += key + ": ";
+  return out + message;
+}
+
+namespace {
+
+// Files in the order they first appear, lines ascending within a file.
+void sort_by_place(std::vector<Problem>& problems) {
+  std::map<std::string, std::size_t, std::less<>> rank;
+  for (const auto& p : problems)
+    rank.emplace(p.file, rank.size());
+  std::stable_sort(problems.begin(), problems.end(), [&](const Problem& a, const Problem& b) {
+    const auto ra = rank[a.file];
+    const auto rb = rank[b.file];
+    return ra != rb ? ra < rb : a.line < b.line;
+  });
+}
+
+LoadResult load(const std::filesystem::path& ini_path) {
+  LoadResult result;
+  auto ini = std::make_shared<IniFile>(IniFile::read(ini_path, result.problems, result.warnings));
+  if (ini->sections().empty() && ini->entries().empty()) {
+    // Nothing to interpret (a missing file, binary junk, an empty file): listing every
+    // missing key on top would bury the one problem that matters.
+    if (result.problems.empty()) {
+      result.problems.push_back(Problem{ini_path.lexically_normal().string(), 0, "", "",
+                                        "no sections; is this an INI file?"});
+    }
+    return result;
+  }
+  TypedReader reader(*ini, result.problems, result.warnings);
+  MachineConfig config;
+  config.path = ini_path;
+  load_general(reader, config);
+  if (check_sections(reader)) {
+    load_motion(reader, config);
+    validate(reader, config);
+  }
+  config.ini = std::move(ini);
+  sort_by_place(result.problems);
+  sort_by_place(result.warnings);
+  if (result.problems.empty()) result.config = std::move(config);
+  return result;
+}
+
+}  // namespace
+
+LoadResult load_machine_config(const std::filesystem::path& ini_path) {
+  // Bad input never throws here; what remains is running out of memory or a filesystem
+  // error, which must still reach the operator as a problem rather than terminate the daemon.
+  try {
+    return load(ini_path);
+  } catch (const std::exception& e) {
+    LoadResult failed;
+    failed.problems.push_back(
+        Problem{ini_path.string(), 0, "", "", std::string("cannot load: ") + e.what()});
+    return failed;
+  }
+}
+
+}  // namespace cncd::config
