@@ -1,5 +1,6 @@
 // Canned cycles G73, G74, G81-G89 in the three planes, with L repeats, G98/G99 and absolute
-// or incremental distances, expanded into straight moves, dwells and spindle commands.
+// or incremental distances, expanded into straight moves, dwells and spindle commands in the
+// order LinuxCNC emits them (including where its errors interrupt a cycle).
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -11,38 +12,44 @@
 namespace cncd::interp {
 namespace {
 
-struct CycleAxes {
-  int a;  // first plane axis
-  int b;  // second plane axis
-  int c;  // drilling axis
-  const char* plane;
-};
+const char* plane_name(Plane plane) {
+  return plane == Plane::xz ? "xz" : plane == Plane::yz ? "yz" : "xy";
+}
 
-CycleAxes cycle_axes(Plane plane) {
-  switch (plane) {
-    case Plane::xz:
-      return {kZ, kX, kY, "xz"};
-    case Plane::yz:
-      return {kY, kZ, kX, "yz"};
-    case Plane::xy:
-    default:
-      return {kX, kY, kZ, "xy"};
-  }
+bool is_canned_cycle(int code) {
+  return code == 730 || code == 740 || (code >= 810 && code <= 890);
+}
+
+std::string g_name(int code) {
+  return "g" + std::to_string(code / 10);
+}
+
+// LinuxCNC's chip-break and peck clearance: 0.010 inch.
+double peck_clearance(Units units) {
+  return units == Units::inches ? 0.010 : 0.254;
 }
 
 }  // namespace
 
 void Interpreter::Impl::do_canned_cycle(int code) {
-  const CycleAxes axes = cycle_axes(modal_.plane);
-  const char a_letter = kAxisLetters[axes.a];
-  const char b_letter = kAxisLetters[axes.b];
-  const char c_letter = kAxisLetters[axes.c];
+  CycleGeometry g;
+  switch (modal_.plane) {
+    case Plane::xz:
+      g.a = kZ, g.b = kX, g.c = kY;
+      break;
+    case Plane::yz:
+      g.a = kY, g.b = kZ, g.c = kX;
+      break;
+    case Plane::xy:
+      break;
+  }
+  const char c_letter = kAxisLetters[g.c];
   const bool same_cycle = previous_motion_ == code;
-  const auto ca = static_cast<std::size_t>(axes.a);
-  const auto cb = static_cast<std::size_t>(axes.b);
 
-  for (const char letter : {'a', 'b', 'c'}) {
-    if (block_.has(letter)) fail("Cannot put an a, b, or c in canned cycle", block_.col(letter));
+  int repeats = 1;
+  if (block_.has('l')) {
+    repeats = static_cast<int>(block_.get('l'));
+    if (repeats == 0) fail("Cannot do zero repeats of cycle", block_.col('l'));
   }
   if (block_.has('r')) {
     cycle_.r = block_.get('r');
@@ -53,62 +60,34 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     cycle_.z = block_.get(c_letter);
   } else if (!same_cycle) {
     fail(std::string(1, static_cast<char>(std::toupper(c_letter))) + " value unspecified in " +
-         axes.plane + " plane canned cycle");
-  }
-  int repeats = 1;
-  if (block_.has('l')) {
-    repeats = static_cast<int>(std::nearbyint(block_.get('l')));
-    if (repeats < 1) fail("Negative or zero l word used", block_.col('l'));
-  }
-  if (code == 820 || code == 860 || code == 880 || code == 890) {
-    if (block_.has('p')) {
-      cycle_.p = block_.get('p');
-    } else if (!same_cycle) {
-      fail("Dwell time P word missing with G" + std::to_string(code / 10));
-    }
-    if (cycle_.p < 0) fail("Negative dwell time");
-  }
-  if (code == 730 || code == 830) {
-    if (block_.has('q')) {
-      cycle_.q = block_.get('q');
-    } else if (!same_cycle) {
-      fail("Q word missing with G" + std::to_string(code / 10));
-    }
-    if (cycle_.q <= 0) fail("Q word must be positive with G" + std::to_string(code / 10));
+         plane_name(modal_.plane) + " plane canned cycle");
   }
   if (modal_.feed_mode == FeedMode::inverse_time) {
-    fail("Cannot use inverse time feed with canned cycle");
+    fail("Cannot use inverse time feed with canned cycles");
   }
   if (modal_.feed_rate == 0.0) fail("Cannot feed with zero feed rate");
 
-  double old_c = cycle_.old_normal;
-  double r = cycle_.r;
-  double bottom = cycle_.z;
+  if (!is_canned_cycle(previous_motion_)) cycle_.initial_level = pos_[g.c];
+  double old_c = cycle_.initial_level;
+  g.r = cycle_.r;
+  g.bottom = cycle_.z;
   if (modal_.incremental) {
-    r += old_c;
-    bottom += r;
+    g.r += old_c;
+    g.bottom += g.r;
   }
-  if (r < bottom) {
-    fail(std::string("R less than ") + c_letter + " in cycle in " + axes.plane + " plane");
+  if (g.r < g.bottom) {
+    fail(std::string("R less than ") + c_letter + " in cycle in " + plane_name(modal_.plane) +
+         " plane");
   }
-  // Moves of the cycle keep the axes outside the cycle's three where they are.
-  auto move = [&](CanonKind kind, double a_value, double b_value, double c_value) {
-    Pose end = pos_;
-    end[ca] = a_value;
-    end[cb] = b_value;
-    end[static_cast<std::size_t>(axes.c)] = c_value;
-    emit_straight(kind, end);
-  };
-  struct {
-    decltype(move)& to;
-    void traverse(double x, double y, double z) { to(CanonKind::straight_traverse, x, y, z); }
-    void feed(double x, double y, double z) { to(CanonKind::straight_feed, x, y, z); }
-  } run{move};
-  if (old_c < r) {
-    run.traverse(pos_[ca], pos_[cb], r);
-    old_c = r;
+  if (old_c < g.r) {
+    // Below the R plane: go up to it first, once for all repeats.
+    Pose up = pos_;
+    up[g.c] = g.r;
+    emit_straight(CanonKind::straight_traverse, up);
+    old_c = g.r;
   }
-  const double clear = (!modal_.retract_r_plane && old_c > r) ? old_c : r;
+  g.clear = (!modal_.retract_r_plane && old_c > g.r) ? old_c : g.r;
+
   const bool switch_mode = modal_.control != MotionMode::exact_path;
   if (switch_mode) {
     CanonCommand& command = make(CanonKind::set_motion_control_mode);
@@ -116,11 +95,45 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     command.value = 0;
     emit(command);
   }
-  double a = pos_[ca];
-  double b = pos_[cb];
-  // The first move across the plane stays clear of the work: at the current height, or at
-  // the retract height when that is higher.
-  double current_c = std::max(pos_[static_cast<std::size_t>(axes.c)], clear);
+  // Cycle-specific words, checked once the cycle has started (as LinuxCNC does).
+  const bool needs_p = code == 820 || code == 860 || code == 880 || code == 890;
+  if (block_.has('p')) cycle_.p = block_.get('p');
+  if (needs_p && !block_.has('p') && !same_cycle) {
+    fail("Dwell time p word missing with " + g_name(code));
+  }
+  if (code == 730 || code == 830) {
+    if (block_.has('q')) cycle_.q = block_.get('q');
+    if ((!block_.has('q') && !same_cycle) || cycle_.q <= 0.0) {
+      fail("Q word missing with " + g_name(code));
+    }
+  }
+  if (code == 870) {
+    // I, J and K belong to X, Y and Z: the plane axes' letters give the entry offset, the
+    // drilling axis' letter the height the back bore cuts up to.
+    static constexpr char kOffsetLetters[] = "ijk";
+    for (const char letter : {'i', 'j', 'k'}) {
+      if (block_.has(letter)) {
+        (letter == 'i' ? cycle_.i : letter == 'j' ? cycle_.j : cycle_.k) = block_.get(letter);
+      } else if (!same_cycle) {
+        fail(std::string(1, static_cast<char>(std::toupper(letter))) + " word missing with g87");
+      }
+    }
+    auto value_of = [this](char letter) {
+      return letter == 'i' ? cycle_.i : letter == 'j' ? cycle_.j : cycle_.k;
+    };
+    g.i = value_of(kOffsetLetters[g.a]);
+    g.j = value_of(kOffsetLetters[g.b]);
+    const double height = value_of(kOffsetLetters[g.c]);
+    g.k = modal_.incremental ? g.bottom + height : height;
+  }
+
+  const char a_letter = kAxisLetters[g.a];
+  const char b_letter = kAxisLetters[g.b];
+  double a = pos_[g.a];
+  double b = pos_[g.b];
+  // The first move across the plane stays clear of the work: at the current height, or at the
+  // retract height when that is higher.
+  double current_c = std::max(pos_[g.c], g.clear);
   for (int repeat = 0; repeat < repeats; ++repeat) {
     if (modal_.incremental) {
       a += block_.has(a_letter) ? block_.get(a_letter) : 0.0;
@@ -129,41 +142,7 @@ void Interpreter::Impl::do_canned_cycle(int code) {
       a = block_.has(a_letter) ? block_.get(a_letter) : a;
       b = block_.has(b_letter) ? block_.get(b_letter) : b;
     }
-    run.traverse(a, b, current_c);
-    if (current_c != r) run.traverse(a, b, r);
-    switch (code) {
-      case 810:
-        run.feed(a, b, bottom);
-        run.traverse(a, b, clear);
-        break;
-      case 820:
-        run.feed(a, b, bottom);
-        emit_simple(CanonKind::dwell, 0, cycle_.p);
-        run.traverse(a, b, clear);
-        break;
-      case 850:
-        run.feed(a, b, bottom);
-        run.feed(a, b, r);
-        if (clear != r) run.traverse(a, b, clear);
-        break;
-      case 860:
-        run.feed(a, b, bottom);
-        emit_simple(CanonKind::dwell, 0, cycle_.p);
-        emit_simple(CanonKind::stop_spindle_turning);
-        run.traverse(a, b, clear);
-        emit_simple(modal_.spindle == SpindleDir::counterclockwise
-                        ? CanonKind::start_spindle_counterclockwise
-                        : CanonKind::start_spindle_clockwise);
-        break;
-      case 890:
-        run.feed(a, b, bottom);
-        emit_simple(CanonKind::dwell, 0, cycle_.p);
-        run.feed(a, b, clear);
-        break;
-      default:
-        fail("G" + std::to_string(code / 10) + " is not supported");
-    }
-    current_c = clear;
+    cycle_body(code, g, a, b, current_c);
   }
   if (switch_mode) {
     CanonCommand& command = make(CanonKind::set_motion_control_mode);
@@ -173,6 +152,131 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     if (modal_.control == MotionMode::continuous) {
       emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
     }
+  }
+}
+
+// One repeat: across the plane to (a, b), down to R, the cycle's own moves, and out to the
+// clear height (`current_c` tracks the drilling-axis position between moves).
+void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, double b,
+                                   double& current_c) {
+  auto move = [&](CanonKind kind, double a_value, double b_value, double c_value) {
+    Pose end = pos_;
+    end[g.a] = a_value;
+    end[g.b] = b_value;
+    end[g.c] = c_value;
+    emit_straight(kind, end);
+    current_c = c_value;
+  };
+  auto traverse = [&](double c_value) { move(CanonKind::straight_traverse, a, b, c_value); };
+  auto feed = [&](double c_value) { move(CanonKind::straight_feed, a, b, c_value); };
+  auto dwell = [&](double seconds) { emit_simple(CanonKind::dwell, 0, seconds); };
+  const CanonKind restart = modal_.spindle == SpindleDir::counterclockwise
+                                ? CanonKind::start_spindle_counterclockwise
+                                : CanonKind::start_spindle_clockwise;
+
+  traverse(current_c);
+  if (current_c != g.r) traverse(g.r);
+  const bool needs_spindle =
+      code == 740 || code == 840 || code == 860 || code == 870 || code == 880;
+  if (needs_spindle && modal_.spindle == SpindleDir::stopped) {
+    fail("Spindle not turning in " +
+         (code == 840 || code == 740 ? "G" + std::to_string(code / 10) : g_name(code)));
+  }
+  switch (code) {
+    case 810:
+      feed(g.bottom);
+      traverse(g.clear);
+      break;
+    case 820:
+      feed(g.bottom);
+      dwell(cycle_.p);
+      traverse(g.clear);
+      break;
+    case 730:
+    case 830: {
+      const double clearance = peck_clearance(modal_.units);
+      for (double depth = g.r - cycle_.q; depth > g.bottom; depth -= cycle_.q) {
+        feed(depth);
+        if (code == 830) traverse(g.r);
+        traverse(depth + clearance);
+      }
+      feed(g.bottom);
+      traverse(g.clear);
+      break;
+    }
+    case 740:
+    case 840: {
+      const bool right_hand = code == 840;
+      if (right_hand && modal_.spindle == SpindleDir::counterclockwise) {
+        fail("Spindle turning counterclockwise in G84");
+      }
+      if (!right_hand && modal_.spindle == SpindleDir::clockwise) {
+        fail("Spindle turning clockwise in G74");
+      }
+      emit_simple(CanonKind::set_feed_override_enable, 0);
+      emit_simple(CanonKind::set_spindle_override_enable, 0);
+      feed(g.bottom);
+      emit_simple(CanonKind::stop_spindle_turning);
+      emit_simple(right_hand ? CanonKind::start_spindle_counterclockwise
+                             : CanonKind::start_spindle_clockwise);
+      dwell(cycle_.p);
+      feed(g.clear);
+      emit_simple(CanonKind::stop_spindle_turning);
+      emit_simple(right_hand ? CanonKind::start_spindle_clockwise
+                             : CanonKind::start_spindle_counterclockwise);
+      emit_simple(CanonKind::set_feed_override_enable, 1);
+      emit_simple(CanonKind::set_spindle_override_enable, 1);
+      break;
+    }
+    case 850:
+      feed(g.bottom);
+      feed(g.r);
+      traverse(g.clear);
+      break;
+    case 860:
+      feed(g.bottom);
+      dwell(cycle_.p);
+      emit_simple(CanonKind::stop_spindle_turning);
+      traverse(g.clear);
+      emit_simple(restart);
+      break;
+    case 870: {
+      // Back boring: enter beside the hole with the spindle oriented, cut upwards to K.
+      const double off_a = a + g.i;
+      const double off_b = b + g.j;
+      auto offset_traverse = [&](double c_value) {
+        move(CanonKind::straight_traverse, off_a, off_b, c_value);
+      };
+      offset_traverse(current_c);
+      emit_simple(CanonKind::stop_spindle_turning);
+      emit_simple(CanonKind::orient_spindle, 2, 0.0);
+      offset_traverse(g.bottom);
+      traverse(g.bottom);
+      emit_simple(restart);
+      feed(g.k);
+      feed(g.bottom);
+      emit_simple(CanonKind::stop_spindle_turning);
+      emit_simple(CanonKind::orient_spindle, 2, 0.0);
+      offset_traverse(g.bottom);
+      offset_traverse(g.clear);
+      traverse(g.clear);
+      emit_simple(restart);
+      break;
+    }
+    case 880:
+      feed(g.bottom);
+      dwell(cycle_.p);
+      emit_simple(CanonKind::stop_spindle_turning);
+      emit_simple(CanonKind::program_stop);
+      emit_simple(restart);
+      break;
+    case 890:
+      feed(g.bottom);
+      dwell(cycle_.p);
+      feed(g.clear);
+      break;
+    default:
+      fail("G" + std::to_string(code / 10) + " is not supported");
   }
 }
 

@@ -58,6 +58,16 @@ void Interpreter::Impl::check_block() const {
       (modal_.motion < 0 || modal_.motion == 800)) {
     fail("Cannot use axis values without a g code that uses them");
   }
+  const int active_motion = motion >= 0 ? motion : modal_.motion;
+  const bool cycle = active_motion == 730 || active_motion == 740 ||
+                     (active_motion >= 810 && active_motion <= 890);
+  if (cycle && !(non_modal >= 0 && uses_axes_non_modal(non_modal))) {
+    for (const char letter : {'a', 'b', 'c'}) {
+      if (b.has(letter)) {
+        fail(std::string("Cannot put an ") + letter + " in canned cycle", b.col(letter));
+      }
+    }
+  }
   if (b.has('e')) fail("E word with no G70, G76, M66, M67 or M68 to use it", b.col('e'));
   if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
   if (b.has('s') && b.get('s') < 0) fail("Negative s word used", b.col('s'));

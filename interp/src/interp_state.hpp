@@ -30,8 +30,8 @@ struct ModalState {
   bool arc_incremental = true;  // G91.1 is LinuxCNC's default
   FeedMode feed_mode = FeedMode::units_per_minute;
   Units units = Units::mm;
-  bool retract_r_plane = false;  // G99
-  int coord_system = 1;          // 1..9 = G54..G59.3
+  bool retract_r_plane = true;  // G99 is LinuxCNC's start-up retract mode
+  int coord_system = 1;         // 1..9 = G54..G59.3
   MotionMode control = MotionMode::continuous;
   double tolerance = 0;        // G64 P
   double naive_tolerance = 0;  // G64 Q
@@ -60,9 +60,9 @@ struct CycleState {
   bool has_z = false;
   bool has_p = false;
   bool has_q = false;
-  // The "old Z" cycles start from: the drilling-axis position of the last programmed move.
-  // The cycles' own retracts do not change it (observed LinuxCNC behaviour).
-  double old_normal = 0;
+  // LinuxCNC's "old Z": the drilling-axis position when a run of canned cycles starts, kept
+  // (unconverted, whatever the plane) while the motion mode stays a canned cycle.
+  double initial_level = 0;
 };
 
 // Control flow: an open O-word block (if/while/do/repeat) or a subroutine call frame.
@@ -84,6 +84,19 @@ struct CallFrame {
 };
 
 class CanonSink;
+
+// Where one canned cycle works: the plane axes, the drilling axis and its heights.
+struct CycleGeometry {
+  std::size_t a = 0;  // first plane axis
+  std::size_t b = 1;  // second plane axis
+  std::size_t c = 2;  // drilling axis
+  double r = 0;       // R plane
+  double bottom = 0;  // hole bottom
+  double clear = 0;   // retract height at the end of each repeat
+  double k = 0;       // G87 back-bore height
+  double i = 0;       // G87 offsets across the plane
+  double j = 0;
+};
 
 struct Interpreter::Impl {
   explicit Impl(InterpOptions opts);
@@ -132,6 +145,7 @@ struct Interpreter::Impl {
 
   // cycles.cpp
   void do_canned_cycle(int code);
+  void cycle_body(int code, const CycleGeometry& g, double a, double b, double& current_c);
 
   // emit helpers
   CanonCommand& make(CanonKind kind);

@@ -33,7 +33,6 @@ void Interpreter::Impl::reset_modal_state() {
   modal_ = ModalState{};
   modal_.units = options_.machine_units;
   cycle_ = CycleState{};
-  cycle_.old_normal = pos_[kZ];
   const int system = static_cast<int>(parameters_.get(5220));
   modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
   load_coord_system(modal_.coord_system);
@@ -153,7 +152,6 @@ Interpreter::~Interpreter() = default;
 
 void Interpreter::set_position(const Pose& position) {
   impl_->pos_ = position;
-  impl_->cycle_.old_normal = position[kZ];
 }
 
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {

@@ -120,13 +120,11 @@ void Interpreter::Impl::do_motion() {
   }
   if (code == 20 || code == 30) {
     arc(code == 20, target_from_words());
-    cycle_.old_normal = pos_[kZ];
     return;
   }
   if (!axis_words) return;
   const Pose end = target_from_words();
   straight(code == 0 ? CanonKind::straight_traverse : CanonKind::straight_feed, end);
-  if (block_.has('z') || non_modal == 530) cycle_.old_normal = pos_[kZ];
 }
 
 void Interpreter::Impl::arc(bool clockwise, const Pose& end) {

@@ -85,7 +85,6 @@ void Interpreter::Impl::change_units(Units units) {
       g92_offset_[a] *= factor;
       tool_offset_[a] *= factor;
     }
-    cycle_.old_normal *= factor;
     modal_.units = units;
   }
   emit_simple(CanonKind::use_length_units, static_cast<int>(units));

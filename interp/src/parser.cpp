@@ -180,7 +180,14 @@ void BlockParser::read_word(Block& block) {
   if (block.present & (1U << index)) {
     fail(std::string("Multiple ") + c + " words on one line", col);
   }
-  const double value = read_real_value();
+  double value = 0;
+  if (c == 'l' || c == 't' || c == 'h') {
+    // Integer words.
+    value = read_integer_value();
+    if (value < 0) fail(std::string("Negative ") + c + " word used", col);
+  } else {
+    value = read_real_value();
+  }
   block.present |= 1U << index;
   block.value[index] = value;
   block.column[index] = col;
@@ -197,7 +204,13 @@ void BlockParser::read_g(Block& block, int col) {
   const CodeInfo info = g_code_info(number);
   if (info.group < 0) fail("Unknown g code used", col);
   const auto group = static_cast<std::size_t>(info.group);
-  if (block.g[group] != -1) fail("Two g codes used from same modal group", col);
+  if (block.g[group] != -1) {
+    // LinuxCNC lets G80 share a line with another motion code, which then wins.
+    const bool g80_pair = info.group == static_cast<std::int8_t>(GGroup::motion) &&
+                          (block.g[group] == 800 || number == 800);
+    if (!g80_pair) fail("Two g codes used from same modal group", col);
+    if (number == 800) return;
+  }
   block.g[group] = number;
   block.g_column[group] = col;
 }
@@ -324,7 +337,7 @@ int BlockParser::read_integer_value() {
   const double value = read_real_value();
   const double rounded = std::nearbyint(value);
   if (std::fabs(value - rounded) > kTolerance || std::fabs(rounded) > 2e9) {
-    fail("Non-integer value for integer", col);
+    fail("Non integer value for integer", col);
   }
   return static_cast<int>(rounded);
 }

@@ -162,6 +162,11 @@ std::string format_rs274(const CanonCommand& c, int axes) {
       out = "SET_SPINDLE_SPEED(0, ";
       append(out, "%.4f", c.value);
       break;
+    case CanonKind::orient_spindle:
+      out = "ORIENT_SPINDLE(0, ";
+      append(out, "%.4f", c.value);
+      out += ", " + std::to_string(c.ivalue);
+      break;
     case CanonKind::set_spindle_mode:
       out = "SET_SPINDLE_MODE(0 ";
       append(out, "%.4f", c.value);

@@ -76,8 +76,8 @@ TEST(SeedExamples, G80SectionProgram) {
       "N130 X2\nN140 X3\nN150 X4\nN160 Y1 Z0.5\nN170 X3\nN180 X2\nN190 X1\n"
       "N200 G80 (turn off canned cycle)\n"
       "N210 G0 X0 (rapid home moves)\nN220 Y0\nN220 Z0\nN220 M2 (program end)\n");
-  // LinuxCNC's "old Z" for a cycle is the Z of the last programmed move (0, from N100): a
-  // cycle's own retract does not change it, so every hole starts with a move up to R.
+  // LinuxCNC's "old Z" is the Z where the run of modal cycles started (0, from N100); the
+  // cycles' retracts do not change it, so every hole starts with a move up to R.
   const std::vector<std::string> expected{
       "STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000)", "STRAIGHT_FEED(0.0000, 0.0000, 0.0000)",
       "STRAIGHT_TRAVERSE(0.0000, 0.0000, 1.0000)", "STRAIGHT_TRAVERSE(1.0000, 0.0000, 1.0000)",

@@ -57,8 +57,9 @@ enum class CanonKind : std::uint8_t {
   program_end,            // M2/M30
   pallet_shuttle,         // M60 (stop)
   on_reset,
-  finish,        // the program ended with a closing '%'
-  start_change,  // M6: the tool change begins (emitted before CHANGE_TOOL)
+  finish,          // the program ended with a closing '%'
+  start_change,    // M6: the tool change begins (emitted before CHANGE_TOOL)
+  orient_spindle,  // value: angle in degrees; ivalue: LinuxCNC's orientation mode
 };
 
 struct CanonCommand {
