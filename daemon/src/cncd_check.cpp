@@ -1,9 +1,10 @@
 // cncd-check: runs a G-code program through the interpreter without a machine and reports the
 // first error as FILE:LINE:COLUMN: message (exit status 1), or prints the canonical commands.
 //
-//   cncd-check [--canon] [--inch] [-t TOOL.tbl] [-v PARAMS.var] PROGRAM.ngc
+//   cncd-check [--canon] [--inch] [--tool-units mm|inch] [-t TOOL.tbl] [-v PARAMS.var] PROGRAM
 //
-// --canon prints every canonical command the way LinuxCNC's rs274 does.
+// --canon prints every canonical command the way LinuxCNC's rs274 does; --inch makes the
+// machine's units inches; --tool-units says what units the tool table is written in.
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -15,7 +16,8 @@
 namespace {
 
 int usage() {
-  std::cerr << "usage: cncd-check [--canon] [--inch] [-t TOOL.tbl] [-v PARAMS.var] PROGRAM.ngc\n";
+  std::cerr << "usage: cncd-check [--canon] [--inch] [--tool-units mm|inch] [-t TOOL.tbl] "
+               "[-v PARAMS.var] PROGRAM.ngc\n";
   return 64;  // EX_USAGE
 }
 
@@ -32,6 +34,10 @@ int main(int argc, char** argv) {
       canon = true;
     } else if (arg == "--inch") {
       options.machine_units = Units::inches;
+    } else if (arg == "--tool-units" && i + 1 < argc) {
+      const std::string units = argv[++i];
+      if (units != "mm" && units != "inch") return usage();
+      options.tool_table_units = units == "mm" ? Units::mm : Units::inches;
     } else if ((arg == "-t" || arg == "-v") && i + 1 < argc) {
       (arg == "-t" ? options.tool_table : options.parameter_file) = argv[++i];
     } else if (!arg.empty() && arg[0] != '-' && program.empty()) {

@@ -9,10 +9,6 @@
 namespace cncd::interp {
 namespace {
 
-bool uses_axes_non_modal(int code) {
-  return code == 100 || code == 280 || code == 300 || code == 520 || code == 920;
-}
-
 bool starts_with_word(const std::string& text, const char* word, std::size_t& rest) {
   std::size_t i = 0;
   for (; word[i] != '\0'; ++i) {
@@ -24,6 +20,18 @@ bool starts_with_word(const std::string& text, const char* word, std::size_t& re
 }
 
 }  // namespace
+
+// G10, G28, G30, G52 and G92 take the line's axis words for themselves; so does G43.1 when
+// no motion code shares its line (with one, both use them).
+bool Interpreter::Impl::axes_belong_elsewhere() const {
+  return axes_belong_to_non_modal() ||
+         (block_.g_code(GGroup::tool_length) == 431 && block_.g_code(GGroup::motion) < 0);
+}
+
+bool Interpreter::Impl::axes_belong_to_non_modal() const {
+  const int code = block_.g_code(GGroup::non_modal);
+  return code == 100 || code == 280 || code == 300 || code == 520 || code == 920;
+}
 
 void Interpreter::Impl::check_block() const {
   const Block& b = block_;
@@ -46,32 +54,67 @@ void Interpreter::Impl::check_block() const {
   for (const char letter : kAxisLetters) {
     if (letter != '\0' && b.has(letter)) axis_words = true;
   }
-  const int non_modal = b.g_code(GGroup::non_modal);
   const int motion = b.g_code(GGroup::motion);
-  if (non_modal >= 0 && uses_axes_non_modal(non_modal) && motion >= 0 && motion != 800) {
+  if (axes_belong_to_non_modal() && motion >= 0 && motion != 800) {
     fail("Cannot use two g codes that both use axis values", b.g_column[0]);
   }
-  if (motion == 800 && axis_words && !(non_modal >= 0 && uses_axes_non_modal(non_modal))) {
+  if (motion == 800 && axis_words && !axes_belong_elsewhere()) {
     fail("Cannot use axis values with g80", b.g_column[static_cast<std::size_t>(GGroup::motion)]);
   }
-  if (axis_words && motion < 0 && !(non_modal >= 0 && uses_axes_non_modal(non_modal)) &&
+  if (axis_words && motion < 0 && !axes_belong_elsewhere() &&
       (modal_.motion < 0 || modal_.motion == 800)) {
     fail("Cannot use axis values without a g code that uses them");
   }
   const int active_motion = motion >= 0 ? motion : modal_.motion;
   const bool cycle = active_motion == 730 || active_motion == 740 ||
                      (active_motion >= 810 && active_motion <= 890);
-  if (cycle && !(non_modal >= 0 && uses_axes_non_modal(non_modal))) {
+  if (cycle && !axes_belong_elsewhere()) {
     for (const char letter : {'a', 'b', 'c'}) {
       if (b.has(letter)) {
         fail(std::string("Cannot put an ") + letter + " in canned cycle", b.col(letter));
       }
     }
   }
+  check_word_users(active_motion);
   if (b.has('e')) fail("E word with no G70, G76, M66, M67 or M68 to use it", b.col('e'));
   if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
-  if (b.has('s') && b.get('s') < 0) fail("Negative s word used", b.col('s'));
+  if (b.has('s') && b.get('s') < 0) fail("Negative spindle speed used", b.col('s'));
   if (b.has('t') && b.get('t') < 0) fail("Negative t word used", b.col('t'));
+}
+
+// Words that no code on the line (or the modal motion) uses are errors in LinuxCNC.
+void Interpreter::Impl::check_word_users(int motion) const {
+  const Block& b = block_;
+  const int non_modal = b.g_code(GGroup::non_modal);
+  const bool g10 = non_modal == 100;
+  const bool arc = motion == 20 || motion == 30;
+  const bool cycle = motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
+  const int overrides = b.m_code(MGroup::overrides);
+  auto require = [&](char letter, bool used, const char* message) {
+    if (b.has(letter) && !used) fail(message, b.col(letter));
+  };
+  require('i', arc || g10 || motion == 870,
+          "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
+  require('j', arc || g10 || motion == 870,
+          "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
+  require('k', arc || motion == 870, "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
+  require('r', arc || cycle || g10, "R word with no g code that uses it");
+  const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
+                      motion == 820 || motion == 860 || motion == 880 || motion == 890 ||
+                      motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53);
+  require('p', p_user,
+          "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
+          "M63 M64 M65 M66 M98 or user M code to use it");
+  const bool q_user = g10 || b.g_code(GGroup::path_control) == 640 || motion == 730 ||
+                      motion == 830 || b.m_code(MGroup::tool_change) == 61;
+  require('q', q_user,
+          "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
+          "uses it");
+  require('l', g10 || cycle,
+          "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
+          "NURBS code");
+  require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+  require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
 }
 
 void Interpreter::Impl::execute_block() {
@@ -139,7 +182,8 @@ void Interpreter::Impl::do_tool_and_spindle() {
   if (block_.has('t')) {
     const int tool = static_cast<int>(block_.get('t'));
     if (tool != 0 && tools_.find(tool) == nullptr && !options_.tool_table.empty()) {
-      fail("Selected tool slot number too large", block_.col('t'));
+      fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
+           block_.col('t'));
     }
     tool_prepped_ = tool;
     emit_simple(CanonKind::select_tool, tool);
@@ -153,9 +197,10 @@ void Interpreter::Impl::do_tool_and_spindle() {
     tool_in_spindle_ = tool;
     modal_.spindle = SpindleDir::stopped;
   } else if (change == 61) {
-    if (!block_.has('q')) fail("Q word missing with M61", block_.m_column[6]);
+    if (!block_.has('q') || block_.get('q') < 0) {
+      fail("Need non-negative Q-word to specify tool number with M61", block_.m_column[6]);
+    }
     const int tool = static_cast<int>(block_.get('q'));
-    if (tool < 0) fail("Need non-negative Q value with M61", block_.col('q'));
     tool_in_spindle_ = tool;
     emit_simple(CanonKind::change_tool_number, tool);
   }
@@ -231,8 +276,9 @@ void Interpreter::Impl::do_coolant_and_overrides() {
 
 void Interpreter::Impl::do_dwell() {
   if (block_.g_code(GGroup::non_modal) != 40) return;
-  if (!block_.has('p')) fail("Dwell time missing with g4", block_.g_column[0]);
-  if (block_.get('p') < 0) fail("Negative dwell time", block_.col('p'));
+  if (!block_.has('p') || block_.get('p') < 0) {
+    fail("Dwell time missing with g4", block_.g_column[0]);
+  }
   emit_simple(CanonKind::dwell, 0, block_.get('p'));
 }
 
@@ -284,8 +330,13 @@ void Interpreter::Impl::do_modes() {
     emit_comment("interpreter: distance mode changed to incremental");
   }
   const int arc_distance = block_.g_code(GGroup::arc_distance);
-  if (arc_distance == 901) modal_.arc_incremental = false;
-  if (arc_distance == 911) modal_.arc_incremental = true;
+  if (arc_distance == 901 && modal_.arc_incremental) {
+    modal_.arc_incremental = false;
+    emit_comment("interpreter: IJK distance mode changed to absolute");
+  } else if (arc_distance == 911 && !modal_.arc_incremental) {
+    modal_.arc_incremental = true;
+    emit_comment("interpreter: IJK distance mode changed to incremental");
+  }
   const int retract = block_.g_code(GGroup::retract);
   if (retract == 980) {
     modal_.retract_r_plane = false;
@@ -359,17 +410,17 @@ void Interpreter::Impl::program_end_reset() {
   emit_simple(CanonKind::set_feed_mode, 0);
   modal_.feed_rate = 0;
   emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+  if (!modal_.feed_override) {
+    // LinuxCNC re-enables only the feed override here; the speed override stays as it was.
+    modal_.feed_override = true;
+    emit_simple(CanonKind::set_feed_override_enable, 1);
+  }
   modal_.spindle = SpindleDir::stopped;
   emit_simple(CanonKind::stop_spindle_turning);
   emit_simple(CanonKind::set_spindle_mode, 0, 0.0);
   if (modal_.mist) emit_simple(CanonKind::mist_off);
   if (modal_.flood) emit_simple(CanonKind::flood_off);
   modal_.mist = modal_.flood = false;
-  if (!modal_.feed_override || !modal_.speed_override) {
-    modal_.feed_override = modal_.speed_override = true;
-    emit_simple(CanonKind::set_feed_override_enable, 1);
-    emit_simple(CanonKind::set_spindle_override_enable, 1);
-  }
   modal_.motion = 10;
   if (block_.m_code(MGroup::stopping) == 30) emit_simple(CanonKind::pallet_shuttle);
   emit_simple(CanonKind::program_end);

@@ -111,6 +111,9 @@ struct Interpreter::Impl {
   // execute.cpp: one block in LinuxCNC's order of execution.
   void execute_block();
   void check_block() const;
+  bool axes_belong_elsewhere() const;
+  bool axes_belong_to_non_modal() const;
+  void check_word_users(int motion) const;
   void do_comment();
   void do_feed_mode();
   void do_tool_and_spindle();
@@ -153,7 +156,8 @@ struct Interpreter::Impl {
   void emit_comment(const std::string& text);
   void emit_simple(CanonKind kind, int ivalue = 0, double value = 0);
 
-  double to_program_units(double mm) const;
+  double to_program_units(double machine_value) const;
+  Units tool_table_units() const;
 
   InterpOptions options_;
   Parameters parameters_;

@@ -28,6 +28,10 @@ double unit_factor(Units from, Units to) {
 
 }  // namespace
 
+Units Interpreter::Impl::tool_table_units() const {
+  return options_.tool_table_units.value_or(options_.machine_units);
+}
+
 double Interpreter::Impl::to_program_units(double machine_value) const {
   return machine_value * unit_factor(options_.machine_units, modal_.units);
 }
@@ -97,13 +101,21 @@ void Interpreter::Impl::apply_tool_length(int code) {
     if (tool < 0) fail("Negative h word tool length offset index used", block_.col('h'));
     if (tool != 0) {
       const ToolEntry* entry = tools_.find(tool);
-      if (entry == nullptr) fail("Invalid tool number " + std::to_string(tool), block_.col('h'));
-      for (int axis = 0; axis < kAxes; ++axis) {
-        const double value = entry->offset[static_cast<std::size_t>(axis)];
-        offset[static_cast<std::size_t>(axis)] = is_linear(axis) ? to_program_units(value) : value;
+      if (entry == nullptr && !options_.tool_table.empty()) {
+        fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
+             block_.col('h'));
+      }
+      if (entry != nullptr) {
+        const double factor = unit_factor(tool_table_units(), modal_.units);
+        for (int axis = 0; axis < kAxes; ++axis) {
+          const double value = entry->offset[static_cast<std::size_t>(axis)];
+          offset[static_cast<std::size_t>(axis)] = is_linear(axis) ? value * factor : value;
+        }
       }
     }
   } else if (code == 431) {
+    // G43.1 replaces the offsets of the axes it names and keeps the others.
+    offset = tool_offset_;
     for (int axis = 0; axis < kAxes; ++axis) {
       const char letter = kAxisLetters[axis];
       if (block_.has(letter)) offset[static_cast<std::size_t>(axis)] = block_.get(letter);
@@ -225,7 +237,7 @@ void Interpreter::Impl::do_g10() {
   ToolEntry entry;
   if (const ToolEntry* existing = tools_.find(p)) entry = *existing;
   entry.number = p;
-  const double to_machine = unit_factor(modal_.units, options_.machine_units);
+  const double to_machine = unit_factor(modal_.units, tool_table_units());
   for (int axis = 0; axis < kAxes; ++axis) {
     const char letter = kAxisLetters[axis];
     if (!block_.has(letter)) continue;

@@ -48,7 +48,15 @@ std::string read_file(const std::filesystem::path& path) {
   return text.str();
 }
 
-std::string line_diff(const std::string& expected, const std::string& actual) {
+std::string line_diff(const std::string& expected_raw, const std::string& actual_raw) {
+  // A center that LinuxCNC computes as a tiny negative number prints as -0.0000; ours is an
+  // exact zero. The sign of a printed zero carries no meaning, so it is not compared.
+  auto unsign_zeros = [](std::string text) {
+    static const std::regex negative_zero(R"(-(0\.0+)(?![0-9]))");
+    return std::regex_replace(text, negative_zero, "$1");
+  };
+  const std::string expected = unsign_zeros(expected_raw);
+  const std::string actual = unsign_zeros(actual_raw);
   if (expected == actual) return {};
   auto split = [](const std::string& text) {
     std::vector<std::string> lines;
@@ -76,7 +84,11 @@ std::string line_diff(const std::string& expected, const std::string& actual) {
 SessionFiles files_next_to(const std::filesystem::path& program) {
   SessionFiles files;
   const auto dir = program.parent_path();
-  if (std::filesystem::exists(dir / "tool.tbl")) files.tool_table = dir / "tool.tbl";
+  if (std::filesystem::exists(dir / "tool.tbl")) {
+    files.tool_table = dir / "tool.tbl";
+  } else if (std::filesystem::exists(kRs274DefaultToolTable)) {
+    files.tool_table = kRs274DefaultToolTable;
+  }
   if (std::filesystem::exists(dir / "params.var")) files.parameter_file = dir / "params.var";
   return files;
 }
@@ -84,6 +96,7 @@ SessionFiles files_next_to(const std::filesystem::path& program) {
 SessionOutput run_ours(const std::filesystem::path& program, const SessionFiles& files) {
   InterpOptions options;
   options.tool_table = files.tool_table;
+  options.tool_table_units = Units::inches;  // how rs274 reads tool tables
   if (!files.parameter_file.empty()) {
     // rs274 rewrites its parameter file; work on a copy like the differential test does.
     options.parameter_file = files.parameter_file;

@@ -19,7 +19,11 @@ struct SessionFiles {
   std::filesystem::path parameter_file;  // empty = none
 };
 
-// Looks for tool.tbl and params.var next to the program.
+// The table rs274 reads when given none.
+inline constexpr const char* kRs274DefaultToolTable =
+    "/usr/share/doc/linuxcnc/examples/sample-configs/common/tool.tbl";
+
+// Looks for tool.tbl and params.var next to the program; without tool.tbl, rs274's default.
 SessionFiles files_next_to(const std::filesystem::path& program);
 
 SessionOutput run_ours(const std::filesystem::path& program, const SessionFiles& files);

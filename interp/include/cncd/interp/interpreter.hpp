@@ -26,6 +26,9 @@ struct InterpOptions {
   Units machine_units = Units::mm;       // units of the machine (INI LINEAR_UNITS)
   std::filesystem::path parameter_file;  // empty = none
   std::filesystem::path tool_table;      // empty = none
+  // Units the tool table is written in (LinuxCNC: the machine's units; its standalone rs274
+  // reads tables as inches). Unset = machine_units.
+  std::optional<Units> tool_table_units;
   std::vector<std::filesystem::path> subroutine_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'

@@ -1,0 +1,152 @@
+// G2/G3: center (IJK) and radius (R) formats, full circles, P turns and helices, with
+// LinuxCNC's tolerances and error messages.
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "failure.hpp"
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+namespace {
+
+struct PlaneAxes {
+  std::size_t first;
+  std::size_t second;
+  std::size_t normal;
+  char first_offset;    // center offset letter along `first`
+  char second_offset;   // along `second`
+  char foreign_offset;  // the offset letter that does not belong to the plane
+  const char* name;
+};
+
+PlaneAxes plane_axes(Plane plane) {
+  switch (plane) {
+    case Plane::xz:
+      return {kZ, kX, kY, 'k', 'i', 'j', "xz"};
+    case Plane::yz:
+      return {kY, kZ, kX, 'j', 'k', 'i', "yz"};
+    case Plane::xy:
+    default:
+      return {kX, kY, kZ, 'i', 'j', 'k', "xy"};
+  }
+}
+
+// LinuxCNC's limits: a center-format arc may miss its radius by this much (and by 0.1 %),
+// a radius-format arc may be this much too short to reach its end point.
+constexpr double kCenterToleranceMm = 0.028284271247461905;  // 0.02 * sqrt(2)
+constexpr double kCenterToleranceInch = 0.0028284271247461905;
+constexpr double kCenterRelativeTolerance = 0.001;
+constexpr double kRadiusToleranceInch = 0.00005;
+
+std::string format(const char* pattern, double a, double b) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
+
+}  // namespace
+
+void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
+  const PlaneAxes axes = plane_axes(modal_.plane);
+  const double start1 = pos_[axes.first];
+  const double start2 = pos_[axes.second];
+  const double end1 = end[axes.first];
+  const double end2 = end[axes.second];
+  const char letter1 = static_cast<char>(std::toupper(kAxisLetters[axes.first]));
+  const char letter2 = static_cast<char>(std::toupper(kAxisLetters[axes.second]));
+  const bool inches = modal_.units == Units::inches;
+  const bool radius_format = block_.has('r');
+  const bool has_offsets = block_.has(axes.first_offset) || block_.has(axes.second_offset);
+
+  if (block_.has(axes.foreign_offset)) {
+    fail(std::string(1, static_cast<char>(std::toupper(axes.foreign_offset))) +
+         " word given for arc in " + axes.name + " plane");
+  }
+  if (!radius_format && !has_offsets) fail("R i j k words all missing for arc");
+  if (radius_format && has_offsets) fail("Mixed radius ijk format for arc");
+  int turns = 1;
+  if (block_.has('p')) {
+    const double p = block_.get('p');
+    if (p != std::floor(p)) fail("P value not an integer with M19 G2 or G3", block_.col('p'));
+    if (p < 1.0) fail("P value should be 1 or greater with G2 or G3", block_.col('p'));
+    turns = static_cast<int>(p);
+  }
+
+  double center1 = 0;
+  double center2 = 0;
+  if (radius_format) {
+    // The plane letters in order (X before Y before Z), as LinuxCNC names them.
+    const bool first_is_later = axes.first > axes.second;
+    const char low = static_cast<char>(std::tolower(first_is_later ? letter2 : letter1));
+    const char high = static_cast<char>(std::tolower(first_is_later ? letter1 : letter2));
+    if (!block_.has(low) && !block_.has(high)) {
+      fail(std::string(1, static_cast<char>(std::toupper(low))) + " and " + high +
+           " words missing for arc in " + axes.name + " plane");
+    }
+    const double radius = block_.get('r');
+    const double d1 = end1 - start1;
+    const double d2 = end2 - start2;
+    const double chord = std::hypot(d1, d2);
+    if (chord == 0.0) fail("Current point same as end point of arc");
+    const double half = chord / 2.0;
+    const double abs_radius = std::fabs(radius);
+    const double tolerance = inches ? kRadiusToleranceInch : kRadiusToleranceInch * 25.4;
+    if (half - abs_radius > tolerance) fail("Arc radius too small to reach end point");
+    const double offset =
+        abs_radius > half ? std::sqrt(abs_radius * abs_radius - half * half) : 0.0;
+    // The center is right of the chord for a clockwise minor arc, left for a counterclockwise
+    // one; a negative R asks for the major arc, on the other side.
+    const bool right = clockwise != (radius < 0.0);
+    const double u1 = right ? d2 / chord : -d2 / chord;
+    const double u2 = right ? -d1 / chord : d1 / chord;
+    center1 = start1 + d1 / 2.0 + offset * u1;
+    center2 = start2 + d2 / 2.0 + offset * u2;
+  } else {
+    const double o1 = block_.has(axes.first_offset) ? block_.get(axes.first_offset) : 0.0;
+    const double o2 = block_.has(axes.second_offset) ? block_.get(axes.second_offset) : 0.0;
+    center1 = modal_.arc_incremental ? start1 + o1 : o1;
+    center2 = modal_.arc_incremental ? start2 + o2 : o2;
+    const double r1 = std::hypot(start1 - center1, start2 - center2);
+    const double r2 = std::hypot(end1 - center1, end2 - center2);
+    auto where = [&]() {
+      return std::string(" start=(") + letter1 + format("%.4f,", start1, 0) + letter2 +
+             format("%.4f) center=(", start2, 0) + letter1 + format("%.4f,", center1, 0) + letter2 +
+             format("%.4f) end=(", center2, 0) + letter1 + format("%.4f,", end1, 0) + letter2 +
+             format("%.4f)", end2, 0) + format(" r1=%.4f r2=%.4f", r1, r2);
+    };
+    if (r1 == 0.0 || r2 == 0.0) fail("Zero-radius arc:" + where());
+    const double abs_err = std::fabs(r1 - r2);
+    const double rel_err = abs_err / std::max(r1, r2);
+    if (abs_err > (inches ? kCenterToleranceInch : kCenterToleranceMm) &&
+        rel_err > kCenterRelativeTolerance) {
+      fail("Radius to end of arc differs from radius to start:" + where() +
+           format(" abs_err=%.4g rel_err=%.4f%%", abs_err, rel_err * 100.0));
+    }
+  }
+
+  if (modal_.feed_mode == FeedMode::inverse_time) {
+    const double radius = std::hypot(start1 - center1, start2 - center2);
+    const double a0 = std::atan2(start2 - center2, start1 - center1);
+    const double a1 = std::atan2(end2 - center2, end1 - center1);
+    double sweep = clockwise ? a0 - a1 : a1 - a0;
+    if (sweep <= 1e-12) sweep += 2.0 * std::numbers::pi;
+    sweep += 2.0 * std::numbers::pi * (turns - 1);
+    set_inverse_time_rate(std::hypot(radius * sweep, end[axes.normal] - pos_[axes.normal]));
+  }
+  CanonCommand& command = make(CanonKind::arc_feed);
+  command.first_end = end1;
+  command.second_end = end2;
+  command.first_axis = center1;
+  command.second_axis = center2;
+  command.rotation = clockwise ? -turns : turns;
+  command.axis_end_point = end[axes.normal];
+  command.plane = modal_.plane;
+  command.pos = end;
+  emit(command);
+  pos_ = end;
+}
+
+}  // namespace cncd::interp
