@@ -85,6 +85,12 @@ struct CallFrame {
 
 class CanonSink;
 
+inline constexpr int kG5xBase = 5221;  // G54 X; each system takes 20 parameters, R at +9
+inline constexpr int kG92Base = 5211;
+
+bool is_linear_axis(int axis);
+double unit_factor(Units from, Units to);
+
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {
   std::size_t a = 0;  // first plane axis
@@ -132,8 +138,13 @@ struct Interpreter::Impl {
   void set_inverse_time_rate(double length);
   void emit_straight(CanonKind kind, const Pose& end);
 
-  // offsets.cpp
+  // offsets.cpp, setup_codes.cpp
   void do_g10();
+  void set_coord_system_data(int l, int system);
+  void set_tool_data(int l, int tool);
+  Pose read_offset_parameters(int base) const;
+  void write_offset_parameters(int base, const Pose& offset, std::uint32_t axes);
+  double to_machine_units(double program_value) const;
   void do_g92(int code);
   void do_home(int code);
   void select_coord_system(int index);

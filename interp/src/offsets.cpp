@@ -1,6 +1,6 @@
-// Coordinate systems, G92/G52 offsets, units, tool length offsets, G10, G28/G30.
-// Offsets are kept in program units; the parameters hold them in machine units, as the
-// LinuxCNC .var file does for a machine of those units.
+// Coordinate systems, G92/G52 offsets, units and tool length offsets. Offsets are kept in
+// program units; the parameters hold them in machine units, as LinuxCNC's .var file does.
+// Whenever an offset changes, the machine position stays put and the program position moves.
 #include <cmath>
 #include <numbers>
 
@@ -8,14 +8,8 @@
 #include "interp_state.hpp"
 
 namespace cncd::interp {
-namespace {
 
-constexpr int kG5xBase = 5221;  // G54 X; each system takes 20 parameters, R at +9
-constexpr int kG92Base = 5211;
-constexpr int kG28Base = 5161;
-constexpr int kG30Base = 5181;
-
-bool is_linear(int axis) {
+bool is_linear_axis(int axis) {
   return axis <= kZ || axis >= kU;
 }
 
@@ -26,8 +20,6 @@ double unit_factor(Units from, Units to) {
   return mm(from) / mm(to);
 }
 
-}  // namespace
-
 Units Interpreter::Impl::tool_table_units() const {
   return options_.tool_table_units.value_or(options_.machine_units);
 }
@@ -36,17 +28,32 @@ double Interpreter::Impl::to_program_units(double machine_value) const {
   return machine_value * unit_factor(options_.machine_units, modal_.units);
 }
 
-void Interpreter::Impl::load_coord_system(int index) {
-  const int base = kG5xBase + 20 * (index - 1);
+double Interpreter::Impl::to_machine_units(double program_value) const {
+  return program_value * unit_factor(modal_.units, options_.machine_units);
+}
+
+Pose Interpreter::Impl::read_offset_parameters(int base) const {
+  Pose offset{};
   for (int axis = 0; axis < kAxes; ++axis) {
     const double value = parameters_.get(base + axis);
-    g5x_offset_[static_cast<std::size_t>(axis)] = is_linear(axis) ? to_program_units(value) : value;
+    offset[static_cast<std::size_t>(axis)] = is_linear_axis(axis) ? to_program_units(value) : value;
   }
-  rotation_deg_ = parameters_.get(base + 9);
+  return offset;
+}
+
+void Interpreter::Impl::write_offset_parameters(int base, const Pose& offset, std::uint32_t axes) {
   for (int axis = 0; axis < kAxes; ++axis) {
-    const double value = parameters_.get(kG92Base + axis);
-    g92_offset_[static_cast<std::size_t>(axis)] = is_linear(axis) ? to_program_units(value) : value;
+    if (((axes >> axis) & 1U) == 0) continue;
+    const double value = offset[static_cast<std::size_t>(axis)];
+    parameters_.set(base + axis, is_linear_axis(axis) ? to_machine_units(value) : value);
   }
+}
+
+void Interpreter::Impl::load_coord_system(int index) {
+  const int base = kG5xBase + 20 * (index - 1);
+  g5x_offset_ = read_offset_parameters(base);
+  rotation_deg_ = parameters_.get(base + 9);
+  g92_offset_ = read_offset_parameters(kG92Base);
 }
 
 void Interpreter::Impl::emit_g5x() {
@@ -63,12 +70,11 @@ void Interpreter::Impl::emit_g92() {
 }
 
 void Interpreter::Impl::select_coord_system_quiet(int index) {
-  const Pose old_offset = g5x_offset_;
+  const Pose machine = program_to_machine(pos_);
   modal_.coord_system = index;
   parameters_.set(5220, index);
   load_coord_system(index);
-  for (std::size_t axis = 0; axis < kAxes; ++axis)
-    pos_[axis] += old_offset[axis] - g5x_offset_[axis];
+  pos_ = machine_to_program(machine);
 }
 
 void Interpreter::Impl::select_coord_system(int index) {
@@ -82,7 +88,7 @@ void Interpreter::Impl::change_units(Units units) {
   if (units != modal_.units) {
     const double factor = unit_factor(modal_.units, units);
     for (int axis = 0; axis < kAxes; ++axis) {
-      if (!is_linear(axis)) continue;
+      if (!is_linear_axis(axis)) continue;
       const auto a = static_cast<std::size_t>(axis);
       pos_[a] *= factor;
       g5x_offset_[a] *= factor;
@@ -98,7 +104,6 @@ void Interpreter::Impl::apply_tool_length(int code) {
   Pose offset{};
   if (code == 430) {
     const int tool = block_.has('h') ? static_cast<int>(block_.get('h')) : tool_in_spindle_;
-    if (tool < 0) fail("Negative h word tool length offset index used", block_.col('h'));
     if (tool != 0) {
       const ToolEntry* entry = tools_.find(tool);
       if (entry == nullptr && !options_.tool_table.empty()) {
@@ -109,7 +114,7 @@ void Interpreter::Impl::apply_tool_length(int code) {
         const double factor = unit_factor(tool_table_units(), modal_.units);
         for (int axis = 0; axis < kAxes; ++axis) {
           const double value = entry->offset[static_cast<std::size_t>(axis)];
-          offset[static_cast<std::size_t>(axis)] = is_linear(axis) ? value * factor : value;
+          offset[static_cast<std::size_t>(axis)] = is_linear_axis(axis) ? value * factor : value;
         }
       }
     }
@@ -121,172 +126,77 @@ void Interpreter::Impl::apply_tool_length(int code) {
       if (block_.has(letter)) offset[static_cast<std::size_t>(axis)] = block_.get(letter);
     }
   }
-  for (std::size_t axis = 0; axis < kAxes; ++axis)
-    pos_[axis] += tool_offset_[axis] - offset[axis];
+  const Pose machine = program_to_machine(pos_);
   tool_offset_ = offset;
+  pos_ = machine_to_program(machine);
   modal_.tool_length_code = code;
   CanonCommand& command = make(CanonKind::use_tool_length_offset);
   command.pos = tool_offset_;
   emit(command);
 }
 
+// LinuxCNC's canon order: the G92 offset applies in the rotated system, the G5x origin and the
+// tool offset after the rotation.
 Pose Interpreter::Impl::program_to_machine(const Pose& program) const {
-  Pose machine = program;
+  Pose p = program;
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    p[axis] += g92_offset_[axis];
   if (rotation_deg_ != 0.0) {
     const double angle = rotation_deg_ * std::numbers::pi / 180.0;
-    machine[kX] = program[kX] * std::cos(angle) - program[kY] * std::sin(angle);
-    machine[kY] = program[kX] * std::sin(angle) + program[kY] * std::cos(angle);
+    const double x = p[kX] * std::cos(angle) - p[kY] * std::sin(angle);
+    const double y = p[kX] * std::sin(angle) + p[kY] * std::cos(angle);
+    p[kX] = x;
+    p[kY] = y;
   }
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    machine[axis] += g5x_offset_[axis] + g92_offset_[axis] + tool_offset_[axis];
-  }
-  return machine;
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    p[axis] += g5x_offset_[axis] + tool_offset_[axis];
+  return p;
 }
 
 Pose Interpreter::Impl::machine_to_program(const Pose& machine) const {
-  Pose shifted = machine;
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    shifted[axis] -= g5x_offset_[axis] + g92_offset_[axis] + tool_offset_[axis];
+  Pose p = machine;
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    p[axis] -= g5x_offset_[axis] + tool_offset_[axis];
+  if (rotation_deg_ != 0.0) {
+    const double angle = -rotation_deg_ * std::numbers::pi / 180.0;
+    const double x = p[kX] * std::cos(angle) - p[kY] * std::sin(angle);
+    const double y = p[kX] * std::sin(angle) + p[kY] * std::cos(angle);
+    p[kX] = x;
+    p[kY] = y;
   }
-  if (rotation_deg_ == 0.0) return shifted;
-  const double angle = -rotation_deg_ * std::numbers::pi / 180.0;
-  Pose program = shifted;
-  program[kX] = shifted[kX] * std::cos(angle) - shifted[kY] * std::sin(angle);
-  program[kY] = shifted[kX] * std::sin(angle) + shifted[kY] * std::cos(angle);
-  return program;
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    p[axis] -= g92_offset_[axis];
+  return p;
 }
 
 void Interpreter::Impl::do_g92(int code) {
-  const Pose old_offset = g92_offset_;
-  const double to_machine = unit_factor(modal_.units, options_.machine_units);
+  const Pose machine = program_to_machine(pos_);
   if (code == 920 || code == 520) {
-    bool any = false;
+    std::uint32_t axes = 0;
     for (int axis = 0; axis < kAxes; ++axis) {
       const char letter = kAxisLetters[axis];
       if (!block_.has(letter)) continue;
-      any = true;
+      axes |= 1U << axis;
       const auto a = static_cast<std::size_t>(axis);
       const double value = block_.get(letter);
       // G92: the current point gets the given coordinate; G52: the offset is the given value.
-      g92_offset_[a] = code == 920 ? pos_[a] + old_offset[a] - value : value;
+      g92_offset_[a] = code == 920 ? pos_[a] + g92_offset_[a] - value : value;
     }
-    if (!any) {
-      fail(code == 920 ? "All axes missing with g92" : "All axes missing with g52",
-           block_.g_column[0]);
-    }
+    if (axes == 0) fail("All axes missing with g52 or g92", block_.g_column[0]);
     parameters_.set(5210, 1);
+    write_offset_parameters(kG92Base, g92_offset_, 0x1FFU);
   } else if (code == 921 || code == 922) {
     g92_offset_ = Pose{};
-    if (code == 921) parameters_.set(5210, 0);
-  } else {
-    for (int axis = 0; axis < kAxes; ++axis) {
-      const double value = parameters_.get(kG92Base + axis);
-      g92_offset_[static_cast<std::size_t>(axis)] =
-          is_linear(axis) ? to_program_units(value) : value;
+    if (code == 921) {
+      parameters_.set(5210, 0);
+      write_offset_parameters(kG92Base, g92_offset_, 0x1FFU);
     }
+  } else {
+    g92_offset_ = read_offset_parameters(kG92Base);
     parameters_.set(5210, 1);
   }
-  if (code != 922 && code != 923) {
-    for (int axis = 0; axis < kAxes; ++axis) {
-      const double value = g92_offset_[static_cast<std::size_t>(axis)];
-      parameters_.set(kG92Base + axis, is_linear(axis) ? value * to_machine : value);
-    }
-  }
-  for (std::size_t axis = 0; axis < kAxes; ++axis)
-    pos_[axis] += old_offset[axis] - g92_offset_[axis];
+  pos_ = machine_to_program(machine);
   emit_g92();
-}
-
-void Interpreter::Impl::do_g10() {
-  if (!block_.has('l')) fail("Line number missing with g10", block_.g_column[0]);
-  const int l = static_cast<int>(block_.get('l'));
-  if (l != 1 && l != 2 && l != 10 && l != 11 && l != 20) {
-    fail("Invalid l value with g10", block_.col('l'));
-  }
-  if (!block_.has('p')) fail("P word missing with g10", block_.g_column[0]);
-  const int p = static_cast<int>(block_.get('p'));
-  if (l == 2 || l == 20) {
-    if (p < 0 || p > 9) fail("P value out of range with G10 L2", block_.col('p'));
-    const int system = p == 0 ? modal_.coord_system : p;
-    const int base = kG5xBase + 20 * (system - 1);
-    const double to_machine = unit_factor(modal_.units, options_.machine_units);
-    for (int axis = 0; axis < kAxes; ++axis) {
-      const char letter = kAxisLetters[axis];
-      if (!block_.has(letter)) continue;
-      double value = block_.get(letter);
-      if (l == 20) {
-        // The offset that makes the current point read `value` in that system.
-        const auto a = static_cast<std::size_t>(axis);
-        value = pos_[a] + g5x_offset_[a] - value;
-      }
-      parameters_.set(base + axis, is_linear(axis) ? value * to_machine : value);
-    }
-    if (block_.has('r')) parameters_.set(base + 9, block_.get('r'));
-    if (system == modal_.coord_system) {
-      const Pose old_offset = g5x_offset_;
-      load_coord_system(system);
-      for (std::size_t axis = 0; axis < kAxes; ++axis) {
-        pos_[axis] += old_offset[axis] - g5x_offset_[axis];
-      }
-      emit_g5x();
-      emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
-    }
-    return;
-  }
-  if (p <= 0) fail("P value out of range with G10 L1", block_.col('p'));
-  ToolEntry entry;
-  if (const ToolEntry* existing = tools_.find(p)) entry = *existing;
-  entry.number = p;
-  const double to_machine = unit_factor(modal_.units, tool_table_units());
-  for (int axis = 0; axis < kAxes; ++axis) {
-    const char letter = kAxisLetters[axis];
-    if (!block_.has(letter)) continue;
-    const auto a = static_cast<std::size_t>(axis);
-    double value = block_.get(letter);
-    if (l == 10 || l == 11) {
-      // The tool offset that makes the current point read `value`.
-      value = pos_[a] + tool_offset_[a] - value;
-    }
-    entry.offset[a] = is_linear(axis) ? value * to_machine : value;
-  }
-  if (block_.has('r')) entry.diameter = 2.0 * block_.get('r') * to_machine;
-  if (block_.has('i')) entry.front_angle = block_.get('i');
-  if (block_.has('j')) entry.back_angle = block_.get('j');
-  if (block_.has('q')) entry.orientation = static_cast<int>(block_.get('q'));
-  tools_.set(entry);
-}
-
-void Interpreter::Impl::do_home(int code) {
-  const int base = (code == 280 || code == 281) ? kG28Base : kG30Base;
-  if (code == 281 || code == 301) {
-    const Pose machine = program_to_machine(pos_);
-    const double to_machine = unit_factor(modal_.units, options_.machine_units);
-    for (int axis = 0; axis < kAxes; ++axis) {
-      const double value = machine[static_cast<std::size_t>(axis)];
-      parameters_.set(base + axis, is_linear(axis) ? value * to_machine : value);
-    }
-    return;
-  }
-  // Optional intermediate point (program coordinates), then the stored point (machine).
-  bool any = false;
-  Pose intermediate = pos_;
-  for (int axis = 0; axis < kAxes; ++axis) {
-    const char letter = kAxisLetters[axis];
-    if (!block_.has(letter)) continue;
-    any = true;
-    const auto a = static_cast<std::size_t>(axis);
-    intermediate[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
-  }
-  if (any) straight(CanonKind::straight_traverse, intermediate);
-  Pose home_machine = program_to_machine(pos_);
-  for (int axis = 0; axis < kAxes; ++axis) {
-    const char letter = kAxisLetters[axis];
-    if (any && !block_.has(letter)) continue;
-    const double value = parameters_.get(base + axis);
-    home_machine[static_cast<std::size_t>(axis)] =
-        is_linear(axis) ? to_program_units(value) : value;
-  }
-  straight(CanonKind::straight_traverse, machine_to_program(home_machine));
 }
 
 }  // namespace cncd::interp

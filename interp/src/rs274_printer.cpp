@@ -167,6 +167,17 @@ std::string format_rs274(const CanonCommand& c, int axes) {
       append(out, "%.4f", c.value);
       out += ", " + std::to_string(c.ivalue);
       break;
+    case CanonKind::set_tool_table_entry:
+      out = "SET_TOOL_TABLE_ENTRY(" + std::to_string(c.ivalue) + ", " + std::to_string(c.ivalue2) +
+            ", ";
+      for (int axis = 0; axis < kAxes; ++axis) {
+        if (axis > 0) out += ' ';
+        append(out, "%.4f", c.pos[static_cast<std::size_t>(axis)]);
+      }
+      append(out, ", %.4f", c.value);
+      append(out, ", %.4f", c.value2);
+      out += ", " + std::to_string(c.ivalue3);
+      break;
     case CanonKind::set_spindle_mode:
       out = "SET_SPINDLE_MODE(0 ";
       append(out, "%.4f", c.value);

@@ -57,9 +57,11 @@ enum class CanonKind : std::uint8_t {
   program_end,            // M2/M30
   pallet_shuttle,         // M60 (stop)
   on_reset,
-  finish,          // the program ended with a closing '%'
-  start_change,    // M6: the tool change begins (emitted before CHANGE_TOOL)
-  orient_spindle,  // value: angle in degrees; ivalue: LinuxCNC's orientation mode
+  finish,                // the program ended with a closing '%'
+  start_change,          // M6: the tool change begins (emitted before CHANGE_TOOL)
+  orient_spindle,        // value: angle in degrees; ivalue: LinuxCNC's orientation mode
+  set_tool_table_entry,  // ivalue: pocket, ivalue2: tool, pos: offsets (tool table units),
+                         // value/value2: front/back angle, ivalue3: orientation
 };
 
 struct CanonCommand {
@@ -73,6 +75,8 @@ struct CanonCommand {
   double value = 0;         // feed rate, dwell seconds, spindle speed, tolerance, rotation angle
   double value2 = 0;        // second number (naivecam tolerance ...)
   int ivalue = 0;
+  int ivalue2 = 0;  // SET_TOOL_TABLE_ENTRY: tool number
+  int ivalue3 = 0;  // SET_TOOL_TABLE_ENTRY: orientation
   std::string text;
 };
 
