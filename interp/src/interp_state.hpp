@@ -2,12 +2,17 @@
 // execution, motion, canned cycles, control flow).
 #pragma once
 
+#include <array>
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "block.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "failure.hpp"
 #include "parameters.hpp"
 #include "parser.hpp"
 #include "source.hpp"
@@ -65,22 +70,30 @@ struct CycleState {
   double initial_level = 0;
 };
 
-// Control flow: an open O-word block (if/while/do/repeat) or a subroutine call frame.
+// An open O-word block: if/elseif/else, while, do or repeat.
 struct ControlFrame {
   OKind kind = OKind::none;
   std::string name;
-  std::int64_t offset = 0;  // offset of the line after the opening o-line (loops)
+  std::int64_t offset = 0;  // where the loop starts again (while: the while line itself)
   int line_before = 0;      // line number before that offset
-  int remaining = 0;        // repeat count left
-  bool taken = false;       // an if/elseif branch already ran
+  int remaining = 0;        // repeat: passes left
+};
+
+// Where a subroutine starts: the line after its "sub" line.
+struct SubInfo {
+  std::size_t source = 0;  // index into the open sources
+  std::int64_t offset = 0;
+  int line_before = 0;
+  bool found_by_search = false;
 };
 
 struct CallFrame {
   std::string name;
+  std::size_t source = 0;  // the caller's source
   std::int64_t return_offset = 0;
   int return_line = 0;
   std::size_t control_depth = 0;
-  std::size_t source_index = 0;
+  std::array<double, 30> saved_parameters{};  // the caller's #1-#30
 };
 
 class CanonSink;
@@ -121,6 +134,9 @@ struct Interpreter::Impl {
   bool axes_belong_to_non_modal() const;
   void check_word_users(int motion) const;
   void do_comment();
+  std::string substitute_parameters(const std::string& text) const;
+  std::optional<double> predefined_parameter(std::string_view name) const;
+  void publish_parameters();
   void do_feed_mode();
   void do_tool_and_spindle();
   void do_coolant_and_overrides();
@@ -161,6 +177,16 @@ struct Interpreter::Impl {
   void do_canned_cycle(int code);
   void cycle_body(int code, const CycleGeometry& g, double a, double b, double& current_c);
 
+  // control.cpp: O-words.
+  void handle_o_word();
+  void do_call();
+  void do_return(bool has_value, double value);
+  void skip_block(const std::string& name, std::initializer_list<OKind> stops);
+  bool find_sub(const std::string& name);
+  void skip_loop_end(const ControlFrame& frame);
+  std::string label_error(const char* what) const;
+  LineSource& source() { return sources_.back(); }
+
   // emit helpers
   CanonCommand& make(CanonKind kind);
   void emit(const CanonCommand& command) { sink_->emit(command); }
@@ -200,6 +226,12 @@ struct Interpreter::Impl {
   int tool_prepped_ = -1;
   std::vector<ControlFrame> control_;
   std::vector<CallFrame> calls_;
+  std::unordered_map<std::string, SubInfo> subs_;
+  std::int64_t line_offset_ = 0;  // offset of the line being executed
+  int line_before_ = 0;           // line number before it
+  double last_value_ = 0;         // #<_value>
+  bool value_returned_ = false;   // #<_value_returned>
+  std::string o_scan_name_;       // scratch for skipping lines
 };
 
 }  // namespace cncd::interp

@@ -16,6 +16,7 @@ std::string InterpError::to_string() const {
 }
 
 Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
+  parameters_.set_predefined([this](std::string_view name) { return predefined_parameter(name); });
   if (!options_.parameter_file.empty()) {
     if (auto problem = parameters_.load(options_.parameter_file)) {
       error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
@@ -38,6 +39,7 @@ void Interpreter::Impl::reset_modal_state() {
   load_coord_system(modal_.coord_system);
   control_.clear();
   calls_.clear();
+  subs_.clear();
   preamble_done_ = false;
   ended_ = false;
   seen_percent_ = false;
@@ -108,6 +110,8 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     if (sources_.empty()) fail("No program open");
     if (!preamble_done_) emit_preamble();
     LineSource& source = sources_.back();
+    line_offset_ = source.tell();
+    line_before_ = source.line_number();
     if (!source.read_line(line_)) {
       current_line_ = source.line_number();
       fail("File ended with no percent sign or program end");
@@ -125,6 +129,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
       }
     }
     run_line();
+    publish_parameters();
     return ended_ ? Step::end : Step::block;
   } catch (const Failure& failure) {
     error_ = make_error(failure);
@@ -141,7 +146,10 @@ void Interpreter::Impl::run_line() {
     const auto& [name, value] = block_.named_assignments[static_cast<std::size_t>(i)];
     parameters_.set_named(name, value);
   }
-  if (block_.o_kind != OKind::none) fail("O-word control flow is not supported");
+  if (block_.o_kind != OKind::none) {
+    handle_o_word();
+    return;
+  }
   execute_block();
 }
 

@@ -99,7 +99,8 @@ void Interpreter::Impl::do_motion() {
     if (axis_words || arc_words || explicit_code >= 0) arc(code == 20, target_from_words());
     return;
   }
-  if (!axis_words) return;
+  // An explicit G0/G1 moves (possibly nowhere); a modal one only with axis words.
+  if (!axis_words && explicit_code < 0) return;
   const Pose end = target_from_words();
   straight(code == 0 ? CanonKind::straight_traverse : CanonKind::straight_feed, end);
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@
 
 namespace cncd::interp::testing {
 namespace {
+
+constexpr const char* kLinuxCncSamples = "/usr/share/doc/linuxcnc/examples/nc_files";
 
 std::vector<std::string> programs() {
   std::vector<std::string> found;
@@ -24,6 +27,14 @@ std::vector<std::string> programs() {
          std::filesystem::recursive_directory_iterator(CNCD_EXTRA_PROGRAMS_DIR)) {
       if (entry.path().extension() == ".ngc") found.push_back(entry.path().string());
     }
+  }
+  // LinuxCNC's own sample programs, when installed.
+  std::ifstream list(CNCD_SAMPLES_LIST);
+  std::string name;
+  while (std::getline(list, name)) {
+    if (name.empty() || name[0] == '#') continue;
+    const auto path = std::filesystem::path(kLinuxCncSamples) / name;
+    if (std::filesystem::exists(path)) found.push_back(path.string());
   }
   std::sort(found.begin(), found.end());
   return found;

@@ -127,10 +127,10 @@ std::optional<SessionOutput> run_rs274(const std::filesystem::path& program,
     command += " -v " + quote((work / "params.var").string());
   }
   command += " " + quote(program.string());
-  const std::string canon_raw =
-      run_command("cd " + quote(work.string()) + " && " + command + " 2>/dev/null");
-  const std::string err_raw =
-      run_command("cd " + quote(work.string()) + " && " + command + " 2>&1 >/dev/null");
+  const auto errors_file = work / "stderr";
+  const std::string canon_raw = run_command("cd " + quote(work.string()) + " && " + command +
+                                            " 2>" + quote(errors_file.string()));
+  const std::string err_raw = read_file(errors_file);
   std::filesystem::remove_all(work);
 
   SessionOutput result;

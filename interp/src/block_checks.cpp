@@ -1,0 +1,106 @@
+// Checks of a whole block before anything runs: unsupported codes, axis words without a user,
+// words no code uses, negative words. LinuxCNC's wording throughout.
+#include <string>
+
+#include "failure.hpp"
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+
+// G10, G28, G30, G52 and G92 take the line's axis words for themselves; so does G43.1 when
+// no motion code shares its line (with one, both use them).
+bool Interpreter::Impl::axes_belong_elsewhere() const {
+  return axes_belong_to_non_modal() ||
+         (block_.g_code(GGroup::tool_length) == 431 && block_.g_code(GGroup::motion) < 0);
+}
+
+bool Interpreter::Impl::axes_belong_to_non_modal() const {
+  const int code = block_.g_code(GGroup::non_modal);
+  return code == 100 || code == 280 || code == 300 || code == 520 || code == 920;
+}
+
+void Interpreter::Impl::check_block() const {
+  const Block& b = block_;
+  for (int group = 0; group < kGGroups; ++group) {
+    const int code = b.g[static_cast<std::size_t>(group)];
+    if (code >= 0 && !g_code_info(code).supported) {
+      fail("G" + std::to_string(code / 10) +
+               (code % 10 != 0 ? "." + std::to_string(code % 10) : "") + " is not supported",
+           b.g_column[static_cast<std::size_t>(group)]);
+    }
+  }
+  for (int group = 0; group < kMGroups; ++group) {
+    const int code = b.m[static_cast<std::size_t>(group)];
+    if (code >= 0 && !m_code_info(code).supported) {
+      fail("M" + std::to_string(code) + " is not supported",
+           b.m_column[static_cast<std::size_t>(group)]);
+    }
+  }
+  bool axis_words = false;
+  for (const char letter : kAxisLetters) {
+    if (letter != '\0' && b.has(letter)) axis_words = true;
+  }
+  const int motion = b.g_code(GGroup::motion);
+  if (axes_belong_to_non_modal() && motion >= 0 && motion != 800) {
+    fail("Cannot use two g codes that both use axis values", b.g_column[0]);
+  }
+  if (motion == 800 && axis_words && !axes_belong_elsewhere()) {
+    fail("Cannot use axis values with g80", b.g_column[static_cast<std::size_t>(GGroup::motion)]);
+  }
+  if (axis_words && motion < 0 && !axes_belong_elsewhere() &&
+      (modal_.motion < 0 || modal_.motion == 800)) {
+    fail("Cannot use axis values without a g code that uses them");
+  }
+  const int active_motion = motion >= 0 ? motion : modal_.motion;
+  const bool cycle = active_motion == 730 || active_motion == 740 ||
+                     (active_motion >= 810 && active_motion <= 890);
+  if (cycle && !axes_belong_elsewhere()) {
+    for (const char letter : {'a', 'b', 'c'}) {
+      if (b.has(letter)) {
+        fail(std::string("Cannot put an ") + letter + " in canned cycle", b.col(letter));
+      }
+    }
+  }
+  check_word_users(active_motion);
+  if (b.has('e')) fail("E word with no G70, G76, M66, M67 or M68 to use it", b.col('e'));
+  if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
+  if (b.has('s') && b.get('s') < 0) fail("Negative spindle speed used", b.col('s'));
+  if (b.has('t') && b.get('t') < 0) fail("Negative t word used", b.col('t'));
+}
+
+// Words that no code on the line (or the modal motion) uses are errors in LinuxCNC.
+void Interpreter::Impl::check_word_users(int motion) const {
+  const Block& b = block_;
+  const int non_modal = b.g_code(GGroup::non_modal);
+  const bool g10 = non_modal == 100;
+  const bool arc = motion == 20 || motion == 30;
+  const bool cycle = motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
+  const int overrides = b.m_code(MGroup::overrides);
+  auto require = [&](char letter, bool used, const char* message) {
+    if (b.has(letter) && !used) fail(message, b.col(letter));
+  };
+  require('i', arc || g10 || motion == 870,
+          "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
+  require('j', arc || g10 || motion == 870,
+          "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
+  require('k', arc || motion == 870, "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
+  require('r', arc || cycle || g10, "R word with no g code that uses it");
+  const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
+                      motion == 820 || motion == 860 || motion == 880 || motion == 890 ||
+                      motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53);
+  require('p', p_user,
+          "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
+          "M63 M64 M65 M66 M98 or user M code to use it");
+  const bool q_user = g10 || b.g_code(GGroup::path_control) == 640 || motion == 730 ||
+                      motion == 830 || b.m_code(MGroup::tool_change) == 61;
+  require('q', q_user,
+          "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
+          "uses it");
+  require('l', g10 || cycle,
+          "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
+          "NURBS code");
+  require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+  require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
+}
+
+}  // namespace cncd::interp

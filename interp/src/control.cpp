@@ -1,0 +1,329 @@
+// O-word control flow: subroutines (in the program file or in NAME.ngc on the subroutine
+// path), if/elseif/else, while, do/while, repeat, break, continue, return. The program is
+// re-read from remembered file offsets, so loops and calls cost no memory per line.
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "failure.hpp"
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+namespace {
+
+// The O-word of a raw line without evaluating anything: used while skipping lines.
+bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
+  std::size_t i = 0;
+  auto skip_blanks = [&] {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t'))
+      ++i;
+  };
+  auto lower = [&](std::size_t k) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(line[k])));
+  };
+  skip_blanks();
+  if (i < line.size() && line[i] == '/') ++i;
+  skip_blanks();
+  if (i < line.size() && lower(i) == 'n') {
+    ++i;
+    while (i < line.size() && (std::isdigit(static_cast<unsigned char>(line[i])) ||
+                               line[i] == ' ' || line[i] == '.')) {
+      ++i;
+    }
+  }
+  skip_blanks();
+  if (i >= line.size() || lower(i) != 'o') return false;
+  ++i;
+  name.clear();
+  skip_blanks();
+  if (i < line.size() && line[i] == '<') {
+    ++i;
+    while (i < line.size() && line[i] != '>') {
+      if (line[i] != ' ' && line[i] != '\t') name.push_back(lower(i));
+      ++i;
+    }
+    ++i;
+  } else {
+    while (i < line.size() &&
+           (std::isdigit(static_cast<unsigned char>(line[i])) || line[i] == ' ')) {
+      if (line[i] != ' ') name.push_back(line[i]);
+      ++i;
+    }
+  }
+  std::string word;
+  skip_blanks();
+  while (i < line.size() && std::isalpha(static_cast<unsigned char>(line[i])))
+    word += lower(i++);
+  static constexpr std::pair<const char*, OKind> kWords[] = {
+      {"sub", OKind::sub},        {"endsub", OKind::endsub}, {"call", OKind::call},
+      {"do", OKind::do_},         {"while", OKind::while_},  {"endwhile", OKind::endwhile},
+      {"if", OKind::if_},         {"elseif", OKind::elseif}, {"else", OKind::else_},
+      {"endif", OKind::endif},    {"break", OKind::break_},  {"continue", OKind::continue_},
+      {"return", OKind::return_}, {"repeat", OKind::repeat}, {"endrepeat", OKind::endrepeat},
+  };
+  for (const auto& [text, value] : kWords) {
+    if (word == text) {
+      kind = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string o_label(const std::string& name) {
+  return std::isdigit(static_cast<unsigned char>(name.empty() ? 'x' : name[0])) ? "o" + name
+                                                                                : "o<" + name + ">";
+}
+
+}  // namespace
+
+// Reads on until a line with this O-word name and one of `stops`; that line is then in
+// `line_` and is the current line.
+void Interpreter::Impl::skip_block(const std::string& name, std::initializer_list<OKind> stops) {
+  const int start_line = current_line_;
+  for (;;) {
+    line_offset_ = source().tell();
+    line_before_ = source().line_number();
+    if (!source().read_line(line_)) {
+      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
+           "> from line: " + std::to_string(start_line));
+    }
+    current_line_ = source().line_number();
+    OKind kind = OKind::none;
+    if (!scan_o_word(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
+    for (const OKind stop : stops) {
+      if (kind == stop) return;
+    }
+  }
+}
+
+bool Interpreter::Impl::find_sub(const std::string& name) {
+  // Search the rest of the program file first, as LinuxCNC does, then NAME.ngc files.
+  const std::int64_t offset = source().tell();
+  const int line_number = source().line_number();
+  OKind kind = OKind::none;
+  while (source().read_line(line_)) {
+    if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
+      subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
+      source().seek(offset, line_number);
+      return true;
+    }
+  }
+  source().seek(offset, line_number);
+  std::vector<std::filesystem::path> dirs = options_.subroutine_path;
+  dirs.push_back(std::filesystem::path(program_name_).parent_path());
+  for (const auto& dir : dirs) {
+    const auto file = dir / (name + ".ngc");
+    if (!std::filesystem::exists(file)) continue;
+    LineSource sub_file;
+    if (!sub_file.open_file(file)) continue;
+    while (sub_file.read_line(line_)) {
+      if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
+        sources_.push_back(std::move(sub_file));
+        subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+void Interpreter::Impl::do_call() {
+  const std::string name = block_.o_name;
+  const std::size_t caller = sources_.size() - 1;
+  const std::int64_t return_offset = source().tell();
+  const int return_line = source().line_number();
+  auto it = subs_.find(name);
+  if (it == subs_.end()) {
+    if (!find_sub(name)) {
+      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
+           "> from line: " + std::to_string(current_line_));
+    }
+    it = subs_.find(name);
+  }
+  if (calls_.size() >= 64) fail("Too many nested subroutine calls");
+  CallFrame frame;
+  frame.name = name;
+  frame.source = caller;
+  frame.return_offset = return_offset;
+  frame.return_line = return_line;
+  frame.control_depth = control_.size();
+  for (int i = 0; i < 30; ++i) {
+    frame.saved_parameters[static_cast<std::size_t>(i)] = parameters_.get(i + 1);
+    const auto arg = static_cast<std::size_t>(i);
+    parameters_.set(i + 1, arg < block_.call_args.size() ? block_.call_args[arg] : 0.0);
+  }
+  calls_.push_back(frame);
+  parameters_.push_scope();
+  if (it->second.source != sources_.size() - 1) {
+    // The sub lives in an already open file further down the stack: bring it back on top.
+    fail("Subroutine " + o_label(name) + " is not reachable from here");
+  }
+  source().seek(it->second.offset, it->second.line_before);
+}
+
+void Interpreter::Impl::do_return(bool has_value, double value) {
+  if (calls_.empty()) fail("Return or endsub outside a subroutine");
+  const CallFrame frame = calls_.back();
+  calls_.pop_back();
+  control_.resize(frame.control_depth);
+  parameters_.pop_scope();
+  for (int i = 0; i < 30; ++i)
+    parameters_.set(i + 1, frame.saved_parameters[static_cast<std::size_t>(i)]);
+  last_value_ = has_value ? value : 0.0;
+  value_returned_ = has_value;
+  while (sources_.size() - 1 > frame.source) {
+    // Leaving a NAME.ngc file: keep it open only while a sub in it may be called again.
+    for (auto it = subs_.begin(); it != subs_.end();) {
+      it = it->second.source == sources_.size() - 1 ? subs_.erase(it) : std::next(it);
+    }
+    sources_.pop_back();
+  }
+  source().seek(frame.return_offset, frame.return_line);
+}
+
+// LinuxCNC's wording for O-word label errors: "LINE: what: 'the line as written'".
+std::string Interpreter::Impl::label_error(const char* what) const {
+  return std::to_string(current_line_) + ": " + what + ": '" + line_ + "'";
+}
+
+void Interpreter::Impl::skip_loop_end(const ControlFrame& frame) {
+  if (frame.kind == OKind::do_) {
+    skip_block(frame.name, {OKind::while_});
+  } else if (frame.kind == OKind::repeat) {
+    skip_block(frame.name, {OKind::endrepeat});
+  } else {
+    skip_block(frame.name, {OKind::endwhile});
+  }
+}
+
+void Interpreter::Impl::handle_o_word() {
+  const std::string& name = block_.o_name;
+  const bool top_is_this = !control_.empty() && control_.back().name == name;
+  switch (block_.o_kind) {
+    case OKind::sub: {
+      auto it = subs_.find(name);
+      if (it != subs_.end() && it->second.found_by_search) {
+        fail("File:" + source().name() + " line:" + std::to_string(current_line_) + " sub: o|" +
+             name + "| found in illegal location");
+      }
+      subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), false};
+      skip_block(name, {OKind::endsub});
+      return;
+    }
+    case OKind::endsub:
+    case OKind::return_:
+      do_return(block_.has_o_value, block_.o_value);
+      return;
+    case OKind::call:
+      do_call();
+      return;
+    case OKind::if_:
+      if (block_.o_value != 0.0) {
+        control_.push_back(ControlFrame{OKind::if_, name, 0, 0, 0});
+        return;
+      }
+      // Look for a branch that runs: an elseif whose condition holds, an else, or the end.
+      for (;;) {
+        skip_block(name, {OKind::elseif, OKind::else_, OKind::endif});
+        parser_.parse(line_, block_);
+        if (block_.o_kind == OKind::endif) return;
+        if (block_.o_kind == OKind::else_ || block_.o_value != 0.0) {
+          control_.push_back(ControlFrame{OKind::if_, name, 0, 0, 0});
+          return;
+        }
+      }
+    case OKind::elseif:
+    case OKind::else_:
+      // The branch before ran: skip the rest of the if.
+      if (!top_is_this) fail(label_error("undefined O-word label"));
+      control_.pop_back();
+      skip_block(name, {OKind::endif});
+      return;
+    case OKind::endif:
+      if (!top_is_this) fail(label_error("undefined O-word label"));
+      control_.pop_back();
+      return;
+    case OKind::do_:
+      control_.push_back(
+          ControlFrame{OKind::do_, name, source().tell(), source().line_number(), 0});
+      return;
+    case OKind::while_:
+      if (top_is_this && control_.back().kind == OKind::do_) {
+        // The end of a do loop.
+        if (block_.o_value != 0.0) {
+          source().seek(control_.back().offset, control_.back().line_before);
+        } else {
+          control_.pop_back();
+        }
+        return;
+      }
+      if (block_.o_value == 0.0) {
+        if (top_is_this) control_.pop_back();
+        skip_block(name, {OKind::endwhile});
+        return;
+      }
+      if (!top_is_this) {
+        control_.push_back(ControlFrame{OKind::while_, name, line_offset_, line_before_, 0});
+      }
+      return;
+    case OKind::endwhile:
+      if (!top_is_this || control_.back().kind != OKind::while_) {
+        fail(label_error("undefined O-word label"));
+      }
+      source().seek(control_.back().offset, control_.back().line_before);
+      return;
+    case OKind::repeat: {
+      const int count = static_cast<int>(std::nearbyint(block_.o_value));
+      if (count <= 0) {
+        skip_block(name, {OKind::endrepeat});
+        return;
+      }
+      control_.push_back(
+          ControlFrame{OKind::repeat, name, source().tell(), source().line_number(), count});
+      return;
+    }
+    case OKind::endrepeat:
+      if (!top_is_this || control_.back().kind != OKind::repeat) {
+        fail(label_error("undefined O-word label"));
+      }
+      if (--control_.back().remaining > 0) {
+        source().seek(control_.back().offset, control_.back().line_before);
+      } else {
+        control_.pop_back();
+      }
+      return;
+    case OKind::break_:
+    case OKind::continue_: {
+      // Leave the if blocks nested in the loop, then end or restart the loop.
+      while (!control_.empty() && control_.back().name != name)
+        control_.pop_back();
+      if (control_.empty()) fail(label_error("undefined O-word label"));
+      ControlFrame& loop = control_.back();
+      if (block_.o_kind == OKind::break_) {
+        const ControlFrame ended = loop;
+        control_.pop_back();
+        skip_loop_end(ended);
+      } else if (loop.kind == OKind::repeat) {
+        if (--loop.remaining > 0) {
+          source().seek(loop.offset, loop.line_before);
+        } else {
+          const ControlFrame ended = loop;
+          control_.pop_back();
+          skip_loop_end(ended);
+        }
+      } else if (loop.kind == OKind::do_) {
+        skip_block(name, {OKind::while_});
+        parser_.parse(line_, block_);
+        handle_o_word();
+      } else {
+        source().seek(loop.offset, loop.line_before);
+      }
+      return;
+    }
+    case OKind::none:
+      return;
+  }
+}
+
+}  // namespace cncd::interp

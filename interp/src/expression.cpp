@@ -1,0 +1,246 @@
+// Expressions inside [ ]: LinuxCNC's binary operators and precedence, and its unary functions
+// (trigonometry in degrees). Part of BlockParser: values come from the same line reader.
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <string_view>
+
+#include "failure.hpp"
+#include "parser.hpp"
+
+namespace cncd::interp {
+namespace {
+
+enum class Op : int {
+  none,
+  power,
+  times,
+  divide,
+  mod,
+  plus,
+  minus,
+  eq,
+  ne,
+  gt,
+  ge,
+  lt,
+  le,
+  and_,
+  or_,
+  xor_
+};
+
+// LinuxCNC's precedence: ** > * / MOD > + - > comparisons > AND OR XOR; all left-associative.
+int precedence(Op op) {
+  switch (op) {
+    case Op::power:
+      return 5;
+    case Op::times:
+    case Op::divide:
+    case Op::mod:
+      return 4;
+    case Op::plus:
+    case Op::minus:
+      return 3;
+    case Op::eq:
+    case Op::ne:
+    case Op::gt:
+    case Op::ge:
+    case Op::lt:
+    case Op::le:
+      return 2;
+    case Op::and_:
+    case Op::or_:
+    case Op::xor_:
+      return 1;
+    case Op::none:
+      break;
+  }
+  return 0;
+}
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+// LinuxCNC compares with this tolerance in EQ/NE/.. and when a real must be an integer.
+constexpr double kTolerance = 0.0001;
+
+}  // namespace
+
+int BlockParser::read_binary_operator() {
+  auto match = [this](const char* word) {
+    std::size_t n = 0;
+    while (word[n] != '\0') {
+      if (peek_at(n) != word[n]) return false;
+      ++n;
+    }
+    pos_ += n;
+    return true;
+  };
+  const char c = peek();
+  switch (c) {
+    case '*':
+      ++pos_;
+      if (peek() == '*') {
+        ++pos_;
+        return static_cast<int>(Op::power);
+      }
+      return static_cast<int>(Op::times);
+    case '/':
+      ++pos_;
+      return static_cast<int>(Op::divide);
+    case '+':
+      ++pos_;
+      return static_cast<int>(Op::plus);
+    case '-':
+      ++pos_;
+      return static_cast<int>(Op::minus);
+    default:
+      break;
+  }
+  static constexpr std::pair<const char*, Op> kWords[] = {
+      {"mod", Op::mod}, {"eq", Op::eq}, {"ne", Op::ne},    {"gt", Op::gt},  {"ge", Op::ge},
+      {"lt", Op::lt},   {"le", Op::le}, {"and", Op::and_}, {"or", Op::or_}, {"xor", Op::xor_},
+  };
+  for (const auto& [word, op] : kWords) {
+    if (match(word)) return static_cast<int>(op);
+  }
+  if (c == '\0') error("Unclosed expression");
+  error("Unknown operation");
+}
+
+namespace {
+double apply(Op op, double left, double right, int column) {
+  switch (op) {
+    case Op::power:
+      if (left < 0.0 && std::floor(right) != right) {
+        fail("Attempt to raise negative to non-integer power", column);
+      }
+      return std::pow(left, right);
+    case Op::times:
+      return left * right;
+    case Op::divide:
+      if (right == 0.0) fail("Attempt to divide by zero", column);
+      return left / right;
+    case Op::mod: {
+      if (right == 0.0) fail("Attempt to divide by zero", column);
+      double result = std::fmod(left, right);
+      if (result < 0.0) result += std::fabs(right);
+      return result;
+    }
+    case Op::plus:
+      return left + right;
+    case Op::minus:
+      return left - right;
+    case Op::eq:
+      return std::fabs(left - right) < kTolerance ? 1.0 : 0.0;
+    case Op::ne:
+      return std::fabs(left - right) >= kTolerance ? 1.0 : 0.0;
+    case Op::gt:
+      return left > right ? 1.0 : 0.0;
+    case Op::ge:
+      return left >= right ? 1.0 : 0.0;
+    case Op::lt:
+      return left < right ? 1.0 : 0.0;
+    case Op::le:
+      return left <= right ? 1.0 : 0.0;
+    case Op::and_:
+      return (left == 0.0 || right == 0.0) ? 0.0 : 1.0;
+    case Op::or_:
+      return (left != 0.0 || right != 0.0) ? 1.0 : 0.0;
+    case Op::xor_:
+      return ((left == 0.0) != (right == 0.0)) ? 1.0 : 0.0;
+    case Op::none:
+      break;
+  }
+  return 0.0;
+}
+}  // namespace
+
+double BlockParser::read_expression() {
+  ++pos_;  // '['
+  // Operator-precedence evaluation with explicit stacks (expressions nest via read_real_value).
+  constexpr int kMaxDepth = 16;
+  double values[kMaxDepth];
+  Op ops[kMaxDepth];
+  int op_columns[kMaxDepth];
+  int top = 0;
+  values[0] = read_real_value();
+  for (;;) {
+    if (peek() == ']') {
+      ++pos_;
+      while (top > 0) {
+        values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+        --top;
+      }
+      return values[0];
+    }
+    const int col = column();
+    const Op op = static_cast<Op>(read_binary_operator());
+    while (top > 0 && precedence(ops[top - 1]) >= precedence(op)) {
+      values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+      --top;
+    }
+    if (top + 1 >= kMaxDepth) error("Expression too complex");
+    ops[top] = op;
+    op_columns[top] = col;
+    values[++top] = read_real_value();
+  }
+}
+
+double BlockParser::read_unary(int col) {
+  std::string_view rest(text_.data() + pos_, text_.size() - pos_);
+  static constexpr const char* kNames[] = {"abs", "acos", "asin",  "atan", "cos",  "exp", "fix",
+                                           "fup", "ln",   "round", "sin",  "sqrt", "tan", "exists"};
+  std::string_view name;
+  for (const char* candidate : kNames) {
+    const std::string_view word(candidate);
+    if (rest.substr(0, word.size()) == word && rest.size() > word.size() &&
+        rest[word.size()] == '[') {
+      if (word.size() > name.size()) name = word;
+    }
+  }
+  if (name.empty()) fail("Unknown word where unary operation could be", col);
+  pos_ += name.size();
+  if (name == "exists") {
+    ++pos_;  // '['
+    if (peek() != '#' || peek_at(1) != '<') error("Named parameter expected in EXISTS");
+    ++pos_;
+    read_name(name_);
+    if (peek() != ']') error("Right bracket missing after EXISTS argument");
+    ++pos_;
+    return parameters_.exists_named(name_) ? 1.0 : 0.0;
+  }
+  const double arg = read_expression();
+  if (name == "atan") {
+    if (peek() != '/') error("Slash missing after first atan argument");
+    ++pos_;
+    if (peek() != '[') error("Left bracket missing after slash with atan");
+    const double x = read_expression();
+    return std::atan2(arg, x) / kDegree;
+  }
+  if (name == "abs") return std::fabs(arg);
+  if (name == "acos") {
+    if (arg < -1.0 || arg > 1.0) fail("Argument to acos out of range", col);
+    return std::acos(arg) / kDegree;
+  }
+  if (name == "asin") {
+    if (arg < -1.0 || arg > 1.0) fail("Argument to asin out of range", col);
+    return std::asin(arg) / kDegree;
+  }
+  if (name == "cos") return std::cos(arg * kDegree);
+  if (name == "exp") return std::exp(arg);
+  if (name == "fix") return std::floor(arg);
+  if (name == "fup") return std::ceil(arg);
+  if (name == "ln") {
+    if (arg <= 0.0) fail("Zero or negative argument to ln", col);
+    return std::log(arg);
+  }
+  if (name == "round") return std::round(arg);
+  if (name == "sin") return std::sin(arg * kDegree);
+  if (name == "sqrt") {
+    if (arg < 0.0) fail("Negative argument to sqrt", col);
+    return std::sqrt(arg);
+  }
+  return std::tan(arg * kDegree);
+}
+
+}  // namespace cncd::interp
