@@ -1,11 +1,26 @@
 // Checks of a whole block before anything runs: unsupported codes, axis words without a user,
 // words no code uses, negative words. LinuxCNC's wording throughout.
+#include <cstdio>
 #include <string>
 
 #include "failure.hpp"
 #include "interp_state.hpp"
 
 namespace cncd::interp {
+namespace {
+
+// "G41.1 is not supported"; `code` is ten times the number.
+std::string not_supported(char letter, int code) {
+  char text[48];
+  if (code % 10 != 0) {
+    std::snprintf(text, sizeof text, "%c%d.%d is not supported", letter, code / 10, code % 10);
+  } else {
+    std::snprintf(text, sizeof text, "%c%d is not supported", letter, code / 10);
+  }
+  return text;
+}
+
+}  // namespace
 
 // G10, G28, G30, G52 and G92 take the line's axis words for themselves; so does G43.1 when
 // no motion code shares its line (with one, both use them).
@@ -24,16 +39,13 @@ void Interpreter::Impl::check_block() const {
   for (int group = 0; group < kGGroups; ++group) {
     const int code = b.g[static_cast<std::size_t>(group)];
     if (code >= 0 && !g_code_info(code).supported) {
-      fail("G" + std::to_string(code / 10) +
-               (code % 10 != 0 ? "." + std::to_string(code % 10) : "") + " is not supported",
-           b.g_column[static_cast<std::size_t>(group)]);
+      fail(not_supported('G', code), b.g_column[static_cast<std::size_t>(group)]);
     }
   }
   for (int group = 0; group < kMGroups; ++group) {
     const int code = b.m[static_cast<std::size_t>(group)];
     if (code >= 0 && !m_code_info(code).supported) {
-      fail("M" + std::to_string(code) + " is not supported",
-           b.m_column[static_cast<std::size_t>(group)]);
+      fail(not_supported('M', code * 10), b.m_column[static_cast<std::size_t>(group)]);
     }
   }
   bool axis_words = false;
@@ -57,7 +69,9 @@ void Interpreter::Impl::check_block() const {
   if (cycle && !axes_belong_elsewhere()) {
     for (const char letter : {'a', 'b', 'c'}) {
       if (b.has(letter)) {
-        fail(std::string("Cannot put an ") + letter + " in canned cycle", b.col(letter));
+        char message[40];
+        std::snprintf(message, sizeof message, "Cannot put an %c in canned cycle", letter);
+        fail(message, b.col(letter));
       }
     }
   }
