@@ -45,6 +45,12 @@ struct Block {
   std::array<int, kMGroups> m_column{};
   int m_count = 0;
 
+  // LinuxCNC's polar words: @ distance and ^ angle (degrees) in the XY plane.
+  bool has_polar_distance = false;
+  bool has_polar_angle = false;
+  double polar_distance = 0;
+  double polar_angle = 0;
+
   bool block_delete = false;
   bool has_line_number = false;
   double line_number = 0;
@@ -72,6 +78,7 @@ struct Block {
 
   void clear() {
     present = 0;
+    has_polar_distance = has_polar_angle = false;
     g.fill(-1);
     m.fill(-1);
     m_count = 0;

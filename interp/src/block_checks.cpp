@@ -48,7 +48,10 @@ void Interpreter::Impl::check_block() const {
       fail(not_supported('M', code * 10), b.m_column[static_cast<std::size_t>(group)]);
     }
   }
-  bool axis_words = false;
+  const bool polar = b.has_polar_distance || b.has_polar_angle;
+  if (polar && b.has('x')) fail("Cannot specify both polar coordinate and X word", b.col('x'));
+  if (polar && b.has('y')) fail("Cannot specify both polar coordinate and Y word", b.col('y'));
+  bool axis_words = polar;
   for (const char letter : kAxisLetters) {
     if (letter != '\0' && b.has(letter)) axis_words = true;
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "failure.hpp"
@@ -23,6 +24,8 @@ bool is_canned_cycle(int code) {
 std::string g_name(int code) {
   return "g" + std::to_string(code / 10);
 }
+
+constexpr double kDegree = std::numbers::pi / 180.0;
 
 // LinuxCNC's chip-break and peck clearance: 0.010 inch.
 double peck_clearance(Units units) {
@@ -134,8 +137,23 @@ void Interpreter::Impl::do_canned_cycle(int code) {
   // The first move across the plane stays clear of the work: at the current height, or at the
   // retract height when that is higher.
   double current_c = std::max(pos_[g.c], g.clear);
+  const bool polar =
+      modal_.plane == Plane::xy && (block_.has_polar_distance || block_.has_polar_angle);
   for (int repeat = 0; repeat < repeats; ++repeat) {
-    if (modal_.incremental) {
+    if (polar) {
+      // Polar words place the hole around the XY origin; incremental ones step the distance
+      // and angle from the previous hole.
+      double distance = std::hypot(a, b);
+      double angle = std::atan2(b, a) / kDegree;
+      if (block_.has_polar_distance) {
+        distance = modal_.incremental ? distance + block_.polar_distance : block_.polar_distance;
+      }
+      if (block_.has_polar_angle) {
+        angle = modal_.incremental ? angle + block_.polar_angle : block_.polar_angle;
+      }
+      a = distance * std::cos(angle * kDegree);
+      b = distance * std::sin(angle * kDegree);
+    } else if (modal_.incremental) {
       a += block_.has(a_letter) ? block_.get(a_letter) : 0.0;
       b += block_.has(b_letter) ? block_.get(b_letter) : 0.0;
     } else {

@@ -1,5 +1,6 @@
 // G0/G1/G2/G3 (and G53) and the dispatch to canned cycles.
 #include <cmath>
+#include <numbers>
 
 #include "failure.hpp"
 #include "interp_state.hpp"
@@ -45,6 +46,21 @@ Pose Interpreter::Impl::target_from_words() const {
     const auto a = static_cast<std::size_t>(axis);
     end[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
   }
+  if (block_.has_polar_distance || block_.has_polar_angle) {
+    // Polar words give X and Y around the origin; incremental ones add to the current
+    // distance and angle.
+    const double degree = std::numbers::pi / 180.0;
+    double distance = std::hypot(pos_[kX], pos_[kY]);
+    double angle = std::atan2(pos_[kY], pos_[kX]) / degree;
+    if (block_.has_polar_distance) {
+      distance = modal_.incremental ? distance + block_.polar_distance : block_.polar_distance;
+    }
+    if (block_.has_polar_angle) {
+      angle = modal_.incremental ? angle + block_.polar_angle : block_.polar_angle;
+    }
+    end[kX] = distance * std::cos(angle * degree);
+    end[kY] = distance * std::sin(angle * degree);
+  }
   return end;
 }
 
@@ -74,7 +90,7 @@ void Interpreter::Impl::do_motion() {
   const int non_modal = block_.g_code(GGroup::non_modal);
   if (axes_belong_elsewhere()) return;
   const int code = modal_.motion;
-  bool axis_words = false;
+  bool axis_words = block_.has_polar_distance || block_.has_polar_angle;
   for (int axis = 0; axis < kAxes; ++axis)
     axis_words |= block_.has(kAxisLetters[axis]);
   if (code == 530 || code < 0 || code == 800) return;

@@ -100,6 +100,14 @@ void BlockParser::read_word(Block& block) {
     read_assignment(block);
     return;
   }
+  if (c == '@' || c == '^') {
+    ++pos_;
+    bool& seen = c == '@' ? block.has_polar_distance : block.has_polar_angle;
+    if (seen) fail(std::string("Multiple ") + c + " words on one line", col);
+    seen = true;
+    (c == '@' ? block.polar_distance : block.polar_angle) = read_real_value();
+    return;
+  }
   if (!is_alpha(c)) {
     error(std::string("Bad character '") + c + "' used");
   }
