@@ -125,6 +125,7 @@ struct Interpreter::Impl {
   Step step(CanonSink& sink);
   void emit_preamble();
   void run_line();
+  void run_startup_code();
   InterpError make_error(const Failure& failure) const;
 
   // execute.cpp: one block in LinuxCNC's order of execution.

@@ -108,7 +108,10 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
   sink_ = &sink;
   try {
     if (sources_.empty()) fail("No program open");
-    if (!preamble_done_) emit_preamble();
+    if (!preamble_done_) {
+      emit_preamble();
+      run_startup_code();
+    }
     LineSource& source = sources_.back();
     line_offset_ = source.tell();
     line_before_ = source.line_number();
@@ -134,6 +137,23 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
   } catch (const Failure& failure) {
     error_ = make_error(failure);
     return Step::error;
+  }
+}
+
+// RS274NGC_STARTUP_CODE: blocks run before the program's first line, as LinuxCNC's task
+// does when it starts the interpreter. Reported as line 0.
+void Interpreter::Impl::run_startup_code() {
+  std::size_t start = 0;
+  const std::string& code = options_.startup_code;
+  while (start < code.size()) {
+    std::size_t end = code.find('\n', start);
+    if (end == std::string::npos) end = code.size();
+    line_.assign(code, start, end - start);
+    start = end + 1;
+    current_line_ = 0;
+    parser_.parse(line_, block_);
+    if (block_.o_kind != OKind::none) fail("O-words are not allowed in the startup code");
+    run_line();
   }
 }
 
@@ -197,6 +217,15 @@ const std::optional<InterpError>& Interpreter::error() const {
 
 int Interpreter::current_line() const {
   return impl_->current_line_;
+}
+
+std::optional<InterpError> Interpreter::save_parameters() const {
+  const auto& path = impl_->options_.parameter_file;
+  if (path.empty()) return std::nullopt;
+  if (auto problem = impl_->parameters_.save(path)) {
+    return InterpError{path.string(), 0, 0, *problem};
+  }
+  return std::nullopt;
 }
 
 std::optional<InterpError> run_program(Interpreter& interp, CanonSink& sink) {

@@ -58,6 +58,11 @@ class Interpreter {
   // Line number of the block last executed.
   int current_line() const;
 
+  // Writes the persistent parameters (coordinate systems, G28/G30 points, G92 offsets) to
+  // InterpOptions::parameter_file, as LinuxCNC does when its interpreter shuts down: temp file,
+  // flush, rename. Does nothing without a parameter file.
+  std::optional<InterpError> save_parameters() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,0 +1,170 @@
+// The Interpreter's public behaviour beyond rs274 parity: stepping, files, startup code,
+// parameter persistence, block delete, machine conversion of a whole program.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/interp/rs274_printer.hpp"
+#include "cncd/interp/to_machine.hpp"
+
+namespace cncd::interp {
+namespace {
+
+std::filesystem::path temp_file(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("cncd_interp_" + std::to_string(::getpid()) + "_" + name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string run_text(Interpreter& interp, const std::string& program) {
+  EXPECT_FALSE(interp.open_string(program, "t.ngc"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  const auto error = run_program(interp, printer);
+  EXPECT_FALSE(error) << (error ? error->to_string() : "");
+  return out.str();
+}
+
+TEST(InterpreterApi, StepReportsBlocksThenEndThenStaysEnded) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("G0 X1\n\nM2\nG0 X5\n"));
+  NullSink sink;
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::block);
+  EXPECT_EQ(interp.current_line(), 1);
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::block);
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::end);
+  EXPECT_EQ(interp.current_line(), 3);
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::end);
+}
+
+TEST(InterpreterApi, ErrorsCarryFileLineAndColumnAndStick) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("G0 X1\nG0 X1 Y2 Y3\nM2\n", "part.ngc"));
+  NullSink sink;
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::block);
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::error);
+  ASSERT_TRUE(interp.error());
+  EXPECT_EQ(interp.error()->to_string(), "part.ngc:2:10: Multiple y words on one line");
+  EXPECT_EQ(interp.step(sink), Interpreter::Step::error);
+}
+
+TEST(InterpreterApi, ReadsFilesWithCrLfAndSubroutineFiles) {
+  const auto sub =
+      temp_file("sub.ngc", "o<cncd_square> sub\r\nG1 X#1 F100\r\no<cncd_square> endsub\r\n");
+  const auto renamed = sub.parent_path() / "cncd_square.ngc";
+  std::filesystem::rename(sub, renamed);
+  const auto program = temp_file("main.ngc", "%\r\no<cncd_square> call [4]\r\nG0 Y1\r\n%\r\n");
+  Interpreter interp;
+  ASSERT_FALSE(interp.open(program));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  const auto error = run_program(interp, printer);
+  EXPECT_FALSE(error) << (error ? error->to_string() : "");
+  EXPECT_NE(out.str().find("STRAIGHT_FEED(4.0000, 0.0000, 0.0000"), std::string::npos);
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(4.0000, 1.0000, 0.0000"), std::string::npos);
+  EXPECT_NE(out.str().find("FINISH()"), std::string::npos);
+  std::filesystem::remove(renamed);
+  std::filesystem::remove(program);
+}
+
+TEST(InterpreterApi, MissingFileIsAnError) {
+  Interpreter interp;
+  const auto error = interp.open("/nonexistent/cncd/part.ngc");
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->message, "Unable to open file");
+}
+
+TEST(InterpreterApi, StartupCodeRunsBeforeTheProgram) {
+  InterpOptions options;
+  options.startup_code = "G20 G91\nF5";
+  Interpreter interp(options);
+  const std::string out = run_text(interp, "G1 X1\nG1 X1\nM2\n");
+  EXPECT_NE(out.find("USE_LENGTH_UNITS(CANON_UNITS_INCHES)"), std::string::npos);
+  EXPECT_NE(out.find("STRAIGHT_FEED(2.0000, 0.0000, 0.0000"), std::string::npos);
+}
+
+TEST(InterpreterApi, BlockDeleteSkipsSlashLinesOnlyWhenEnabled) {
+  InterpOptions options;
+  options.block_delete = true;
+  Interpreter with(options);
+  EXPECT_EQ(run_text(with, "/G0 X1\nM2\n").find("STRAIGHT_TRAVERSE"), std::string::npos);
+  Interpreter without;
+  EXPECT_NE(run_text(without, "/G0 X1\nM2\n").find("STRAIGHT_TRAVERSE"), std::string::npos);
+}
+
+TEST(InterpreterApi, ParametersPersistThroughTheVarFile) {
+  const auto var = temp_file("params.var", "5220 1\n");
+  {
+    InterpOptions options;
+    options.parameter_file = var;
+    Interpreter interp(options);
+    run_text(interp, "G10 L2 P2 X5 Y-2 R30\nG28.1\nM2\n");
+    EXPECT_FALSE(interp.save_parameters());
+  }
+  InterpOptions options;
+  options.parameter_file = var;
+  Interpreter interp(options);
+  const std::string out = run_text(interp, "G55\nM2\n");
+  EXPECT_NE(out.find("SET_G5X_OFFSET(2, 5.0000, -2.0000, 0.0000"), std::string::npos);
+  EXPECT_NE(out.find("SET_XY_ROTATION(30.0000)"), std::string::npos);
+  std::filesystem::remove(var);
+}
+
+TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
+  for (const char* line :
+       {"G41 D1",     "G42.1 D1", "G33 Z-1 K1", "G33.1 Z-1 K1", "G38.3 Z-1 F1", "G5 X1 I1 J1 P1 Q1",
+        "G5.2 X1 P1", "G7",       "G8",         "G70 Q1",       "G71 Q1",       "G76 P1 Z-1",
+        "G96 S100",   "G43.2 H1", "G17.1",      "M19",          "M62 P0",       "M66 P0 L0",
+        "M70",        "M73",      "M100"}) {
+    Interpreter interp;
+    ASSERT_FALSE(interp.open_string(std::string(line) + "\nM2\n", "u.ngc"));
+    NullSink sink;
+    const auto error = run_program(interp, sink);
+    ASSERT_TRUE(error) << line;
+    EXPECT_NE(error->message.find("is not supported"), std::string::npos) << error->message;
+  }
+}
+
+// The whole path the daemon uses: program -> canon -> MachineTracker -> machine moves.
+TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
+  struct Machine final : CanonSink {
+    void emit(const CanonCommand& command) override {
+      const CanonCommand m = tracker.to_machine(command);
+      if (m.kind == CanonKind::straight_traverse || m.kind == CanonKind::straight_feed ||
+          m.kind == CanonKind::arc_feed) {
+        moves.push_back(m);
+        feeds.push_back(tracker.feed_per_minute());
+      }
+    }
+    MachineTracker tracker{Units::mm};
+    std::vector<CanonCommand> moves;
+    std::vector<double> feeds;
+  } machine;
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string(
+      "G10 L2 P2 X10 Y20 Z30\nG55 G20 F10\nG1 X1 Y1 Z1\nG92 X0\nG1 X1\nG43.1 Z0.5\n"
+      "G1 Z0\nG2 X2 Y1 I0.5 J0\nM2\n"));
+  const auto error = run_program(interp, machine);
+  ASSERT_FALSE(error) << error->to_string();
+  ASSERT_EQ(machine.moves.size(), 4U);
+  EXPECT_NEAR(machine.moves[0].pos[0], 10 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.moves[0].pos[1], 20 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.moves[0].pos[2], 30 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.feeds[0], 254.0, 1e-9);
+  EXPECT_NEAR(machine.moves[1].pos[0], 10 + 2 * 25.4, 1e-9);    // G92 shifted X by 1 inch
+  EXPECT_NEAR(machine.moves[2].pos[2], 30 + 0.5 * 25.4, 1e-9);  // tool length offset
+  const CanonCommand& arc = machine.moves[3];
+  EXPECT_NEAR(arc.first_end, 10 + 3 * 25.4, 1e-9);
+  EXPECT_NEAR(arc.first_axis, 10 + 2.5 * 25.4, 1e-9);
+  EXPECT_NEAR(arc.second_axis, 20 + 25.4, 1e-9);
+  EXPECT_EQ(arc.rotation, -1);
+}
+
+}  // namespace
+}  // namespace cncd::interp
