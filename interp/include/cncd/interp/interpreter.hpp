@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cncd/interp/canon.hpp"
+#include "cncd/interp/to_machine.hpp"  // MachineTracker, which every user of the stream needs
 
 namespace cncd::interp {
 
