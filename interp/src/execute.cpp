@@ -366,8 +366,7 @@ bool Interpreter::Impl::do_stop() {
 void Interpreter::Impl::program_end_reset() {
   select_coord_system_quiet(1);
   emit_g5x();
-  rotation_deg_ = 0;
-  emit_simple(CanonKind::set_xy_rotation, 0, 0.0);
+  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
   if (modal_.plane != Plane::xy) {
     modal_.plane = Plane::xy;
     CanonCommand& command = make(CanonKind::select_plane);

@@ -102,6 +102,7 @@ inline constexpr int kG5xBase = 5221;  // G54 X; each system takes 20 parameters
 inline constexpr int kG92Base = 5211;
 
 bool is_linear_axis(int axis);
+void rotate_xy(Pose& pose, double degrees);
 double unit_factor(Units from, Units to);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.

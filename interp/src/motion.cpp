@@ -32,13 +32,27 @@ Pose Interpreter::Impl::target_from_words() const {
   Pose end = pos_;
   const bool machine = block_.g_code(GGroup::non_modal) == 530;
   if (machine) {
-    // G53: the words are machine coordinates; unspecified axes stay where they are.
-    Pose target = program_to_machine(pos_);
+    // G53: the named axes are machine coordinates. LinuxCNC works this out in the rotated
+    // frame with the G92 offset inside the rotation; the other axes stay where they are.
+    const double angle = rotation_deg_ * std::numbers::pi / 180.0;
+    Pose q = pos_;
+    for (std::size_t axis = 0; axis < kAxes; ++axis)
+      q[axis] += g92_offset_[axis];
+    const double qx = q[kX] * std::cos(angle) - q[kY] * std::sin(angle);
+    const double qy = q[kX] * std::sin(angle) + q[kY] * std::cos(angle);
+    q[kX] = qx;
+    q[kY] = qy;
     for (int axis = 0; axis < kAxes; ++axis) {
       const char letter = kAxisLetters[axis];
-      if (block_.has(letter)) target[static_cast<std::size_t>(axis)] = block_.get(letter);
+      const auto a = static_cast<std::size_t>(axis);
+      if (block_.has(letter)) q[a] = block_.get(letter) - g5x_offset_[a] - tool_offset_[a];
     }
-    return machine_to_program(target);
+    end = q;
+    end[kX] = q[kX] * std::cos(-angle) - q[kY] * std::sin(-angle);
+    end[kY] = q[kX] * std::sin(-angle) + q[kY] * std::cos(-angle);
+    for (std::size_t axis = 0; axis < kAxes; ++axis)
+      end[axis] -= g92_offset_[axis];
+    return end;
   }
   for (int axis = 0; axis < kAxes; ++axis) {
     const char letter = kAxisLetters[axis];
@@ -101,6 +115,8 @@ void Interpreter::Impl::do_motion() {
   if (non_modal == 530 && code != 0 && code != 10) {
     fail("Must use g0 or g1 with g53", block_.g_column[0]);
   }
+  if (non_modal == 530 && modal_.incremental)
+    fail("Cannot use g53 incremental", block_.g_column[0]);
   if (code == 10 || code == 20 || code == 30) {
     if (modal_.feed_mode == FeedMode::inverse_time && !block_.has('f') && axis_words) {
       fail(code == 10 ? "F word missing with inverse time g1 move"

@@ -13,6 +13,15 @@ bool is_linear_axis(int axis) {
   return axis <= kZ || axis >= kU;
 }
 
+void rotate_xy(Pose& pose, double degrees) {
+  if (degrees == 0.0) return;
+  const double angle = degrees * std::numbers::pi / 180.0;
+  const double x = pose[kX] * std::cos(angle) - pose[kY] * std::sin(angle);
+  const double y = pose[kX] * std::sin(angle) + pose[kY] * std::cos(angle);
+  pose[kX] = x;
+  pose[kY] = y;
+}
+
 double unit_factor(Units from, Units to) {
   auto mm = [](Units units) {
     return units == Units::inches ? 25.4 : units == Units::cm ? 10.0 : 1.0;
@@ -126,28 +135,22 @@ void Interpreter::Impl::apply_tool_length(int code) {
       if (block_.has(letter)) offset[static_cast<std::size_t>(axis)] = block_.get(letter);
     }
   }
-  const Pose machine = program_to_machine(pos_);
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    pos_[axis] += tool_offset_[axis] - offset[axis];
   tool_offset_ = offset;
-  pos_ = machine_to_program(machine);
   modal_.tool_length_code = code;
   CanonCommand& command = make(CanonKind::use_tool_length_offset);
   command.pos = tool_offset_;
   emit(command);
 }
 
-// LinuxCNC's canon order: the G92 offset applies in the rotated system, the G5x origin and the
-// tool offset after the rotation.
+// LinuxCNC's canon order: the G92 offset applies inside the XY rotation, the G5x origin and
+// the tool offset after it.
 Pose Interpreter::Impl::program_to_machine(const Pose& program) const {
   Pose p = program;
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     p[axis] += g92_offset_[axis];
-  if (rotation_deg_ != 0.0) {
-    const double angle = rotation_deg_ * std::numbers::pi / 180.0;
-    const double x = p[kX] * std::cos(angle) - p[kY] * std::sin(angle);
-    const double y = p[kX] * std::sin(angle) + p[kY] * std::cos(angle);
-    p[kX] = x;
-    p[kY] = y;
-  }
+  rotate_xy(p, rotation_deg_);
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     p[axis] += g5x_offset_[axis] + tool_offset_[axis];
   return p;
@@ -157,20 +160,16 @@ Pose Interpreter::Impl::machine_to_program(const Pose& machine) const {
   Pose p = machine;
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     p[axis] -= g5x_offset_[axis] + tool_offset_[axis];
-  if (rotation_deg_ != 0.0) {
-    const double angle = -rotation_deg_ * std::numbers::pi / 180.0;
-    const double x = p[kX] * std::cos(angle) - p[kY] * std::sin(angle);
-    const double y = p[kX] * std::sin(angle) + p[kY] * std::cos(angle);
-    p[kX] = x;
-    p[kY] = y;
-  }
+  rotate_xy(p, -rotation_deg_);
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     p[axis] -= g92_offset_[axis];
   return p;
 }
 
+// LinuxCNC changes the G92 offset axis by axis and shifts the program position by the same
+// amount on that axis (so with an XY rotation the machine point is not kept exactly).
 void Interpreter::Impl::do_g92(int code) {
-  const Pose machine = program_to_machine(pos_);
+  const Pose old_offset = g92_offset_;
   if (code == 920 || code == 520) {
     std::uint32_t axes = 0;
     for (int axis = 0; axis < kAxes; ++axis) {
@@ -195,7 +194,8 @@ void Interpreter::Impl::do_g92(int code) {
     g92_offset_ = read_offset_parameters(kG92Base);
     parameters_.set(5210, 1);
   }
-  pos_ = machine_to_program(machine);
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    pos_[axis] += old_offset[axis] - g92_offset_[axis];
   emit_g92();
 }
 

@@ -11,14 +11,6 @@ namespace {
 constexpr int kG28Base = 5161;
 constexpr int kG30Base = 5181;
 
-void rotate(double& x, double& y, double degrees) {
-  const double angle = degrees * std::numbers::pi / 180.0;
-  const double rx = x * std::cos(angle) - y * std::sin(angle);
-  const double ry = x * std::sin(angle) + y * std::cos(angle);
-  x = rx;
-  y = ry;
-}
-
 }  // namespace
 
 void Interpreter::Impl::do_g10() {
@@ -45,19 +37,16 @@ void Interpreter::Impl::set_coord_system_data(int l, int system) {
   std::uint32_t axes = 0;
   if (l == 20) {
     // The origin that makes the current point read the given coordinates in that system
-    // (with its rotation and the G92 offset as they stand).
+    // (with its rotation; the G92 offset stays as it is).
     Pose wanted = pos_;
     for (int axis = 0; axis < kAxes; ++axis) {
-      if (block_.has(kAxisLetters[axis]))
+      if (block_.has(kAxisLetters[axis])) {
         wanted[static_cast<std::size_t>(axis)] = block_.get(kAxisLetters[axis]);
+      }
     }
     Pose now = pos_;
-    for (std::size_t axis = 0; axis < kAxes; ++axis) {
-      now[axis] += g92_offset_[axis];
-      wanted[axis] += g92_offset_[axis];
-    }
-    rotate(now[kX], now[kY], rotation_deg_);
-    rotate(wanted[kX], wanted[kY], rotation);
+    rotate_xy(now, rotation_deg_);
+    rotate_xy(wanted, rotation);
     for (int axis = 0; axis < kAxes; ++axis) {
       const auto a = static_cast<std::size_t>(axis);
       const bool named = block_.has(kAxisLetters[axis]);
@@ -81,9 +70,17 @@ void Interpreter::Impl::set_coord_system_data(int l, int system) {
     emit_comment("interpreter: setting coordinate system origin");
     return;
   }
-  const Pose machine = program_to_machine(pos_);
+  // LinuxCNC keeps the rotated program point plus the origin where it was; the G92 offset
+  // takes no part in this (unlike a change of coordinate system).
+  Pose fixed = pos_;
+  rotate_xy(fixed, rotation_deg_);
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    fixed[axis] += g5x_offset_[axis];
   load_coord_system(system);
-  pos_ = machine_to_program(machine);
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    fixed[axis] -= g5x_offset_[axis];
+  rotate_xy(fixed, -rotation_deg_);
+  pos_ = fixed;
   emit_g5x();
   emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
 }

@@ -1,5 +1,5 @@
 // Turns the interpreter's canonical stream (program coordinates, program units) into machine
-// coordinates and machine units, the way LinuxCNC's canon layer does:
+// coordinates and machine units in LinuxCNC canon's order:
 //   machine = rotate_xy(program + g92, rotation) + g5x + tool_length_offset, then scaled to
 //   machine units (linear axes only; A B C stay in degrees).
 // Feed in machine units per minute. Called on the thread that runs the interpreter.
