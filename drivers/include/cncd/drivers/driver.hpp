@@ -24,16 +24,16 @@ struct JointCommand {
 
 // What a driver reports each period.
 struct JointFeedback {
-  double position = 0;         // joint units
+  double position = 0;  // joint units
   bool home_switch = false;
   bool min_limit = false;
   bool max_limit = false;
-  bool fault = false;          // drive reports a fault
-  bool stale = false;          // no fresh feedback within the driver's deadline
+  bool fault = false;  // drive reports a fault
+  bool stale = false;  // no fresh feedback within the driver's deadline
 };
 
 struct MachineInputs {
-  bool estop = false;          // external estop input asserted
+  bool estop = false;  // external estop input asserted
   bool probe = false;
 };
 

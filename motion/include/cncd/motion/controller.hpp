@@ -7,8 +7,11 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/sim_driver.hpp"
+#include "cncd/motion/servo_loop.hpp"
 #include "cncd/motion/status.hpp"
 #include "cncd/motion/types.hpp"
 
@@ -27,25 +30,33 @@ class MotionController {
   // Stops motion, disables the drives, joins the servo thread. Idempotent.
   void stop();
 
-  // Queues one move (planned here, on the caller's thread). False when the segment queue is
-  // full: call again later. Moves are refused (false) while the machine is not on.
-  bool enqueue(const Move& move);
+  enum class EnqueueResult { queued, full, refused };
+  // Queues one move (planned here, on the caller's thread). `full`: the segment queue has no
+  // room, call again later. `refused`: the move cannot be made (machine not on, outside the
+  // soft limits, zero feed ...); enqueue_error() says why.
+  EnqueueResult enqueue(const Move& move);
+  const std::string& enqueue_error() const;
   // Free slots in the segment queue.
   std::size_t queue_space() const;
 
   // Priority commands: they bypass queued motion.
-  void estop();          // latch estop: stop within one period, drives disabled
-  void reset_estop();    // leave estop (machine stays off)
-  void machine_on();     // enable drives (needs estop reset)
-  void machine_off();    // controlled stop, disable drives
+  void estop();                         // latch estop: stop within one period, drives disabled
+  void reset_estop();                   // leave estop (machine stays off)
+  void machine_on();                    // enable drives (needs estop reset)
+  void machine_off();                   // controlled stop, disable drives
   void home(std::uint32_t joint_mask);  // home these joints (all-ones = all in HOME_SEQUENCE)
-  void abort();          // controlled stop, flush queued motion
-  void pause();          // feed hold: controlled stop on the path
+  void abort();                         // controlled stop, flush queued motion
+  void pause();                         // feed hold: controlled stop on the path
   void resume();
-  void clear_fault();
 
   // Lock-free copy of the latest status.
   Status status() const;
+  // Takes the next event the servo thread posted (faults, warnings); false when none.
+  bool poll_event(Event& event);
+  // Warnings from start() (real-time scheduling or memory locking refused), for the log.
+  const std::vector<std::string>& start_warnings() const;
+  // The simulated driver, when one drives any joint (tests inject lag and faults through it).
+  drivers::SimDriver* sim_driver();
 
  private:
   struct Impl;

@@ -13,31 +13,31 @@ enum class MotionState : std::uint8_t { idle, moving, pausing, paused, stopping,
 
 struct RtStats {
   std::uint64_t cycles = 0;
-  std::uint64_t overruns = 0;        // periods whose wake-up came later than one period
+  std::uint64_t overruns = 0;  // periods whose wake-up came later than one period
   std::int64_t wake_error_p50_ns = 0;
   std::int64_t wake_error_p99_ns = 0;
   std::int64_t wake_error_p999_ns = 0;
   std::int64_t wake_error_max_ns = 0;
-  bool realtime = false;             // SCHED_FIFO granted
-  bool memory_locked = false;        // mlockall succeeded
+  bool realtime = false;       // SCHED_FIFO granted
+  bool memory_locked = false;  // mlockall succeeded
 };
 
 struct Status {
-  std::uint64_t sequence = 0;        // servo cycle count at publication
+  std::uint64_t sequence = 0;  // servo cycle count at publication
   MachineState machine = MachineState::estop;
   MotionState motion = MotionState::idle;
   int joint_count = 0;
   std::array<bool, kJoints> homed{};
   std::array<bool, kJoints> joint_fault{};
-  AxisPose commanded{};              // machine units, machine coordinates
+  AxisPose commanded{};  // machine units, machine coordinates
   AxisPose actual{};
   JointArray joint_commanded{};
   JointArray joint_actual{};
-  double velocity = 0;               // units/s along the path
-  std::int32_t line = 0;             // source line of the segment being executed
-  std::uint32_t queued = 0;          // segments waiting in the queue (including the active one)
-  std::uint64_t segments_done = 0;   // segments completed since start
-  char fault_reason[96] = {};        // latched fault, "" when none
+  double velocity = 0;              // units/s along the path
+  std::int32_t line = 0;            // source line of the segment being executed
+  std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
+  std::uint64_t segments_done = 0;  // segments completed since start
+  char fault_reason[96] = {};       // latched fault, "" when none
   RtStats rt;
 };
 

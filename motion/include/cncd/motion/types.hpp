@@ -20,16 +20,16 @@ using JointArray = std::array<double, kJoints>;
 struct Move {
   enum class Kind : std::uint8_t { traverse, feed, arc, dwell };
   Kind kind = Kind::traverse;
-  AxisPose end{};             // end point (traverse, feed, arc)
-  double feed = 0;            // units/s along the path (feed, arc); traverse uses the limits
+  AxisPose end{};   // end point (traverse, feed, arc)
+  double feed = 0;  // units/s along the path (feed, arc); traverse uses the limits
   // Arc: centre in the plane's two axes, the plane's normal axis, turns (>0 ccw, <0 cw,
   // LinuxCNC's "rotation": 1 = one ccw arc, -1 = one cw arc, 2 = one full extra ccw turn ...).
   std::array<int, 3> plane_axes{0, 1, 2};  // first, second, normal axis index (XY: 0,1,2)
   double center_first = 0;
   double center_second = 0;
   int turns = 0;
-  double dwell_s = 0;         // dwell
-  std::int32_t line = 0;      // source line of the program, 0 = none
+  double dwell_s = 0;     // dwell
+  std::int32_t line = 0;  // source line of the program, 0 = none
 };
 
 }  // namespace cncd::motion

@@ -1,0 +1,228 @@
+// cncd: the machine controller daemon.
+#include <signal.h>
+#include <sys/signalfd.h>
+#include <systemd/sd-daemon.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "cncd/config/ini_file.hpp"
+#include "cncd/config/machine_config.hpp"
+#include "logging.hpp"
+#include "methods.hpp"
+#include "server.hpp"
+#include "task.hpp"
+#include "version.hpp"
+
+namespace {
+
+constexpr int kExitUsage = 64;        // EX_USAGE
+constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE
+
+void print_usage(std::FILE* out) {
+  std::fprintf(out,
+               "usage: cncd --ini FILE [--socket PATH] [--log-level LEVEL]\n"
+               "       cncd --check-config FILE\n"
+               "       cncd --version\n"
+               "\n"
+               "  --ini FILE           machine configuration (LinuxCNC-style INI)\n"
+               "  --socket PATH        control socket (default: [CNCD] SOCKET, else "
+               "/run/cncd/cncd.sock)\n"
+               "  --log-level LEVEL    trace, debug, info, warn, error, critical or off\n"
+               "                       (default: [CNCD] LOG_LEVEL, else info)\n"
+               "  --check-config FILE  validate FILE, print a summary of the machine, exit 0;\n"
+               "                       or list every problem and exit 78\n");
+}
+
+struct Options {
+  std::string ini;
+  std::string socket;
+  std::string log_level;
+  bool check_only = false;
+};
+
+// Returns an exit status when the process should stop right away.
+std::optional<int> parse_args(int argc, char** argv, Options& options) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](const char* name) -> std::optional<std::string> {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "cncd: %s needs a value\n", name);
+        return std::nullopt;
+      }
+      return std::string(argv[++i]);
+    };
+    if (arg == "--help" || arg == "-h") {
+      print_usage(stdout);
+      return 0;
+    }
+    if (arg == "--version") {
+      std::printf("cncd %s\n", cncd::kVersion);
+      return 0;
+    }
+    std::optional<std::string> v;
+    if (arg == "--ini" || arg == "--check-config") {
+      if (!(v = value(arg.c_str()))) return kExitUsage;
+      options.ini = *v;
+      options.check_only = options.check_only || arg == "--check-config";
+    } else if (arg == "--socket") {
+      if (!(v = value("--socket"))) return kExitUsage;
+      options.socket = *v;
+    } else if (arg == "--log-level") {
+      if (!(v = value("--log-level"))) return kExitUsage;
+      options.log_level = *v;
+    } else {
+      std::fprintf(stderr, "cncd: unknown argument '%s'\n", arg.c_str());
+      print_usage(stderr);
+      return kExitUsage;
+    }
+  }
+  if (options.ini.empty()) {
+    std::fprintf(stderr, "cncd: no machine configuration given (--ini FILE)\n");
+    print_usage(stderr);
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+int serve(const cncd::config::MachineConfig& config, const std::string& socket_path) {
+  using namespace cncd::daemon;
+  AccessPolicy policy;
+  if (const auto error =
+          make_access_policy(config.cncd.read_group, config.cncd.control_group, policy);
+      !error.empty()) {
+    spdlog::critical("{}: [CNCD]: {}", config.path.string(), error);
+    return cncd::config::kExitConfig;
+  }
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);
+  // Blocked before any thread starts so that every thread inherits the mask.
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  const int signal_fd = signalfd(-1, &signals, SFD_CLOEXEC | SFD_NONBLOCK);
+  if (signal_fd < 0) {
+    spdlog::critical("signalfd: {}", std::strerror(errno));
+    return kExitUnavailable;
+  }
+
+  EventLog events;
+  Task task(config, events);
+  if (const auto error = task.start(); !error.empty()) {
+    spdlog::critical("cannot start motion: {}", error);
+    return kExitUnavailable;
+  }
+  RpcDispatcher dispatcher;
+  register_methods(dispatcher, task, config, events);
+  Server server(
+      dispatcher, policy, [&task] { return task.status(); }, events);
+  std::string serving = socket_path;
+  // Socket activation: systemd hands over the listening socket of cncd.socket.
+  if (sd_listen_fds(1) == 1 &&
+      sd_is_socket_unix(SD_LISTEN_FDS_START, SOCK_STREAM, 1, nullptr, 0) > 0) {
+    server.adopt(SD_LISTEN_FDS_START);
+    serving = "the socket handed over by systemd";
+  } else if (const auto error = server.listen(socket_path); !error.empty()) {
+    spdlog::critical("cannot open control socket: {}", error);
+    task.shutdown();
+    return kExitUnavailable;
+  }
+  spdlog::info("cncd {} serving {} on {} (servo period {} ns)", cncd::kVersion,
+               config.path.string(), serving, config.servo_period_ns);
+  sd_notify(0, "READY=1\nSTATUS=ready");
+
+  // The watchdog is fed only while the servo loop's heartbeat advances, so systemd restarts a
+  // daemon whose servo thread has died or hangs.
+  std::uint64_t watchdog_usec = 0;
+  const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
+  auto last_watchdog = std::chrono::steady_clock::now();
+  std::uint64_t last_heartbeat = task.servo_heartbeat();
+  std::string last_summary;
+  for (;;) {
+    server.poll_once(task.busy() ? 2 : 50, signal_fd);
+    const auto now = std::chrono::steady_clock::now();
+    if (watchdog && now - last_watchdog >= std::chrono::microseconds(watchdog_usec / 2)) {
+      const std::uint64_t heartbeat = task.servo_heartbeat();
+      if (heartbeat != last_heartbeat) sd_notify(0, "WATCHDOG=1");
+      last_heartbeat = heartbeat;
+      last_watchdog = now;
+    }
+    if (std::string summary = task.summary(); summary != last_summary) {
+      sd_notifyf(0, "STATUS=%s", summary.c_str());
+      last_summary = std::move(summary);
+    }
+    signalfd_siginfo info{};
+    if (read(signal_fd, &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
+      if (info.ssi_signo == SIGHUP) {
+        spdlog::info("SIGHUP ignored: restart the service to load a new configuration");
+        continue;
+      }
+      spdlog::info("signal {} received: stopping", info.ssi_signo);
+      break;
+    }
+    task.poll();
+  }
+  sd_notify(0, "STOPPING=1");
+  task.shutdown();
+  server.close();
+  close(signal_fd);
+  spdlog::info("cncd stopped");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  if (const auto status = parse_args(argc, argv, options)) return *status;
+
+  const auto loaded = cncd::config::load_machine_config(options.ini);
+  if (!loaded.ok()) {
+    for (const auto& problem : loaded.problems) {
+      std::fprintf(stderr, "%s\n", problem.to_string().c_str());
+    }
+    std::fprintf(stderr, "cncd: %zu problem%s in %s\n", loaded.problems.size(),
+                 loaded.problems.size() == 1 ? "" : "s", options.ini.c_str());
+    return cncd::config::kExitConfig;
+  }
+  const auto& config = *loaded.config;
+  if (options.check_only) {
+    for (const auto& warning : loaded.warnings) {
+      std::fprintf(stderr, "warning: %s\n", warning.to_string().c_str());
+    }
+    std::fputs(cncd::config::describe(config).c_str(), stdout);
+    return 0;
+  }
+
+  const std::string level_name =
+      options.log_level.empty() ? config.cncd.log_level : options.log_level;
+  const auto level = cncd::daemon::parse_log_level(level_name);
+  if (!level) {
+    std::fprintf(stderr, "cncd: unknown log level '%s'\n", level_name.c_str());
+    return kExitUsage;
+  }
+  cncd::daemon::init_logging(*level);
+  for (const auto& warning : loaded.warnings)
+    spdlog::warn("{}", warning.to_string());
+  if (config.ini) {
+    for (const auto* entry : config.ini->unused_entries()) {
+      spdlog::debug("{}:{}: [{}] {} is not used by cncd", entry->source.file, entry->source.line,
+                    entry->section, entry->key);
+    }
+  }
+  try {
+    return serve(config, options.socket.empty() ? config.cncd.socket_path : options.socket);
+  } catch (const std::exception& e) {
+    spdlog::critical("fatal: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,39 @@
+#include "event_log.hpp"
+
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+namespace cncd::daemon {
+
+void EventLog::add(std::string level, std::string kind, std::string message) {
+  if (level == "error") {
+    spdlog::error("{}: {}", kind, message);
+  } else if (level == "warning") {
+    spdlog::warn("{}: {}", kind, message);
+  } else {
+    spdlog::info("{}: {}", kind, message);
+  }
+  const auto wall = std::chrono::system_clock::now().time_since_epoch();
+  events_.push_back(Event{next_seq_++, std::chrono::duration<double>(wall).count(),
+                          std::move(level), std::move(kind), std::move(message)});
+  if (events_.size() > kCapacity) events_.pop_front();
+}
+
+nlohmann::json EventLog::to_json(const Event& event) {
+  return {{"seq", event.seq},
+          {"time", event.time},
+          {"level", event.level},
+          {"kind", event.kind},
+          {"message", event.message}};
+}
+
+nlohmann::json EventLog::since(std::uint64_t since) const {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& event : events_) {
+    if (event.seq > since) out.push_back(to_json(event));
+  }
+  return out;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,40 @@
+// Recent errors and events, each with a sequence number. Every client sees every entry: they
+// are broadcast and kept for errors.list, never consumed by whoever reads first.
+// Used on the daemon's main loop thread only.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace cncd::daemon {
+
+struct Event {
+  std::uint64_t seq = 0;
+  double time = 0;    // seconds since the Unix epoch
+  std::string level;  // "error" | "warning" | "info"
+  std::string kind;   // "program" | "fault" | "machine" | "message" ...
+  std::string message;
+};
+
+class EventLog {
+ public:
+  static constexpr std::size_t kCapacity = 1000;
+
+  // Records an event (and logs it through spdlog at the matching level).
+  void add(std::string level, std::string kind, std::string message);
+  // Events with seq > since, oldest first.
+  nlohmann::json since(std::uint64_t since) const;
+  std::uint64_t last_seq() const { return next_seq_ - 1; }
+
+  static nlohmann::json to_json(const Event& event);
+
+ private:
+  std::deque<Event> events_;
+  std::uint64_t next_seq_ = 1;
+};
+
+}  // namespace cncd::daemon

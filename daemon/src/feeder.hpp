@@ -1,0 +1,37 @@
+// ProgramFeeder: the canonical-command sink that turns the interpreter's output into motion
+// moves (machine coordinates and units) and remembers spindle, coolant and tool state.
+// Used on the daemon's main loop thread.
+#pragma once
+
+#include <array>
+#include <deque>
+
+#include "cncd/interp/canon.hpp"
+#include "cncd/interp/to_machine.hpp"
+#include "cncd/motion/types.hpp"
+#include "event_log.hpp"
+
+namespace cncd::daemon {
+
+class ProgramFeeder final : public interp::CanonSink {
+ public:
+  ProgramFeeder(interp::Units machine_units, EventLog& events)
+      : tracker_(machine_units), events_(events) {}
+  void emit(const interp::CanonCommand& command) override;
+  // Resets what a new program run must not inherit.
+  void start_program();
+
+  std::deque<motion::Move> pending;  // moves the planner had no room for yet
+  bool stop_seen = false;            // M0/M1/M60 reached in the stream
+  int spindle_direction = 0;         // 1 cw, -1 ccw, 0 stopped
+  double spindle_speed = 0;          // rpm
+  bool mist = false;
+  bool flood = false;
+  int tool = 0;
+
+ private:
+  interp::MachineTracker tracker_;
+  EventLog& events_;
+};
+
+}  // namespace cncd::daemon

@@ -1,0 +1,110 @@
+#include "persist.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace cncd::daemon {
+namespace {
+
+std::string os_error(const std::string& what, const std::filesystem::path& path) {
+  return what + " '" + path.string() + "': " + std::strerror(errno);
+}
+
+}  // namespace
+
+std::string atomic_write_file(const std::filesystem::path& path, const std::string& content) {
+  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::string temp = (dir / ("." + path.filename().string() + ".XXXXXX")).string();
+  const int fd = mkstemp(temp.data());
+  if (fd < 0) return os_error("cannot create a temporary file next to", path);
+  std::size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string error = os_error("cannot write", temp);
+      ::close(fd);
+      ::unlink(temp.c_str());
+      return error;
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) {
+    const std::string error = os_error("cannot flush", temp);
+    ::close(fd);
+    ::unlink(temp.c_str());
+    return error;
+  }
+  ::close(fd);
+  if (::rename(temp.c_str(), path.c_str()) != 0) {
+    const std::string error = os_error("cannot replace", path);
+    ::unlink(temp.c_str());
+    return error;
+  }
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+  return "";
+}
+
+std::string format_position_file(const std::vector<double>& joints) {
+  std::string out;
+  char line[64];
+  for (const double value : joints) {
+    std::snprintf(line, sizeof line, "%.9f\n", value);
+    out += line;
+  }
+  return out;
+}
+
+std::optional<std::vector<double>> read_position_file(const std::filesystem::path& path,
+                                                      std::size_t joint_count, std::string& error) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::vector<double>{};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = os_error("cannot read", path);
+    return std::nullopt;
+  }
+  std::vector<double> joints;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.size() > 256) {
+      error = path.string() + ":" + std::to_string(number) + ": line too long";
+      return std::nullopt;
+    }
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos) continue;
+    const auto last = line.find_last_not_of(" \t\r");
+    double value = 0;
+    const char* begin = line.data() + first;
+    const char* end = line.data() + last + 1;
+    const auto [ptr, ec2] = std::from_chars(begin, end, value);
+    if (ec2 != std::errc() || ptr != end || !std::isfinite(value)) {
+      error = path.string() + ":" + std::to_string(number) + ": '" + line.substr(first) +
+              "' is not a position";
+      return std::nullopt;
+    }
+    joints.push_back(value);
+  }
+  if (joints.size() != joint_count) {
+    error = path.string() + ": holds " + std::to_string(joints.size()) +
+            " positions, the machine has " + std::to_string(joint_count) + " joints";
+    return std::nullopt;
+  }
+  return joints;
+}
+
+}  // namespace cncd::daemon

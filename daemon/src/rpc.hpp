@@ -1,0 +1,74 @@
+// JSON-RPC 2.0 dispatch: one request (or batch) in, one response (or none) out.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace cncd::daemon {
+
+// Stable error codes; docs/protocol.md lists them.
+enum RpcCode : int {
+  kParseError = -32700,
+  kInvalidRequest = -32600,
+  kMethodNotFound = -32601,
+  kInvalidParams = -32602,
+  kInternalError = -32603,
+  kWrongState = 1001,    // not allowed in the machine's current state
+  kNotHomed = 1002,      // motion needs homed joints
+  kProgramError = 1003,  // the program could not be opened or was rejected
+  kBusy = 1004,          // something else is running
+  kPermissionDenied = 1005,
+  kRequestTooLarge = 1006,
+};
+
+class RpcError : public std::runtime_error {
+ public:
+  RpcError(int code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  int code() const { return code_; }
+
+ private:
+  int code_;
+};
+
+// What a connection may do, from its peer credentials.
+enum class Access { none, read, control };
+
+// Per-connection state a method may read or change.
+struct Session {
+  Access access = Access::control;
+  int subscribe_interval_ms = 0;    // 0: not subscribed to status updates
+  std::vector<std::string> fields;  // top-level status fields wanted; empty = all
+};
+
+class RpcDispatcher {
+ public:
+  // A handler gets the params (object, array or null) and the caller's session and returns the
+  // result; it reports failure by throwing RpcError. Called on the server's thread.
+  using Handler = std::function<nlohmann::json(const nlohmann::json& params, Session& session)>;
+  using SimpleHandler = std::function<nlohmann::json(const nlohmann::json& params)>;
+
+  // `needs` is the access a caller must have: read for queries, control for commands.
+  void add(const std::string& method, Handler handler, Access needs = Access::control);
+  void add(const std::string& method, SimpleHandler handler, Access needs = Access::control);
+  // Handles one line of input from a caller. Returns the serialized response without newline,
+  // or nullopt when nothing is to be sent (notifications).
+  std::optional<std::string> handle_line(const std::string& line, Session& session) const;
+
+  static nlohmann::json error_object(int code, const std::string& message);
+
+ private:
+  struct Entry {
+    Handler handler;
+    Access needs;
+  };
+  std::optional<nlohmann::json> handle_one(const nlohmann::json& request, Session& session) const;
+  std::map<std::string, Entry, std::less<>> handlers_;
+};
+
+}  // namespace cncd::daemon

@@ -1,0 +1,82 @@
+// The control socket: a Unix stream socket speaking JSON-RPC 2.0, one JSON object per line,
+// with status subscriptions pushed as "status.update" notifications.
+// Single-threaded: every method runs on the thread that calls poll_once().
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "access.hpp"
+#include "event_log.hpp"
+#include "rpc.hpp"
+
+namespace cncd::daemon {
+
+class Server {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Largest request line accepted; a longer one gets an error and the connection is closed.
+  static constexpr std::size_t kMaxLineBytes = 1 << 20;
+  // Unsent output past which a client that does not read is disconnected.
+  static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
+  static constexpr int kMinSubscribeIntervalMs = 10;
+
+  // `status` produces the full status object for subscriptions (called at most once a loop);
+  // every entry added to `events` is pushed to every client as an "event" notification.
+  Server(const RpcDispatcher& dispatcher, AccessPolicy policy,
+         std::function<nlohmann::json()> status, const EventLog& events);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Binds and listens on `path`; a stale socket file left by a dead daemon is replaced, a live
+  // one is an error. Returns "" or an error message.
+  std::string listen(const std::string& path);
+  // Serves an already listening socket handed over by systemd.
+  void adopt(int listen_fd);
+  // Waits up to timeout_ms for socket activity (and `extra_fd` readability when >= 0), serves
+  // it and pushes due status updates.
+  void poll_once(int timeout_ms, int extra_fd = -1);
+  // Closes every connection and removes the socket file (when this server created it).
+  void close();
+  std::size_t client_count() const { return clients_.size(); }
+
+ private:
+  struct Client {
+    int fd = -1;
+    Session session;
+    std::string in;
+    std::string out;
+    bool closing = false;           // close once `out` is flushed
+    nlohmann::json last_sent;       // status as this client last saw it
+    Clock::time_point next_update;  // when the next status update is due
+    std::uint64_t update_seq = 0;
+    std::uint64_t event_seq = 0;  // last event pushed to this client
+  };
+  void accept_clients();
+  void read_client(Client& client);
+  void write_client(Client& client);
+  void push_updates(Clock::time_point now);
+  void push_events();
+  int next_update_in_ms(Clock::time_point now) const;
+
+  const RpcDispatcher& dispatcher_;
+  AccessPolicy policy_;
+  std::function<nlohmann::json()> status_;
+  const EventLog& events_;
+  int listen_fd_ = -1;
+  std::string path_;  // empty when the socket was handed over
+  std::vector<Client> clients_;
+};
+
+// {"a":1,"b":{"c":2}} vs {"a":1,"b":{"c":3}} gives {"b":{"c":3}}: a JSON merge patch (RFC 7386)
+// taking `before` to `after`, for objects whose keys do not disappear.
+nlohmann::json merge_diff(const nlohmann::json& before, const nlohmann::json& after);
+
+}  // namespace cncd::daemon

@@ -1,0 +1,259 @@
+#include "task.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
+
+#include "rpc.hpp"
+
+namespace cncd::daemon {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+interp::Units machine_units(const config::MachineConfig& config) {
+  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
+                                                          : interp::Units::mm;
+}
+
+std::uint64_t count_lines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t lines = 0;
+  char buffer[65536];
+  bool last_newline = true;
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < n; ++i)
+      lines += buffer[i] == '\n';
+    last_newline = buffer[n - 1] == '\n';
+  }
+  return last_newline ? lines : lines + 1;
+}
+}  // namespace
+
+Task::Task(const config::MachineConfig& config, EventLog& events)
+    : config_(config),
+      events_(events),
+      motion_(config),
+      feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)) {}
+
+Task::~Task() {
+  shutdown();
+}
+
+std::string Task::start() {
+  std::string error = motion_.start();
+  for (const auto& warning : motion_.start_warnings())
+    events_.add("warning", "servo", warning);
+  return error;
+}
+
+void Task::drain_servo_events() {
+  motion::Event event;
+  while (motion_.poll_event(event)) {
+    const char* level = event.level == motion::Event::Level::fault     ? "error"
+                        : event.level == motion::Event::Level::warning ? "warning"
+                                                                       : "info";
+    events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text);
+  }
+}
+
+void Task::shutdown() {
+  if (exec_ != ExecState::idle) finish_program("aborted", "daemon shutting down");
+  motion_.stop();
+}
+
+void Task::estop() {
+  motion_.estop();
+  if (exec_ != ExecState::idle) finish_program("aborted", "estop");
+}
+
+void Task::reset() {
+  if (motion_.status().machine != motion::MachineState::estop) return;
+  motion_.reset_estop();
+}
+
+void Task::machine_on() {
+  const auto status = motion_.status();
+  if (status.machine == motion::MachineState::estop) {
+    throw RpcError(kWrongState, "machine is in estop: reset it first");
+  }
+  motion_.machine_on();
+}
+
+void Task::machine_off() {
+  if (exec_ != ExecState::idle) finish_program("aborted", "machine turned off");
+  motion_.machine_off();
+}
+
+void Task::home(std::uint32_t joint_mask) {
+  const auto status = motion_.status();
+  if (status.machine != motion::MachineState::on) {
+    throw RpcError(kWrongState, "machine is not on");
+  }
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
+  motion_.home(joint_mask);
+}
+
+void Task::open_program(const std::string& path) {
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw RpcError(kProgramError, "cannot open program '" + path + "': no such file");
+  }
+  std::ifstream probe(path);
+  if (!probe) throw RpcError(kProgramError, "cannot open program '" + path + "': not readable");
+  program_path_ = path;
+  program_lines_ = count_lines(path);
+  last_result_.clear();
+  last_error_.clear();
+  spdlog::info("program opened: {} ({} lines)", path, program_lines_);
+}
+
+bool Task::all_homed(const motion::Status& status) const {
+  for (int j = 0; j < status.joint_count; ++j) {
+    if (!status.homed[static_cast<std::size_t>(j)]) return false;
+  }
+  return true;
+}
+
+void Task::run_program() {
+  if (program_path_.empty()) throw RpcError(kProgramError, "no program is open");
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is already running");
+  const auto status = motion_.status();
+  if (status.machine != motion::MachineState::on) throw RpcError(kWrongState, "machine is not on");
+  if (status.motion != motion::MotionState::idle) throw RpcError(kBusy, "the machine is moving");
+  if (!config_.no_force_homing && !all_homed(status)) {
+    throw RpcError(kNotHomed, "all joints must be homed before running a program");
+  }
+  interp::InterpOptions options;
+  options.machine_units = machine_units(config_);
+  options.parameter_file = config_.parameter_file;
+  options.tool_table = config_.tool_table;
+  options.subroutine_path = config_.subroutine_path;
+  options.startup_code = config_.startup_code;
+  auto interpreter = std::make_unique<interp::Interpreter>(options);
+  if (auto error = interpreter->open(program_path_)) {
+    throw RpcError(kProgramError, error->to_string());
+  }
+  // A program starts in the machine's units, so the commanded position needs no conversion.
+  interp::Pose position{};
+  std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
+  interpreter->set_position(position);
+  interp_ = std::move(interpreter);
+  feeder_->start_program();
+  interp_done_ = false;
+  moves_enqueued_ = 0;
+  moves_done_base_ = status.segments_done;
+  exec_ = ExecState::running;
+  started_at_ = Clock::now();
+  elapsed_s_ = 0;
+  last_result_.clear();
+  last_error_.clear();
+  events_.add("info", "program", program_path_ + " started");
+  feed();
+}
+
+void Task::pause() {
+  if (exec_ != ExecState::running) throw RpcError(kWrongState, "no program is running");
+  motion_.pause();
+  exec_ = ExecState::paused;
+}
+
+void Task::resume() {
+  if (exec_ != ExecState::paused) throw RpcError(kWrongState, "the program is not paused");
+  motion_.resume();
+  exec_ = ExecState::running;
+}
+
+void Task::abort() {
+  motion_.abort();
+  if (exec_ != ExecState::idle) finish_program("aborted", "aborted by request");
+}
+
+void Task::finish_program(const std::string& result, const std::string& error) {
+  interp_.reset();
+  feeder_->pending.clear();
+  exec_ = ExecState::idle;
+  moves_completed_ = motion_.status().segments_done - moves_done_base_;
+  elapsed_s_ = std::chrono::duration<double>(Clock::now() - started_at_).count();
+  last_result_ = result;
+  last_error_ = error;
+  if (result == "done") {
+    events_.add("info", "program",
+                fmt::format("{} finished in {:.3f} s", program_path_, elapsed_s_));
+  } else {
+    events_.add(result == "error" ? "error" : "warning", "program",
+                fmt::format("{} {}{}", program_path_, result, error.empty() ? "" : ": " + error));
+  }
+}
+
+void Task::feed() {
+  // Bounded work per call keeps the control socket responsive.
+  constexpr int kMaxBlocksPerPoll = 2000;
+  for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
+    while (!feeder_->pending.empty()) {
+      const auto result = motion_.enqueue(feeder_->pending.front());
+      if (result == motion::MotionController::EnqueueResult::full) return;
+      if (result == motion::MotionController::EnqueueResult::refused) {
+        const int line = feeder_->pending.front().line;
+        motion_.abort();
+        finish_program("error",
+                       program_path_ + ":" + std::to_string(line) + ": " + motion_.enqueue_error());
+        return;
+      }
+      feeder_->pending.pop_front();
+      ++moves_enqueued_;
+    }
+    if (interp_done_ || feeder_->stop_seen) return;
+    const auto step = interp_->step(*feeder_);
+    if (step == interp::Interpreter::Step::error) {
+      const auto& error = interp_->error();
+      motion_.abort();
+      finish_program("error", error ? error->to_string() : "interpreter error");
+      return;
+    }
+    if (step == interp::Interpreter::Step::end) interp_done_ = true;
+  }
+}
+
+void Task::poll() {
+  drain_servo_events();
+  const auto status = motion_.status();
+  if (exec_ == ExecState::idle) return;
+  if (status.machine != motion::MachineState::on) {
+    finish_program("aborted", status.fault_reason[0] != '\0' ? status.fault_reason
+                                                             : "machine left the on state");
+    return;
+  }
+  if (status.fault_reason[0] != '\0') {
+    finish_program("error", status.fault_reason);
+    return;
+  }
+  if (exec_ == ExecState::paused) return;
+  feed();
+  if (exec_ != ExecState::running) return;
+  // Counting completed moves (rather than looking at an empty queue) cannot mistake the instant
+  // between enqueue and the servo thread picking a move up for the end of the program.
+  const bool drained = feeder_->pending.empty() &&
+                       status.segments_done - moves_done_base_ >= moves_enqueued_ &&
+                       status.motion == motion::MotionState::idle;
+  if (!drained) return;
+  if (feeder_->stop_seen) {
+    // M0/M1/M60 reached: the machine has stopped at that point; resume continues.
+    feeder_->stop_seen = false;
+    exec_ = ExecState::paused;
+    events_.add("info", "program",
+                fmt::format("stopped by M0/M1/M60 at line {}", interp_->current_line()));
+    return;
+  }
+  if (interp_done_) finish_program("done", "");
+}
+
+bool Task::busy() const {
+  return exec_ != ExecState::idle || motion_.status().motion != motion::MotionState::idle;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,86 @@
+// The task layer: machine state (estop/off/on), program execution, and the glue from the
+// interpreter's canonical commands to the motion controller's queue.
+//
+// Single-threaded: every method is called from the daemon's main loop thread.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/motion/controller.hpp"
+#include "event_log.hpp"
+#include "feeder.hpp"
+
+namespace cncd::daemon {
+
+enum class ExecState { idle, running, paused };
+
+class Task {
+ public:
+  Task(const config::MachineConfig& config, EventLog& events);
+  ~Task();
+  Task(const Task&) = delete;
+  Task& operator=(const Task&) = delete;
+
+  // Starts the servo thread. Returns "" or an error.
+  std::string start();
+  // Stops motion under control and the servo thread.
+  void shutdown();
+
+  // Each command throws RpcError when refused in the current state.
+  void estop();
+  void reset();
+  void machine_on();
+  void machine_off();
+  void home(std::uint32_t joint_mask);
+  void open_program(const std::string& path);
+  void run_program();
+  void pause();
+  void resume();
+  void abort();
+
+  // Feeds the planner from the interpreter, notices the end of a program, logs servo events.
+  // Called every loop iteration.
+  void poll();
+  // True while a program is being fed or motion is under way: the loop should poll often.
+  bool busy() const;
+
+  nlohmann::json status() const;
+  // The servo thread's cycle counter: it advances while the servo loop is alive.
+  std::uint64_t servo_heartbeat() const { return motion_.status().sequence; }
+  // One line for systemd's STATUS=, e.g. "on, running part.ngc line 12".
+  std::string summary() const;
+
+ private:
+  void feed();
+  void drain_servo_events();
+  void finish_program(const std::string& result, const std::string& error);
+  bool all_homed(const motion::Status& status) const;
+
+  const config::MachineConfig& config_;
+  EventLog& events_;
+  motion::MotionController motion_;
+  std::unique_ptr<ProgramFeeder> feeder_;
+  ExecState exec_ = ExecState::idle;
+  std::string program_path_;
+  std::uint64_t program_lines_ = 0;
+  std::unique_ptr<interp::Interpreter> interp_;
+  bool interp_done_ = false;
+  std::uint64_t moves_enqueued_ = 0;   // moves handed to motion since the program started
+  std::uint64_t moves_done_base_ = 0;  // motion's completed-move count when it started
+  std::uint64_t moves_completed_ = 0;  // moves the last finished run completed
+  std::string last_result_;            // "done" | "aborted" | "error" | "" (never ran)
+  std::string last_error_;
+  std::chrono::steady_clock::time_point started_at_{};
+  double elapsed_s_ = 0;
+};
+
+}  // namespace cncd::daemon

@@ -1,0 +1,50 @@
+#include "cncd/drivers/sim_driver.hpp"
+
+#include <cmath>
+
+namespace cncd::drivers {
+
+std::string SimDriver::configure(const config::MachineConfig& machine,
+                                 const std::vector<int>& joints) {
+  if (joints.size() > static_cast<std::size_t>(kMaxJoints)) return "too many joints for one driver";
+  period_s_ = static_cast<double>(machine.servo_period_ns) * 1e-9;
+  return "";
+}
+
+void SimDriver::write(const JointCommand* commands, int count) noexcept {
+  for (int i = 0; i < count && i < kMaxJoints; ++i) {
+    commanded_[static_cast<std::size_t>(i)] = commands[i].position;
+    if (!primed_) position_[static_cast<std::size_t>(i)] = commands[i].position;
+  }
+  primed_ = true;
+}
+
+void SimDriver::read(JointFeedback* feedback, int count) noexcept {
+  const double lag = lag_s_.load(std::memory_order_relaxed);
+  // Exact discretization of a first-order lag: stable for any period.
+  const double alpha = lag > 0 ? 1.0 - std::exp(-period_s_ / lag) : 1.0;
+  for (int i = 0; i < count && i < kMaxJoints; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    feedback[i].stale = stale_[k].load(std::memory_order_relaxed);
+    feedback[i].fault = fault_[k].load(std::memory_order_relaxed);
+    if (!feedback[i].stale) position_[k] += (commanded_[k] - position_[k]) * alpha;
+    feedback[i].position = position_[k];
+    feedback[i].home_switch = false;
+    feedback[i].min_limit = false;
+    feedback[i].max_limit = false;
+  }
+}
+
+void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
+  if (estop_.load(std::memory_order_relaxed)) inputs.estop = true;
+}
+
+void SimDriver::set_fault(int index, bool fault) noexcept {
+  if (index >= 0 && index < kMaxJoints) fault_[static_cast<std::size_t>(index)].store(fault);
+}
+
+void SimDriver::set_stale(int index, bool stale) noexcept {
+  if (index >= 0 && index < kMaxJoints) stale_[static_cast<std::size_t>(index)].store(stale);
+}
+
+}  // namespace cncd::drivers

@@ -1,0 +1,29 @@
+// Wake-up error histogram of the servo loop: fixed memory, O(1) per sample, percentiles on
+// demand. RT-safe.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace cncd::motion {
+
+class RtHistogram {
+ public:
+  // 1 µs buckets up to 1 ms, 100 µs buckets up to 100 ms, one overflow bucket.
+  static constexpr int kFine = 1000;
+  static constexpr int kCoarse = 990;
+  static constexpr int kBuckets = kFine + kCoarse + 1;
+
+  void add(std::int64_t error_ns) noexcept;
+  // Upper edge (ns) of the bucket holding the q-quantile, q in [0, 1].
+  std::int64_t quantile_ns(double q) const noexcept;
+  std::int64_t max_ns() const noexcept { return max_ns_; }
+  std::uint64_t count() const noexcept { return count_; }
+
+ private:
+  std::array<std::uint32_t, kBuckets> buckets_{};
+  std::uint64_t count_ = 0;
+  std::int64_t max_ns_ = 0;
+};
+
+}  // namespace cncd::motion

@@ -1,0 +1,33 @@
+// A planned move as the servo thread executes it: geometry in machine coordinates, and the
+// path-speed and path-acceleration limits the planner derived from every axis's limits.
+// Trivially copyable: it crosses the planner -> servo ring.
+#pragma once
+
+#include <cstdint>
+
+#include "cncd/motion/types.hpp"
+
+namespace cncd::motion {
+
+struct Segment {
+  enum class Kind : std::uint8_t { line, arc, dwell };
+  Kind kind = Kind::line;
+  AxisPose start{};
+  AxisPose end{};
+  double length = 0;            // path length (units); 0 for dwell
+  double max_velocity = 0;      // path speed limit, units/s (feed, axis and arc limits)
+  double max_acceleration = 0;  // path acceleration limit, units/s^2
+  double dwell_s = 0;
+  // Arc: centre in the plane, radius, start angle and signed sweep (rad), plane axes.
+  std::int8_t first_axis = 0, second_axis = 1, normal_axis = 2;
+  double center_first = 0, center_second = 0;
+  double radius = 0;
+  double start_angle = 0;
+  double sweep = 0;
+  std::int32_t line = 0;
+
+  // Point at path distance s in [0, length]. RT-safe.
+  AxisPose point_at(double s) const noexcept;
+};
+
+}  // namespace cncd::motion

@@ -1,0 +1,257 @@
+#include "cncd/motion/controller.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <thread>
+
+#include "cncd/motion/planner.hpp"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define CNCD_SANITIZED 1
+#else
+#define CNCD_SANITIZED 0
+#endif
+
+namespace cncd::motion {
+namespace {
+
+std::int64_t to_ns(const timespec& t) {
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+timespec from_ns(std::int64_t ns) {
+  timespec t{};
+  t.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
+  t.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  return t;
+}
+
+// Touches the stack the servo thread will use so that no page fault happens inside the loop.
+void prefault_stack() {
+  constexpr std::size_t kBytes = 256 * 1024;
+  char stack[kBytes];
+  std::memset(stack, 0, kBytes);
+  // Keeps the compiler from dropping the writes to a buffer nobody reads.
+  asm volatile("" : : "r"(stack) : "memory");
+}
+
+}  // namespace
+
+struct MotionController::Impl {
+  explicit Impl(const config::MachineConfig& c) : config(c), planner(c) {}
+
+  const config::MachineConfig& config;
+  Planner planner;
+  std::vector<std::unique_ptr<drivers::Driver>> drivers;
+  drivers::SimDriver* sim = nullptr;
+  std::unique_ptr<ServoLoop> loop;
+  std::thread thread;
+  std::atomic<bool> running{false};
+  std::vector<std::string> warnings;
+  std::string enqueue_error;
+  AxisPose plan_end{};
+  std::uint64_t enqueued = 0;
+
+  // Hands a command to the servo thread and waits until a cycle has applied it (a period or
+  // two), so that the caller's next status read already reflects it.
+  void send(Command::Kind kind, std::uint32_t mask = 0) {
+    if (!loop) return;
+    const std::uint64_t before = loop->status().sequence;
+    // The command ring is drained every period; it is full only when the servo thread is not
+    // running, and then there is nobody to act on the command anyway.
+    if (!loop->commands().push(Command{kind, mask}) || !running.load()) return;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    while (loop->status().sequence < before + 2 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  }
+
+  // The servo thread's body: fixed-period absolute sleeps, one cycle per period.
+  void run(bool want_realtime) {
+    bool realtime = false;
+    if (want_realtime) {
+      sched_param param{};
+      param.sched_priority = config.cncd.rt_priority;
+      realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    }
+    if (config.cncd.rt_cpu >= 0) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      CPU_SET(config.cncd.rt_cpu, &set);
+      pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+    }
+    prefault_stack();
+    loop->set_rt_flags(realtime, locked);
+    if (want_realtime && !realtime) {
+      Event event;
+      event.level = Event::Level::warning;
+      std::snprintf(event.text, sizeof event.text,
+                    "SCHED_FIFO priority %d refused: the servo thread runs without real-time "
+                    "scheduling and its timing will suffer",
+                    config.cncd.rt_priority);
+      loop->events().push(event);
+    }
+    const std::int64_t period = config.servo_period_ns;
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    std::int64_t next = to_ns(now) + period;
+    while (running.load(std::memory_order_acquire)) {
+      const timespec deadline = from_ns(next);
+      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+      }
+      clock_gettime(CLOCK_MONOTONIC, &now);
+      const std::int64_t woke = to_ns(now);
+      loop->cycle(woke - next);
+      next += period;
+      // After a long stall, skip the missed periods instead of running them back to back.
+      if (woke - next > 10 * period) next = woke + period;
+    }
+  }
+
+  bool locked = false;
+};
+
+MotionController::MotionController(const config::MachineConfig& config)
+    : impl_(std::make_unique<Impl>(config)) {}
+
+MotionController::~MotionController() {
+  stop();
+}
+
+std::string MotionController::start() {
+  if (impl_->running.load()) return "";
+  const auto& config = impl_->config;
+  // One driver instance per driver name, owning its joints in joint order.
+  std::map<std::string, std::vector<int>> by_driver;
+  for (std::size_t j = 0; j < config.joints.size(); ++j) {
+    by_driver[config.joints[j].driver].push_back(static_cast<int>(j));
+  }
+  std::vector<DriverBinding> bindings;
+  impl_->drivers.clear();
+  for (const auto& [name, joints] : by_driver) {
+    std::string error;
+    auto driver = drivers::make_driver(name, error);
+    if (!driver) return error;
+    if (auto problem = driver->configure(config, joints); !problem.empty()) {
+      return "driver '" + name + "': " + problem;
+    }
+    if (name == "sim") impl_->sim = static_cast<drivers::SimDriver*>(driver.get());
+    bindings.push_back(DriverBinding{driver.get(), joints});
+    impl_->drivers.push_back(std::move(driver));
+  }
+  impl_->loop = std::make_unique<ServoLoop>(config, std::move(bindings));
+  for (auto& driver : impl_->drivers)
+    driver->enable();
+
+  impl_->warnings.clear();
+  if (CNCD_SANITIZED) {
+    impl_->warnings.push_back("memory not locked: sanitizer builds reserve too much to lock");
+  } else if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+    impl_->locked = true;
+  } else {
+    impl_->warnings.push_back(std::string("mlockall refused (") + std::strerror(errno) +
+                              "): servo thread memory may be paged out");
+  }
+  impl_->running.store(true);
+  impl_->thread = std::thread([impl = impl_.get()] { impl->run(true); });
+  return "";
+}
+
+void MotionController::stop() {
+  if (!impl_->running.exchange(false)) return;
+  impl_->thread.join();
+  for (auto& driver : impl_->drivers)
+    driver->disable();
+  if (impl_->locked) {
+    munlockall();
+    impl_->locked = false;
+  }
+}
+
+MotionController::EnqueueResult MotionController::enqueue(const Move& move) {
+  if (!impl_->loop) {
+    impl_->enqueue_error = "motion is not started";
+    return EnqueueResult::refused;
+  }
+  const Status status = impl_->loop->status();
+  if (status.machine != MachineState::on) {
+    impl_->enqueue_error = "machine is not on";
+    return EnqueueResult::refused;
+  }
+  // With every queued segment done, the commanded position is where the next move starts
+  // (after homing, an abort or a jog it differs from the last planned end).
+  if (status.segments_done == impl_->enqueued) impl_->plan_end = status.commanded;
+  bool homed = true;
+  for (int j = 0; j < status.joint_count; ++j)
+    homed = homed && status.homed[static_cast<std::size_t>(j)];
+  const auto segment = impl_->planner.plan(move, impl_->plan_end, homed, impl_->enqueue_error);
+  if (!segment) return EnqueueResult::refused;
+  if (!impl_->loop->segments().push(*segment)) return EnqueueResult::full;
+  impl_->plan_end = segment->end;
+  ++impl_->enqueued;
+  return EnqueueResult::queued;
+}
+
+const std::string& MotionController::enqueue_error() const {
+  return impl_->enqueue_error;
+}
+
+std::size_t MotionController::queue_space() const {
+  if (!impl_->loop) return 0;
+  return ServoLoop::SegmentRing::capacity() - impl_->loop->segments().size();
+}
+
+void MotionController::estop() {
+  impl_->send(Command::Kind::estop);
+}
+void MotionController::reset_estop() {
+  impl_->send(Command::Kind::reset_estop);
+}
+void MotionController::machine_on() {
+  impl_->send(Command::Kind::on);
+}
+void MotionController::machine_off() {
+  impl_->send(Command::Kind::off);
+}
+void MotionController::home(std::uint32_t joint_mask) {
+  impl_->send(Command::Kind::home, joint_mask);
+}
+void MotionController::abort() {
+  impl_->send(Command::Kind::abort);
+}
+void MotionController::pause() {
+  impl_->send(Command::Kind::pause);
+}
+void MotionController::resume() {
+  impl_->send(Command::Kind::resume);
+}
+
+Status MotionController::status() const {
+  if (!impl_->loop) {
+    Status idle;
+    idle.joint_count = static_cast<int>(impl_->config.joints.size());
+    return idle;
+  }
+  return impl_->loop->status();
+}
+
+bool MotionController::poll_event(Event& event) {
+  return impl_->loop && impl_->loop->events().pop(event);
+}
+
+const std::vector<std::string>& MotionController::start_warnings() const {
+  return impl_->warnings;
+}
+
+drivers::SimDriver* MotionController::sim_driver() {
+  return impl_->sim;
+}
+
+}  // namespace cncd::motion

@@ -1,0 +1,190 @@
+#include "cncd/motion/planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cncd::motion {
+namespace {
+
+constexpr double kTiny = 1e-12;
+
+// LinuxCNC measures feed along XYZ when they move, else along UVW, else along ABC.
+double path_length(const AxisPose& delta) {
+  auto norm = [&](int first) {
+    return std::sqrt(delta[first] * delta[first] + delta[first + 1] * delta[first + 1] +
+                     delta[first + 2] * delta[first + 2]);
+  };
+  const double xyz = norm(0);
+  if (xyz > kTiny) return xyz;
+  const double uvw = norm(6);
+  if (uvw > kTiny) return uvw;
+  return norm(3);
+}
+
+}  // namespace
+
+AxisPose Segment::point_at(double s) const noexcept {
+  if (kind == Kind::dwell || length <= 0) return end;
+  const double f = std::clamp(s / length, 0.0, 1.0);
+  AxisPose p{};
+  for (int i = 0; i < kAxes; ++i)
+    p[i] = start[i] + (end[i] - start[i]) * f;
+  if (kind == Kind::arc) {
+    const double angle = start_angle + sweep * f;
+    p[first_axis] = center_first + radius * std::cos(angle);
+    p[second_axis] = center_second + radius * std::sin(angle);
+    if (f >= 1.0) {
+      p[first_axis] = end[first_axis];
+      p[second_axis] = end[second_axis];
+    }
+  }
+  return p;
+}
+
+Planner::Planner(const config::MachineConfig& config) : config_(config) {}
+
+bool Planner::within_limits(const Segment& segment, std::string& error) const {
+  // Lines are convex: their ends suffice. Arcs are sampled densely enough that a bulge past a
+  // limit is found (the chord error of 256 steps is below 1e-4 of the radius).
+  const int samples = segment.kind == Segment::Kind::arc ? 256 : 1;
+  for (int k = 0; k <= samples; ++k) {
+    const AxisPose p = segment.point_at(segment.length * k / samples);
+    for (int i = 0; i < kAxes; ++i) {
+      const auto& axis = config_.axes[static_cast<std::size_t>(i)];
+      if (!axis.present) continue;
+      if (p[i] < axis.min_limit - 1e-9 || p[i] > axis.max_limit + 1e-9) {
+        char text[160];
+        std::snprintf(
+            text, sizeof text, "move to %c %.4f is outside the %c soft limits [%.4f, %.4f]",
+            config::kAxisLetters[static_cast<std::size_t>(i)], p[i],
+            config::kAxisLetters[static_cast<std::size_t>(i)], axis.min_limit, axis.max_limit);
+        error = text;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bool check_limits,
+                                     std::string& error) const {
+  Segment seg;
+  seg.start = start;
+  seg.end = move.kind == Move::Kind::dwell ? start : move.end;
+  seg.line = move.line;
+  for (int i = 0; i < kAxes; ++i) {
+    if (!config_.axes[static_cast<std::size_t>(i)].present) seg.end[i] = start[i];
+  }
+  if (move.kind == Move::Kind::dwell) {
+    seg.kind = Segment::Kind::dwell;
+    seg.dwell_s = std::max(0.0, move.dwell_s);
+    return seg;
+  }
+  if (move.kind != Move::Kind::traverse && !(move.feed > 0)) {
+    error = "feed rate is zero";
+    return std::nullopt;
+  }
+  AxisPose delta{};
+  for (int i = 0; i < kAxes; ++i)
+    delta[i] = seg.end[i] - start[i];
+
+  // Direction cosines along the path, per axis: for a line constant, for an arc the in-plane
+  // axes reach 1 somewhere on a large enough sweep, so they are bounded by 1.
+  AxisPose direction{};
+  double centripetal_radius = 0;
+  if (move.kind == Move::Kind::arc) {
+    seg.kind = Segment::Kind::arc;
+    seg.first_axis = static_cast<std::int8_t>(move.plane_axes[0]);
+    seg.second_axis = static_cast<std::int8_t>(move.plane_axes[1]);
+    seg.normal_axis = static_cast<std::int8_t>(move.plane_axes[2]);
+    seg.center_first = move.center_first;
+    seg.center_second = move.center_second;
+    const double r0 = std::hypot(start[seg.first_axis] - move.center_first,
+                                 start[seg.second_axis] - move.center_second);
+    const double r1 = std::hypot(seg.end[seg.first_axis] - move.center_first,
+                                 seg.end[seg.second_axis] - move.center_second);
+    if (r0 < kTiny || std::abs(r0 - r1) > 1e-6 * std::max(1.0, r0) + 1e-6) {
+      error = "arc radius differs between start and end";
+      return std::nullopt;
+    }
+    seg.radius = r0;
+    seg.start_angle = std::atan2(start[seg.second_axis] - move.center_second,
+                                 start[seg.first_axis] - move.center_first);
+    const double end_angle = std::atan2(seg.end[seg.second_axis] - move.center_second,
+                                        seg.end[seg.first_axis] - move.center_first);
+    const double two_pi = 2 * std::numbers::pi;
+    double sweep = end_angle - seg.start_angle;
+    const int turns = move.turns == 0 ? 1 : move.turns;
+    if (turns > 0) {
+      while (sweep <= 1e-12)
+        sweep += two_pi;
+      sweep += two_pi * (turns - 1);
+    } else {
+      while (sweep >= -1e-12)
+        sweep -= two_pi;
+      sweep -= two_pi * (-turns - 1);
+    }
+    seg.sweep = sweep;
+    const double arc_length = std::abs(sweep) * seg.radius;
+    double other = 0;
+    for (int i = 0; i < kAxes; ++i) {
+      if (i != seg.first_axis && i != seg.second_axis) other += delta[i] * delta[i];
+    }
+    seg.length = std::sqrt(arc_length * arc_length + other);
+    for (int i = 0; i < kAxes; ++i) {
+      direction[i] = (i == seg.first_axis || i == seg.second_axis)
+                         ? arc_length / seg.length
+                         : std::abs(delta[i]) / seg.length;
+    }
+    centripetal_radius = seg.radius;
+  } else {
+    seg.kind = Segment::Kind::line;
+    seg.length = path_length(delta);
+    // A move of only unlisted or rotary axes still has a length along what moves.
+    if (seg.length <= kTiny) {
+      double sum = 0;
+      for (double d : delta)
+        sum += d * d;
+      seg.length = std::sqrt(sum);
+    }
+    if (seg.length <= kTiny) {
+      seg.length = 0;
+    } else {
+      for (int i = 0; i < kAxes; ++i)
+        direction[i] = std::abs(delta[i]) / seg.length;
+    }
+  }
+  if (check_limits && !within_limits(seg, error)) return std::nullopt;
+  if (seg.length == 0) {
+    seg.max_velocity = 1;
+    seg.max_acceleration = 1;
+    return seg;
+  }
+
+  double v = move.kind == Move::Kind::traverse ? 1e300 : move.feed;
+  double a = 1e300;
+  for (int i = 0; i < kAxes; ++i) {
+    if (direction[i] <= kTiny) continue;
+    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
+    v = std::min(v, axis.max_velocity / direction[i]);
+    a = std::min(a, axis.max_acceleration / direction[i]);
+  }
+  const bool linear_motion = direction[0] + direction[1] + direction[2] > kTiny;
+  if (linear_motion && config_.max_linear_velocity > 0)
+    v = std::min(v, config_.max_linear_velocity);
+  if (centripetal_radius > 0) {
+    // Half the in-plane acceleration for speeding up and slowing down, half for turning:
+    // their sum stays within every in-plane axis's limit.
+    const double plane_a =
+        std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
+                 config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
+    a = std::min(a, 0.5 * plane_a);
+    v = std::min(v, std::sqrt(0.5 * plane_a * centripetal_radius));
+  }
+  seg.max_velocity = v;
+  seg.max_acceleration = a;
+  return seg;
+}
+
+}  // namespace cncd::motion

@@ -1,0 +1,56 @@
+// Test helpers: a real cncd process on a temporary socket, and running commands.
+#pragma once
+
+#include <sys/types.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cncd::test {
+
+// A fresh temporary directory, removed on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path write(const std::string& name, const std::string& content) const;
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_status = -1;  // exit code, or 128 + signal
+  std::string out;
+  std::string err;
+};
+
+// Runs argv to completion (stdin from /dev/null), capturing stdout and stderr.
+CommandResult run_command(const std::vector<std::string>& argv);
+
+class DaemonProcess {
+ public:
+  DaemonProcess() = default;
+  ~DaemonProcess();
+  DaemonProcess(const DaemonProcess&) = delete;
+  DaemonProcess& operator=(const DaemonProcess&) = delete;
+
+  // Starts cncd with `args` plus --socket; waits until the socket accepts connections.
+  // Returns "" or what went wrong (with cncd's log).
+  std::string start(const std::filesystem::path& dir, const std::vector<std::string>& args);
+  // SIGTERM and wait; returns the exit status.
+  int stop();
+  const std::string& socket() const { return socket_; }
+  std::string log() const;
+
+ private:
+  pid_t pid_ = -1;
+  std::string socket_;
+  std::filesystem::path log_;
+};
+
+}  // namespace cncd::test

@@ -1,0 +1,100 @@
+#include "persist.hpp"
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "server.hpp"
+
+namespace cncd::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+
+class PersistTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("cncd-persist-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string read(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(PersistTest, ReplacesTheFileAndLeavesNoTemporary) {
+  const auto file = dir_ / "position.txt";
+  ASSERT_EQ(atomic_write_file(file, "old\n"), "");
+  ASSERT_EQ(atomic_write_file(file, "new\n"), "");
+  EXPECT_EQ(read(file), "new\n");
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_))
+    ++entries;
+  EXPECT_EQ(entries, 1);
+}
+
+TEST_F(PersistTest, FailureKeepsTheOldFileAndNamesIt) {
+  const auto sub = dir_ / "ro";
+  fs::create_directories(sub);
+  const auto file = sub / "position.txt";
+  ASSERT_EQ(atomic_write_file(file, "1.0\n"), "");
+  // A directory in the way of the rename makes the replacement fail.
+  const auto blocked = sub / "blocked";
+  fs::create_directories(blocked / "inside");
+  const std::string error = atomic_write_file(blocked, "x");
+  EXPECT_NE(error.find("blocked"), std::string::npos) << error;
+  EXPECT_EQ(read(file), "1.0\n");
+}
+
+TEST_F(PersistTest, PositionFileRoundTrips) {
+  const auto file = dir_ / "position.txt";
+  ASSERT_EQ(atomic_write_file(file, format_position_file({1.5, -2.25, 3})), "");
+  std::string error;
+  const auto joints = read_position_file(file, 3, error);
+  ASSERT_TRUE(joints.has_value()) << error;
+  EXPECT_EQ(*joints, (std::vector<double>{1.5, -2.25, 3}));
+}
+
+TEST_F(PersistTest, MissingPositionFileIsNotAnError) {
+  std::string error;
+  const auto joints = read_position_file(dir_ / "none.txt", 3, error);
+  ASSERT_TRUE(joints.has_value());
+  EXPECT_TRUE(joints->empty());
+}
+
+TEST_F(PersistTest, CorruptPositionFileNamesFileAndLine) {
+  const auto file = dir_ / "position.txt";
+  std::ofstream(file) << "1.0\nbanana\n3.0\n";
+  std::string error;
+  EXPECT_FALSE(read_position_file(file, 3, error).has_value());
+  EXPECT_NE(error.find("position.txt:2"), std::string::npos) << error;
+}
+
+TEST_F(PersistTest, EmptyOrShortPositionFileIsCorrupt) {
+  const auto file = dir_ / "position.txt";
+  std::ofstream(file) << "";
+  std::string error;
+  EXPECT_FALSE(read_position_file(file, 3, error).has_value());
+  EXPECT_NE(error.find("0 positions"), std::string::npos) << error;
+}
+
+TEST(MergeDiff, KeepsOnlyChangedLeaves) {
+  const nlohmann::json before = {{"a", 1}, {"b", {{"c", 2}, {"d", 3}}}, {"e", {1, 2}}};
+  const nlohmann::json after = {{"a", 1}, {"b", {{"c", 2}, {"d", 4}}}, {"e", {1, 3}}};
+  EXPECT_EQ(merge_diff(before, after), (nlohmann::json{{"b", {{"d", 4}}}, {"e", {1, 3}}}));
+  EXPECT_TRUE(merge_diff(after, after).empty());
+}
+
+}  // namespace
+}  // namespace cncd::daemon
