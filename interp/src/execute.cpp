@@ -116,7 +116,6 @@ void Interpreter::Impl::do_feed_mode() {
       emit_comment("interpreter: feed mode set to inverse time");
       emit_simple(CanonKind::set_feed_mode, 0);
       modal_.feed_mode = FeedMode::inverse_time;
-      modal_.feed_rate = 0;
     } else if (code == 940) {
       emit_comment("interpreter: feed mode set to units per minute");
       emit_simple(CanonKind::set_feed_mode, 0);

@@ -112,7 +112,7 @@ double apply(Op op, double left, double right, int column) {
   switch (op) {
     case Op::power:
       if (left < 0.0 && std::floor(right) != right) {
-        fail("Attempt to raise negative to non-integer power", column);
+        fail("Attempt to raise negative to non integer power", column);
       }
       return std::pow(left, right);
     case Op::times:

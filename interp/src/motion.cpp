@@ -85,8 +85,11 @@ void Interpreter::Impl::emit_straight(CanonKind kind, const Pose& end) {
   pos_ = end;
 }
 
+// Inverse time: the move takes 1/F minutes, so its feed is length * F; LinuxCNC keeps that
+// rate as the current feed.
 void Interpreter::Impl::set_inverse_time_rate(double length) {
-  emit_simple(CanonKind::set_feed_rate, 0, length * modal_.feed_rate);
+  modal_.feed_rate = length * block_.get('f');
+  emit_simple(CanonKind::set_feed_rate, 0, modal_.feed_rate);
 }
 
 void Interpreter::Impl::straight(CanonKind kind, const Pose& end) {
@@ -124,6 +127,9 @@ void Interpreter::Impl::do_motion() {
     }
     if (modal_.feed_mode != FeedMode::inverse_time && modal_.feed_rate == 0.0 && axis_words) {
       fail(code == 10 ? "Cannot do g1 with zero feed rate" : "Cannot make arc with zero feed rate");
+    }
+    if (modal_.feed_mode == FeedMode::units_per_rev && modal_.speed == 0.0 && axis_words) {
+      fail("Cannot feed with zero spindle speed in feed per rev mode");
     }
   }
   if (code == 20 || code == 30) {

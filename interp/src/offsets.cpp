@@ -102,7 +102,8 @@ void Interpreter::Impl::change_units(Units units) {
       pos_[a] *= factor;
       g5x_offset_[a] *= factor;
       g92_offset_[a] *= factor;
-      tool_offset_[a] *= factor;
+      // LinuxCNC leaves the tool length offset's number as it is (it is in the units it was
+      // set in); the canon layer converted it when it was set.
     }
     modal_.units = units;
   }

@@ -38,10 +38,15 @@ double MachineTracker::length_factor() const {
   return millimetres(program_units_) / millimetres(machine_units_);
 }
 
+// Offsets are kept in machine units, converted with the program units in force when they
+// were set (as LinuxCNC's canon does), so a later G20/G21 does not change them.
 Pose MachineTracker::machine_pose(const Pose& program) const {
+  const double factor = length_factor();
   Pose p = program;
-  for (std::size_t axis = 0; axis < kAxes; ++axis)
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    if (is_linear(axis)) p[axis] *= factor;
     p[axis] += g92_[axis];
+  }
   if (rotation_deg_ != 0.0) {
     const double angle = rotation_deg_ * std::numbers::pi / 180.0;
     const double x = p[0] * std::cos(angle) - p[1] * std::sin(angle);
@@ -49,9 +54,15 @@ Pose MachineTracker::machine_pose(const Pose& program) const {
     p[0] = x;
     p[1] = y;
   }
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    p[axis] += g5x_[axis] + tool_[axis];
+  return p;
+}
+
+Pose MachineTracker::to_machine_units(const Pose& program) const {
+  Pose p = program;
   const double factor = length_factor();
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    p[axis] += g5x_[axis] + tool_[axis];
     if (is_linear(axis)) p[axis] *= factor;
   }
   return p;
@@ -64,20 +75,20 @@ CanonCommand MachineTracker::to_machine(const CanonCommand& command) {
       program_units_ = static_cast<Units>(command.ivalue);
       break;
     case CanonKind::set_g5x_offset:
-      g5x_ = command.pos;
+      g5x_ = to_machine_units(command.pos);
       break;
     case CanonKind::set_g92_offset:
-      g92_ = command.pos;
+      g92_ = to_machine_units(command.pos);
       break;
     case CanonKind::set_xy_rotation:
       rotation_deg_ = command.value;
       break;
     case CanonKind::use_tool_length_offset:
-      tool_ = command.pos;
+      tool_ = to_machine_units(command.pos);
       break;
     case CanonKind::set_feed_rate:
-      feed_ = command.value;
-      out.value = feed_per_minute();
+      feed_ = command.value * length_factor();
+      out.value = feed_;
       break;
     case CanonKind::straight_traverse:
     case CanonKind::straight_feed:

@@ -148,7 +148,7 @@ TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   } machine;
   Interpreter interp;
   ASSERT_FALSE(interp.open_string(
-      "G10 L2 P2 X10 Y20 Z30\nG55 G20 F10\nG1 X1 Y1 Z1\nG92 X0\nG1 X1\nG43.1 Z0.5\n"
+      "G10 L2 P2 X10 Y20 Z30\nG55 G20\nF10\nG1 X1 Y1 Z1\nG92 X0\nG1 X1\nG43.1 Z0.5\n"
       "G1 Z0\nG2 X2 Y1 I0.5 J0\nM2\n"));
   const auto error = run_program(interp, machine);
   ASSERT_FALSE(error) << error->to_string();

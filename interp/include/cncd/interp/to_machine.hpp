@@ -20,16 +20,20 @@ class MachineTracker {
   // Program pose -> machine pose with the current offsets and units.
   Pose machine_pose(const Pose& program) const;
 
-  // Last SET_FEED_RATE in machine units per minute (units per revolution under G95).
-  double feed_per_minute() const { return feed_ * length_factor(); }
+  // Last SET_FEED_RATE in machine units per minute (units per revolution under G95),
+  // converted with the program units in force when it was set.
+  double feed_per_minute() const { return feed_; }
   Units program_units() const { return program_units_; }
   Units machine_units() const { return machine_units_; }
   // Program units -> machine units.
   double length_factor() const;
 
  private:
+  Pose to_machine_units(const Pose& program) const;
+
   Units machine_units_;
   Units program_units_ = Units::mm;
+  // Offsets and feed in machine units.
   Pose g5x_{};
   Pose g92_{};
   Pose tool_{};
