@@ -8,19 +8,65 @@
 namespace cncd::motion {
 namespace {
 
-// Fastest speed from which a stop at deceleration `a` in steps of `dt` still ends within
-// `distance`: the discrete counterpart of sqrt(2 a d), so velocity changes by at most a*dt
-// per period all the way to rest.
-double stopping_velocity(double distance, double a, double dt) noexcept {
-  if (distance <= 0) return 0;
-  const double half = 0.5 * a * dt;
-  return -half + std::sqrt(half * half + 2.0 * a * distance);
-}
-
-// One period of a rest-to-rest profile toward `remaining`, limited by `v_max`, `a`.
-double next_velocity(double v, double remaining, double v_max, double a, double dt) noexcept {
-  double next = std::min({v_max, stopping_velocity(remaining, a, dt), v + a * dt});
-  return std::max({next, v - a * dt, 0.0});
+// Advances (s, v) along the time-optimal profile that comes to rest exactly at `length`,
+// limited by speed `v_max` (0 = come to a stop and hold) and acceleration `a`, for up to `dt`
+// seconds. The profile is piecewise constant acceleration, so positions sampled from it at any
+// times have second differences within `a`. Returns true when the end is reached; `dt` is then
+// the time left over. RT-safe.
+bool advance_profile(double& s, double& v, double length, double v_max, double a,
+                     double& dt) noexcept {
+  for (int phase = 0; phase < 8 && dt > 0; ++phase) {
+    const double d = length - s;
+    if (d <= 1e-12) {
+      s = length;
+      v = 0;
+      return true;
+    }
+    const double stop_sq = 2.0 * a * d;
+    if (v * v >= stop_sq - 1e-9 * (1.0 + v * v)) {
+      // On the braking curve: brake to rest exactly at the end.
+      if (v <= 0) {
+        s = length;
+        return true;
+      }
+      const double brake = v * v / (2.0 * d);
+      const double t_stop = v / brake;
+      if (t_stop <= dt) {
+        s = length;
+        v = 0;
+        dt -= t_stop;
+        return true;
+      }
+      s += v * dt - 0.5 * brake * dt * dt;
+      v -= brake * dt;
+      dt = 0;
+      return false;
+    }
+    double accel;
+    double duration;
+    if (v > v_max + 1e-12) {
+      accel = -a;  // slow down to the (lowered) limit
+      duration = (v - v_max) / a;
+    } else {
+      const double peak = std::sqrt(0.5 * (stop_sq + v * v));
+      const double target = std::min(v_max, peak);
+      if (target > v + 1e-12) {
+        accel = a;
+        duration = (target - v) / a;
+      } else if (v <= 0) {
+        return false;  // holding at rest
+      } else {
+        accel = 0;  // cruise until the braking curve
+        duration = (d - v * v / (2.0 * a)) / v;
+      }
+    }
+    const double step = std::min(std::max(duration, 0.0), dt);
+    s += v * step + 0.5 * accel * step * step;
+    v = std::max(0.0, v + accel * step);
+    dt -= step;
+    if (s > length) s = length;
+  }
+  return false;
 }
 
 }  // namespace
@@ -171,7 +217,9 @@ void ServoLoop::start_home_sequence() noexcept {
     auto& h = homing_[static_cast<std::size_t>(j)];
     joint_cmd_[static_cast<std::size_t>(j)] = joint.home_offset;
     h.active = true;
+    h.start = joint.home_offset;
     h.target = joint.home;
+    h.traveled = 0;
     h.velocity = 0;
     h.max_velocity = joint.home_final_vel > 0 ? std::min(joint.home_final_vel, joint.max_velocity)
                                               : joint.max_velocity;
@@ -186,16 +234,15 @@ void ServoLoop::advance_homing(double dt) noexcept {
     auto& h = homing_[static_cast<std::size_t>(j)];
     if (!h.active) continue;
     double& pos = joint_cmd_[static_cast<std::size_t>(j)];
-    const double remaining = std::abs(h.target - pos);
-    h.velocity = next_velocity(h.velocity, remaining, h.max_velocity, h.max_acceleration, dt);
-    const double step = h.velocity * dt;
-    if (step >= remaining) {
+    double time = dt;
+    const double length = std::abs(h.target - h.start);
+    if (advance_profile(h.traveled, h.velocity, length, h.max_velocity, h.max_acceleration, time)) {
       pos = h.target;
       h = JointMotion{};
       status_.homed[static_cast<std::size_t>(j)] = true;
       home_pending_ &= ~(1u << j);
     } else {
-      pos += h.target > pos ? step : -step;
+      pos = h.start + (h.target > h.start ? h.traveled : -h.traveled);
       sequence_done = false;
     }
   }
@@ -222,59 +269,50 @@ void ServoLoop::sync_axes_from_joints() noexcept {
 }
 
 void ServoLoop::advance_path(double dt) noexcept {
-  if (!has_active_) {
-    if (abort_requested_) {
-      flush_queue();
-      status_.motion = MotionState::idle;
-      return;
-    }
-    if (!segments_.pop(active_)) {
-      status_.motion = pause_requested_ ? MotionState::paused : MotionState::idle;
-      status_.velocity = 0;
-      return;
-    }
-    has_active_ = true;
-    path_s_ = 0;
-    path_v_ = 0;
-    dwell_elapsed_s_ = 0;
-  }
-  status_.line = active_.line;
   const bool holding = pause_requested_ || abort_requested_;
-  bool done = false;
-  if (active_.kind == Segment::Kind::dwell) {
-    if (abort_requested_) {
-      done = true;
-    } else if (!pause_requested_) {
-      dwell_elapsed_s_ += dt;
-      done = dwell_elapsed_s_ + 1e-12 >= active_.dwell_s;
+  // A period may finish one move and go on with the next: the profile's leftover time is
+  // spent on the following segment, so short moves are not slowed to one a period.
+  while (dt > 0) {
+    if (!has_active_) {
+      if (abort_requested_ || !segments_.pop(active_)) break;
+      has_active_ = true;
+      path_s_ = 0;
+      path_v_ = 0;
+      dwell_elapsed_s_ = 0;
     }
-    path_v_ = 0;
-  } else {
-    const double remaining = active_.length - path_s_;
-    const double v_max = holding ? 0.0 : active_.max_velocity;
-    path_v_ = next_velocity(path_v_, remaining, v_max, active_.max_acceleration, dt);
-    const double step = path_v_ * dt;
-    if (step >= remaining && !holding) {
-      path_s_ = active_.length;
-      done = true;
+    status_.line = active_.line;
+    bool done;
+    if (active_.kind == Segment::Kind::dwell) {
+      if (abort_requested_) {
+        done = true;
+      } else if (pause_requested_) {
+        done = false;
+        dt = 0;
+      } else {
+        const double left = active_.dwell_s - dwell_elapsed_s_;
+        done = left <= dt + 1e-12;
+        dwell_elapsed_s_ += done ? left : dt;
+        dt = done ? std::max(0.0, dt - left) : 0;
+      }
     } else {
-      path_s_ += std::min(step, remaining);
+      done = advance_profile(path_s_, path_v_, active_.length, holding ? 0.0 : active_.max_velocity,
+                             active_.max_acceleration, dt);
+      axis_pose_ = done ? active_.end : active_.point_at(path_s_);
     }
-    axis_pose_ = active_.point_at(path_s_);
-    if (done) axis_pose_ = active_.end;
-  }
-  status_.velocity = path_v_;
-  if (done) {
+    if (!done) break;
     has_active_ = false;
     path_v_ = 0;
     ++status_.segments_done;
   }
+  status_.velocity = path_v_;
   if (abort_requested_ && path_v_ == 0) {
     flush_queue();
     status_.motion = MotionState::idle;
     return;
   }
-  if (pause_requested_) {
+  if (!has_active_ && segments_.size() == 0) {
+    status_.motion = MotionState::idle;
+  } else if (pause_requested_) {
     status_.motion = path_v_ == 0 ? MotionState::paused : MotionState::pausing;
   } else {
     status_.motion = abort_requested_ ? MotionState::stopping : MotionState::moving;

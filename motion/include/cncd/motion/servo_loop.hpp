@@ -57,7 +57,9 @@ class ServoLoop {
  private:
   struct JointMotion {  // homing move of one joint
     bool active = false;
+    double start = 0;
     double target = 0;
+    double traveled = 0;  // distance covered from start
     double velocity = 0;
     double max_velocity = 0;
     double max_acceleration = 0;

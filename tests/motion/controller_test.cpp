@@ -1,0 +1,80 @@
+// MotionController with its real servo thread and clock.
+#include <chrono>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "cncd/motion/controller.hpp"
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using motion::MachineState;
+using Result = motion::MotionController::EnqueueResult;
+
+template <typename Predicate>
+bool wait_for(Predicate done, std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return false;
+}
+
+TEST(MotionController, RunsAMoveOnItsServoThread) {
+  const auto config = small_mill();
+  motion::MotionController motion(config);
+  ASSERT_EQ(motion.start(), "");
+  EXPECT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::refused);
+  EXPECT_EQ(motion.enqueue_error(), "machine is not on");
+  motion.reset_estop();
+  motion.machine_on();
+  // Commands are applied before they return.
+  EXPECT_EQ(motion.status().machine, MachineState::on);
+  motion.home(0xFFFFFFFFu);
+  ASSERT_TRUE(wait_for([&] {
+    const auto s = motion.status();
+    return s.homed[0] && s.homed[1] && s.homed[2] && s.motion == motion::MotionState::idle;
+  }));
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 5, 2, -1, 50)), Result::queued);
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::traverse, 0, 0, 600)), Result::refused);
+  EXPECT_NE(motion.enqueue_error().find("soft limits"), std::string::npos);
+  ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; }));
+  // Feedback trails the command by a period.
+  ASSERT_TRUE(wait_for([&] { return motion.status().actual[0] == 5; }));
+  const auto s = motion.status();
+  EXPECT_EQ(s.commanded[0], 5);
+  EXPECT_EQ(s.commanded[1], 2);
+  EXPECT_EQ(s.commanded[2], -1);
+  EXPECT_EQ(s.actual[0], 5);
+  EXPECT_GT(s.rt.cycles, 10u);
+  motion.stop();
+  motion.stop();  // idempotent
+}
+
+TEST(MotionController, NextMoveStartsWhereAnAbortLeftTheMachine) {
+  const auto config = small_mill();
+  motion::MotionController motion(config);
+  ASSERT_EQ(motion.start(), "");
+  motion.reset_estop();
+  motion.machine_on();
+  motion.home(0xFFFFFFFFu);
+  ASSERT_TRUE(wait_for([&] { return motion.status().homed[2]; }));
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 100, 0, 0, 50)), Result::queued);
+  ASSERT_TRUE(wait_for([&] { return motion.status().commanded[0] > 5; }));
+  motion.abort();
+  ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; }));
+  ASSERT_TRUE(wait_for([&] { return motion.status().motion == motion::MotionState::idle; }));
+  const double stopped_at = motion.status().commanded[0];
+  EXPECT_LT(stopped_at, 100);
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, stopped_at, 10, 0, 50)),
+            Result::queued);
+  ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 2; }));
+  EXPECT_EQ(motion.status().commanded[0], stopped_at);
+  EXPECT_EQ(motion.status().commanded[1], 10);
+}
+
+}  // namespace
+}  // namespace cncd::test

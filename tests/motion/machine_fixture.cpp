@@ -1,0 +1,94 @@
+#include "machine_fixture.hpp"
+
+#include <gtest/gtest.h>
+
+namespace cncd::test {
+
+config::MachineConfig small_mill() {
+  config::MachineConfig c;
+  c.servo_period_ns = 1'000'000;
+  c.coordinates = "XYZ";
+  c.joint_count = 3;
+  c.max_linear_velocity = 250;
+  const double vmax[3] = {200, 200, 100};
+  const double amax[3] = {2000, 2000, 1000};
+  for (int i = 0; i < 3; ++i) {
+    auto& axis = c.axes[static_cast<std::size_t>(i)];
+    axis.present = true;
+    axis.min_limit = i == 2 ? -500 : -1000;
+    axis.max_limit = i == 2 ? 500 : 1000;
+    axis.max_velocity = vmax[i];
+    axis.max_acceleration = amax[i];
+    config::JointConfig joint;
+    joint.axis = "XYZ"[i];
+    joint.min_limit = axis.min_limit;
+    joint.max_limit = axis.max_limit;
+    joint.max_velocity = vmax[i];
+    joint.max_acceleration = amax[i];
+    joint.ferror = 1;
+    joint.min_ferror = 0.5;
+    joint.home_sequence = 0;
+    c.joints.push_back(joint);
+  }
+  return c;
+}
+
+VirtualMachine::VirtualMachine(const config::MachineConfig& config)
+    : config_(config), sim_(std::make_unique<drivers::SimDriver>()), planner_(config_) {
+  std::vector<int> joints;
+  for (std::size_t j = 0; j < config_.joints.size(); ++j)
+    joints.push_back(static_cast<int>(j));
+  EXPECT_EQ(sim_->configure(config_, joints), "");
+  loop_ = std::make_unique<motion::ServoLoop>(
+      config_, std::vector<motion::DriverBinding>{{sim_.get(), joints}});
+}
+
+void VirtualMachine::command(motion::Command::Kind kind, std::uint32_t mask) {
+  ASSERT_TRUE(loop_->commands().push(motion::Command{kind, mask}));
+  loop_->cycle(0);
+}
+
+void VirtualMachine::ready() {
+  command(motion::Command::Kind::reset_estop);
+  command(motion::Command::Kind::on);
+  command(motion::Command::Kind::home, 0xFFFFFFFFu);
+  run_until_idle();
+  trajectory_.clear();
+  plan_end_ = status().commanded;
+}
+
+void VirtualMachine::queue(const motion::Move& move) {
+  std::string error;
+  const auto segment = planner_.plan(move, plan_end_, true, error);
+  ASSERT_TRUE(segment.has_value()) << error;
+  ASSERT_TRUE(loop_->segments().push(*segment));
+  plan_end_ = segment->end;
+}
+
+void VirtualMachine::cycles(int n) {
+  for (int i = 0; i < n; ++i) {
+    loop_->cycle(0);
+    trajectory_.push_back(loop_->status().commanded);
+  }
+}
+
+int VirtualMachine::run_until_idle(int max_cycles) {
+  for (int i = 0; i < max_cycles; ++i) {
+    loop_->cycle(0);
+    const auto s = loop_->status();
+    trajectory_.push_back(s.commanded);
+    if (s.motion == motion::MotionState::idle && s.queued == 0) return i + 1;
+  }
+  ADD_FAILURE() << "motion did not finish within " << max_cycles << " cycles";
+  return max_cycles;
+}
+
+motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed) {
+  motion::Move m;
+  m.kind = kind;
+  m.end = {x, y, z, 0, 0, 0, 0, 0, 0};
+  m.feed = feed;
+  return m;
+}
+
+}  // namespace cncd::test

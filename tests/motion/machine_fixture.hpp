@@ -1,0 +1,49 @@
+// A small fast mill built by hand, and a servo loop run in virtual time with its trajectory
+// recorded, for the motion tests.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/sim_driver.hpp"
+#include "cncd/motion/planner.hpp"
+#include "cncd/motion/servo_loop.hpp"
+
+namespace cncd::test {
+
+// X/Y 200 mm/s and 2000 mm/s², Z 100 mm/s and 1000 mm/s², limits ±1000 (Z -500..500).
+config::MachineConfig small_mill();
+
+class VirtualMachine {
+ public:
+  explicit VirtualMachine(const config::MachineConfig& config);
+  // Machine on and homed.
+  void ready();
+  // Plans and queues; fails the test when the planner refuses.
+  void queue(const motion::Move& move);
+  // Runs cycles until the loop is idle with an empty queue, or `max_cycles`; records every
+  // period's commanded pose. Returns the cycles run.
+  int run_until_idle(int max_cycles = 2'000'000);
+  void cycles(int n);
+  void command(motion::Command::Kind kind, std::uint32_t mask = 0);
+  motion::Status status() const { return loop_->status(); }
+  const std::vector<motion::AxisPose>& trajectory() const { return trajectory_; }
+  void clear_trajectory() { trajectory_.clear(); }
+  drivers::SimDriver& sim() { return *sim_; }
+  motion::ServoLoop& loop() { return *loop_; }
+  const config::MachineConfig& config() const { return config_; }
+  double period_s() const { return static_cast<double>(config_.servo_period_ns) * 1e-9; }
+
+ private:
+  config::MachineConfig config_;
+  std::unique_ptr<drivers::SimDriver> sim_;
+  std::unique_ptr<motion::ServoLoop> loop_;
+  motion::Planner planner_;
+  motion::AxisPose plan_end_{};
+  std::vector<motion::AxisPose> trajectory_;
+};
+
+motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed = 0);
+
+}  // namespace cncd::test

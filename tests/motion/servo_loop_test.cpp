@@ -1,0 +1,186 @@
+// The servo loop in virtual time: estop, pause/resume, abort, faults, homing, dwell.
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using motion::Command;
+using motion::MachineState;
+using motion::MotionState;
+using motion::Move;
+
+TEST(ServoLoop, StartsInEstopAndOnNeedsReset) {
+  VirtualMachine m(small_mill());
+  m.cycles(1);
+  EXPECT_EQ(m.status().machine, MachineState::estop);
+  m.command(Command::Kind::on);
+  EXPECT_EQ(m.status().machine, MachineState::estop);
+  m.command(Command::Kind::reset_estop);
+  EXPECT_EQ(m.status().machine, MachineState::off);
+  m.command(Command::Kind::on);
+  EXPECT_EQ(m.status().machine, MachineState::on);
+}
+
+TEST(ServoLoop, EstopStopsWithinOnePeriodAndFlushes) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
+  m.queue(line_to(Move::Kind::feed, 100, 100, 0, 100));
+  m.cycles(300);
+  m.command(Command::Kind::estop);
+  const auto stopped = m.status();
+  EXPECT_EQ(stopped.machine, MachineState::estop);
+  EXPECT_EQ(stopped.queued, 0u);
+  EXPECT_EQ(stopped.segments_done, 2u);
+  m.cycles(100);
+  EXPECT_EQ(m.status().commanded[0], stopped.commanded[0]);
+  EXPECT_GT(stopped.commanded[0], 0);
+  EXPECT_LT(stopped.commanded[0], 100);
+}
+
+TEST(ServoLoop, PauseHoldsOnThePathAndResumeFinishes) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 100, 50, 0, 100));
+  m.cycles(400);
+  m.command(Command::Kind::pause);
+  m.cycles(200);  // 100 mm/s stops in 0.05 s at 2000 mm/s^2 (along the path, less)
+  const auto held = m.status();
+  EXPECT_EQ(held.motion, MotionState::paused);
+  EXPECT_EQ(held.velocity, 0);
+  m.cycles(500);
+  EXPECT_EQ(m.status().commanded, held.commanded);
+  // Still on the programmed line y = x / 2.
+  EXPECT_NEAR(held.commanded[1], held.commanded[0] / 2, 1e-9);
+  m.command(Command::Kind::resume);
+  m.run_until_idle();
+  EXPECT_EQ(m.status().commanded[0], 100);
+  EXPECT_EQ(m.status().commanded[1], 50);
+}
+
+TEST(ServoLoop, AbortStopsUnderControlAndFlushes) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
+  m.queue(line_to(Move::Kind::feed, 0, 0, 0, 100));
+  m.cycles(500);
+  m.command(Command::Kind::abort);
+  m.run_until_idle(1000);
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::on);
+  EXPECT_EQ(s.queued, 0u);
+  EXPECT_EQ(s.segments_done, 2u);
+  EXPECT_GT(s.commanded[0], 40);
+  EXPECT_LT(s.commanded[0], 60);
+  // The machine takes new moves afterwards.
+  m.queue(line_to(Move::Kind::traverse, 0, 0, 0));
+  m.run_until_idle();
+  EXPECT_EQ(m.status().commanded[0], 0);
+}
+
+TEST(ServoLoop, FollowingErrorLatchesAFault) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.sim().set_lag(0.05);  // 50 ms lag: at 100 mm/s the error grows to ~5 mm
+  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
+  m.run_until_idle();
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::off);
+  EXPECT_TRUE(s.joint_fault[0]);
+  EXPECT_NE(std::strstr(s.fault_reason, "following error"), nullptr) << s.fault_reason;
+  // The fault was posted for the non-RT side exactly once.
+  motion::Event event;
+  int faults = 0;
+  while (m.loop().events().pop(event))
+    faults += event.level == motion::Event::Level::fault;
+  EXPECT_EQ(faults, 1);
+  // Drives off: the command follows the (lagging) feedback, and stays after the fault.
+  m.sim().set_lag(0);
+  m.command(Command::Kind::on);
+  EXPECT_EQ(m.status().machine, MachineState::on);
+  EXPECT_EQ(m.status().fault_reason[0], '\0');
+}
+
+TEST(ServoLoop, DriveFaultAndStaleFeedbackLatch) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.sim().set_fault(2, true);
+  m.cycles(2);
+  EXPECT_EQ(m.status().machine, MachineState::off);
+  EXPECT_NE(std::strstr(m.status().fault_reason, "joint 2: drive fault"), nullptr);
+  m.sim().set_fault(2, false);
+  m.command(Command::Kind::on);
+  m.sim().set_stale(1, true);
+  m.cycles(2);
+  EXPECT_NE(std::strstr(m.status().fault_reason, "joint 1: feedback is stale"), nullptr);
+}
+
+TEST(ServoLoop, EstopInputLatches) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.sim().set_estop_input(true);
+  m.cycles(1);
+  EXPECT_EQ(m.status().machine, MachineState::estop);
+  m.sim().set_estop_input(false);
+  m.command(Command::Kind::reset_estop);
+  EXPECT_EQ(m.status().machine, MachineState::off);
+}
+
+TEST(ServoLoop, HomesInSequenceToHome) {
+  auto config = small_mill();
+  config.joints[2].home_sequence = 0;  // Z first
+  config.joints[0].home_sequence = 1;
+  config.joints[1].home_sequence = 1;
+  config.joints[2].home_offset = 10;  // Z's position becomes 10, then it moves to HOME = 5
+  config.joints[2].home = 5;
+  VirtualMachine m(config);
+  m.command(Command::Kind::reset_estop);
+  m.command(Command::Kind::on);
+  m.command(Command::Kind::home, 0xFFFFFFFFu);
+  EXPECT_TRUE(m.status().motion == MotionState::homing);
+  EXPECT_FALSE(m.status().homed[0]);
+  m.cycles(5);
+  EXPECT_FALSE(m.status().homed[0]);  // X waits for Z's sequence
+  m.run_until_idle();
+  const auto s = m.status();
+  EXPECT_TRUE(s.homed[0] && s.homed[1] && s.homed[2]);
+  EXPECT_EQ(s.commanded[2], 5);
+  EXPECT_EQ(s.joint_commanded[2], 5);
+  EXPECT_EQ(s.actual[2], 5);
+}
+
+TEST(ServoLoop, SwitchHomingWithoutSwitchIsAFault) {
+  auto config = small_mill();
+  config.joints[0].home_search_vel = 10;
+  VirtualMachine m(config);
+  m.command(Command::Kind::reset_estop);
+  m.command(Command::Kind::on);
+  m.command(Command::Kind::home, 1);
+  EXPECT_NE(std::strstr(m.status().fault_reason, "switch homing"), nullptr)
+      << m.status().fault_reason;
+}
+
+TEST(ServoLoop, DwellTakesItsTime) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  Move dwell;
+  dwell.kind = Move::Kind::dwell;
+  dwell.dwell_s = 0.25;
+  m.queue(dwell);
+  EXPECT_EQ(m.run_until_idle(), 250);  // 0.25 s at 1 ms a period
+}
+
+TEST(ServoLoop, StatisticsCountOverruns) {
+  VirtualMachine m(small_mill());
+  m.cycles(10);
+  EXPECT_EQ(m.status().rt.overruns, 0u);
+  EXPECT_EQ(m.status().rt.cycles, 10u);
+}
+
+}  // namespace
+}  // namespace cncd::test
