@@ -81,8 +81,13 @@ void print_status(const json& s) {
   std::printf("actual    %s\n", axes_text(s["position"]["actual"]).c_str());
   const auto& p = s["program"];
   if (!p.value("path", "").empty()) {
-    std::printf("program   %s  line %d of %llu", p.value("path", "").c_str(), p.value("line", 0),
-                static_cast<unsigned long long>(p.value("total_lines", 0ULL)));
+    const auto total = static_cast<unsigned long long>(p.value("total_lines", 0ULL));
+    if (s.value("exec", "") == "idle") {
+      std::printf("program   %s  (%llu lines)", p.value("path", "").c_str(), total);
+    } else {
+      std::printf("program   %s  line %d of %llu", p.value("path", "").c_str(), p.value("line", 0),
+                  total);
+    }
     if (!p.value("result", "").empty())
       std::printf("  last run: %s", p.value("result", "").c_str());
     std::printf("\n");
