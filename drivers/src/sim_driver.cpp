@@ -30,8 +30,8 @@ void SimDriver::read(JointFeedback* feedback, int count) noexcept {
     if (!feedback[i].stale) position_[k] += (commanded_[k] - position_[k]) * alpha;
     feedback[i].position = position_[k];
     feedback[i].home_switch = false;
-    feedback[i].min_limit = false;
-    feedback[i].max_limit = false;
+    feedback[i].min_limit = min_limit_[k].load(std::memory_order_relaxed);
+    feedback[i].max_limit = max_limit_[k].load(std::memory_order_relaxed);
   }
 }
 
@@ -41,6 +41,12 @@ void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
 
 void SimDriver::set_fault(int index, bool fault) noexcept {
   if (index >= 0 && index < kMaxJoints) fault_[static_cast<std::size_t>(index)].store(fault);
+}
+
+void SimDriver::set_limit(int index, bool min_limit, bool max_limit) noexcept {
+  if (index < 0 || index >= kMaxJoints) return;
+  min_limit_[static_cast<std::size_t>(index)].store(min_limit);
+  max_limit_[static_cast<std::size_t>(index)].store(max_limit);
 }
 
 void SimDriver::set_stale(int index, bool stale) noexcept {

@@ -360,6 +360,16 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
       latch_fault(text);
       break;
     }
+    // A tripped limit switch stops everything, except while homing a joint configured to
+    // ignore its limits (its home switch shares the limit input).
+    const bool ignore_limits = homing_[k].active && config_.joints[k].home_ignore_limits;
+    if ((fb.min_limit || fb.max_limit) && !ignore_limits) {
+      status_.joint_fault[k] = true;
+      std::snprintf(text, sizeof text, "joint %d: %s limit switch tripped", j,
+                    fb.min_limit ? "minimum" : "maximum");
+      latch_fault(text);
+      break;
+    }
     const auto& joint = config_.joints[k];
     const double speed = std::abs(commands_out_[k].velocity);
     const double limit =

@@ -120,6 +120,20 @@ TEST(ServoLoop, DriveFaultAndStaleFeedbackLatch) {
   EXPECT_NE(std::strstr(m.status().fault_reason, "joint 1: feedback is stale"), nullptr);
 }
 
+TEST(ServoLoop, LimitSwitchLatches) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
+  m.cycles(100);
+  m.sim().set_limit(0, false, true);
+  m.cycles(1);
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::off);
+  EXPECT_EQ(s.queued, 0u);
+  EXPECT_NE(std::strstr(s.fault_reason, "joint 0: maximum limit switch tripped"), nullptr)
+      << s.fault_reason;
+}
+
 TEST(ServoLoop, EstopInputLatches) {
   VirtualMachine m(small_mill());
   m.ready();

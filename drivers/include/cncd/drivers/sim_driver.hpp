@@ -26,6 +26,7 @@ class SimDriver final : public Driver {
   // Any thread. Injected faults for the joint at `index` (position in configure()'s list).
   void set_fault(int index, bool fault) noexcept;
   void set_stale(int index, bool stale) noexcept;
+  void set_limit(int index, bool min_limit, bool max_limit) noexcept;
   void set_estop_input(bool asserted) noexcept { estop_.store(asserted); }
 
  private:
@@ -34,6 +35,8 @@ class SimDriver final : public Driver {
   std::atomic<bool> estop_{false};
   std::array<std::atomic<bool>, kMaxJoints> fault_{};
   std::array<std::atomic<bool>, kMaxJoints> stale_{};
+  std::array<std::atomic<bool>, kMaxJoints> min_limit_{};
+  std::array<std::atomic<bool>, kMaxJoints> max_limit_{};
   std::array<double, kMaxJoints> commanded_{};
   std::array<double, kMaxJoints> position_{};
   bool primed_ = false;
