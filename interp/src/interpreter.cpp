@@ -36,7 +36,10 @@ void Interpreter::Impl::reset_modal_state() {
   cycle_ = CycleState{};
   const int system = static_cast<int>(parameters_.get(5220));
   modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
+  parameters_.set(5220, modal_.coord_system);
   load_coord_system(modal_.coord_system);
+  // The G92 offset comes back from the parameters only while it is enabled (#5210).
+  g92_offset_ = parameters_.get(5210) != 0.0 ? read_offset_parameters(kG92Base) : Pose{};
   control_.clear();
   calls_.clear();
   subs_.clear();

@@ -62,7 +62,6 @@ void Interpreter::Impl::load_coord_system(int index) {
   const int base = kG5xBase + 20 * (index - 1);
   g5x_offset_ = read_offset_parameters(base);
   rotation_deg_ = parameters_.get(base + 9);
-  g92_offset_ = read_offset_parameters(kG92Base);
 }
 
 void Interpreter::Impl::emit_g5x() {

@@ -146,13 +146,15 @@ void Interpreter::Impl::do_home(int code) {
     intermediate[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
   }
   straight(CanonKind::straight_traverse, intermediate);
-  Pose home = program_to_machine(pos_);
-  const Pose stored = read_offset_parameters(base);
+  // The stored point is in machine coordinates: the whole point is taken to program
+  // coordinates, then only the named axes (or all) move there.
+  const Pose home = machine_to_program(read_offset_parameters(base));
+  Pose end = pos_;
   for (int axis = 0; axis < kAxes; ++axis) {
     if (any && !block_.has(kAxisLetters[axis])) continue;
-    home[static_cast<std::size_t>(axis)] = stored[static_cast<std::size_t>(axis)];
+    end[static_cast<std::size_t>(axis)] = home[static_cast<std::size_t>(axis)];
   }
-  straight(CanonKind::straight_traverse, machine_to_program(home));
+  straight(CanonKind::straight_traverse, end);
 }
 
 }  // namespace cncd::interp
