@@ -167,9 +167,7 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     command.ivalue = static_cast<int>(modal_.control);
     command.value = modal_.tolerance;
     emit(command);
-    if (modal_.control == MotionMode::continuous) {
-      emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
-    }
+    emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
   }
 }
 
@@ -287,6 +285,10 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
       emit_simple(CanonKind::stop_spindle_turning);
       emit_simple(CanonKind::program_stop);
       emit_simple(restart);
+      // The operator retracts by hand during the stop; LinuxCNC then takes the tool to be at
+      // the clear height.
+      pos_[g.c] = g.clear;
+      current_c = g.clear;
       break;
     case 890:
       feed(g.bottom);
