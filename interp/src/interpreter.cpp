@@ -163,6 +163,15 @@ void Interpreter::Impl::run_startup_code() {
 void Interpreter::Impl::run_line() {
   parser_.parse(line_, block_);
   if (block_.block_delete && options_.block_delete) return;
+  // The tool (#5400-#5413) and position (#5420-#5428) parameters and the predefined names
+  // belong to the interpreter.
+  for (const auto& assignment : block_.numbered_assignments) {
+    if (assignment.first >= 5400 && assignment.first <= 5428) fail("Parameter is readonly");
+  }
+  for (int i = 0; i < block_.named_assignment_count; ++i) {
+    const std::string& name = block_.named_assignments[static_cast<std::size_t>(i)].first;
+    if (predefined_parameter(name)) fail("Cannot assign to read-only parameter #<" + name + ">");
+  }
   for (const auto& [number, value] : block_.numbered_assignments)
     parameters_.set(number, value);
   for (int i = 0; i < block_.named_assignment_count; ++i) {
