@@ -204,9 +204,22 @@ std::string format_rs274(const CanonCommand& c, int axes) {
     case CanonKind::message:
     case CanonKind::debug_message:
       return "MESSAGE(\"" + c.text + "\")";
-    default:
-      out = "UNKNOWN_COMMAND(" + std::to_string(static_cast<int>(c.kind));
-      break;
+    case CanonKind::start_spindle_clockwise:
+    case CanonKind::start_spindle_counterclockwise:
+    case CanonKind::stop_spindle_turning:
+    case CanonKind::mist_on:
+    case CanonKind::mist_off:
+    case CanonKind::flood_on:
+    case CanonKind::flood_off:
+    case CanonKind::program_stop:
+    case CanonKind::optional_program_stop:
+    case CanonKind::program_end:
+    case CanonKind::pallet_shuttle:
+    case CanonKind::on_reset:
+    case CanonKind::finish:
+    case CanonKind::start_change:
+    case CanonKind::set_feed_reference:
+      return simple_name(c.kind);  // handled above; listed so the compiler checks coverage
   }
   out += ')';
   return out;
