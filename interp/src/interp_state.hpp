@@ -209,6 +209,7 @@ struct Interpreter::Impl {
   CanonSink* sink_ = nullptr;
   CanonCommand command_;
   std::optional<InterpError> error_;
+  std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
   int current_line_ = 0;
   bool preamble_done_ = false;
   bool ended_ = false;

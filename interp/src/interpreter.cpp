@@ -19,12 +19,12 @@ Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
   parameters_.set_predefined([this](std::string_view name) { return predefined_parameter(name); });
   if (!options_.parameter_file.empty()) {
     if (auto problem = parameters_.load(options_.parameter_file)) {
-      error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
+      config_error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
     }
   }
   if (!options_.tool_table.empty()) {
     if (auto problem = tools_.load(options_.tool_table)) {
-      error_ = InterpError{options_.tool_table.string(), 0, 0, *problem};
+      config_error_ = InterpError{options_.tool_table.string(), 0, 0, *problem};
     }
   }
   reset_modal_state();
@@ -196,6 +196,7 @@ void Interpreter::set_position(const Pose& position) {
 
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
   impl_->sources_.clear();
+  impl_->error_ = impl_->config_error_;  // a new program starts without the last one's error
   impl_->program_name_ = program.string();
   LineSource source;
   if (!source.open_file(program)) {
@@ -210,6 +211,7 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
 
 std::optional<InterpError> Interpreter::open_string(std::string text, std::string name) {
   impl_->sources_.clear();
+  impl_->error_ = impl_->config_error_;
   impl_->program_name_ = name;
   LineSource source;
   source.open_text(std::move(text), std::move(name));

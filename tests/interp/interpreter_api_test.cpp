@@ -54,6 +54,29 @@ TEST(InterpreterApi, ErrorsCarryFileLineAndColumnAndStick) {
   EXPECT_EQ(interp.step(sink), Interpreter::Step::error);
 }
 
+TEST(InterpreterApi, ANewProgramStartsAfterAnErrorWithPositionKept) {
+  Interpreter interp;
+  NullSink sink;
+  ASSERT_FALSE(interp.open_string("G0 X5\nG1 X1\nM2\n"));
+  ASSERT_TRUE(run_program(interp, sink));  // no feed rate
+  ASSERT_FALSE(interp.open_string("G91 G0 X1\nM2\n"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  EXPECT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(6.0000, 0.0000, 0.0000"), std::string::npos);
+}
+
+TEST(InterpreterApi, UnreadableToolTableIsReportedAtOpen) {
+  const auto table = temp_file("bad.tbl", "T1 P1 Zabc\n");
+  InterpOptions options;
+  options.tool_table = table;
+  Interpreter interp(options);
+  const auto error = interp.open_string("M2\n");
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->message.find("bad value 'Zabc'"), std::string::npos) << error->message;
+  std::filesystem::remove(table);
+}
+
 TEST(InterpreterApi, ReadsFilesWithCrLfAndSubroutineFiles) {
   const auto sub =
       temp_file("sub.ngc", "o<cncd_square> sub\r\nG1 X#1 F100\r\no<cncd_square> endsub\r\n");
