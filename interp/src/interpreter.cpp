@@ -194,6 +194,15 @@ void Interpreter::set_position(const Pose& position) {
   impl_->pos_ = position;
 }
 
+void Interpreter::set_machine_position(const Pose& machine) {
+  Pose program = machine;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    if (is_linear_axis(static_cast<int>(axis)))
+      program[axis] = impl_->to_program_units(program[axis]);
+  }
+  impl_->pos_ = impl_->machine_to_program(program);
+}
+
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
   impl_->sources_.clear();
   impl_->error_ = impl_->config_error_;  // a new program starts without the last one's error

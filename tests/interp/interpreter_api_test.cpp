@@ -139,6 +139,22 @@ TEST(InterpreterApi, ParametersPersistThroughTheVarFile) {
   std::filesystem::remove(var);
 }
 
+TEST(InterpreterApi, MachinePositionIsSeenThroughTheOffsets) {
+  // G54 X offset 10 mm on an inch program: machine X 35.4 mm is program X 1 inch.
+  const auto vars = temp_file("machine_pos.var", "5221\t10.000000\n");
+  InterpOptions options;
+  options.parameter_file = vars;
+  Interpreter interp(options);
+  ASSERT_FALSE(interp.open_string("G20 G91 G0 X1\nM2\n", "t.ngc"));
+  interp.set_machine_position({35.4, 0, 0, 0, 0, 0, 0, 0, 0});
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(2.0000, 0.0000, 0.0000"), std::string::npos)
+      << out.str();
+  std::filesystem::remove(vars);
+}
+
 TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
   for (const char* line :
        {"G41 D1",     "G42.1 D1", "G33 Z-1 K1", "G33.1 Z-1 K1", "G38.3 Z-1 F1", "G5 X1 I1 J1 P1 Q1",

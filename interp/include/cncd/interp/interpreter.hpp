@@ -45,6 +45,10 @@ class Interpreter {
   // Tells the interpreter where the machine is, in the machine's units and program
   // coordinates of the current coordinate system (what a machinist sees on the DRO).
   void set_position(const Pose& position);
+  // Tells the interpreter where the machine is in machine coordinates and the machine's units
+  // (what the servo loop reports); the interpreter applies its own offsets and units. Call it
+  // after open(), whose reset may change them.
+  void set_machine_position(const Pose& machine);
 
   // Opens a program file and resets to the start-of-program modal state.
   std::optional<InterpError> open(const std::filesystem::path& program);
