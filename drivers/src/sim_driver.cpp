@@ -7,7 +7,17 @@ namespace cncd::drivers {
 std::string SimDriver::configure(const config::MachineConfig& machine,
                                  const std::vector<int>& joints) {
   if (joints.size() > static_cast<std::size_t>(kMaxJoints)) return "too many joints for one driver";
+  if (machine.servo_period_ns <= 0) return "the servo period must be positive";
   period_s_ = static_cast<double>(machine.servo_period_ns) * 1e-9;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const int j = joints[i];
+    if (j < 0 || static_cast<std::size_t>(j) >= machine.joints.size()) {
+      return "joint " + std::to_string(j) + " is not in the configuration";
+    }
+    const auto& joint = machine.joints[static_cast<std::size_t>(j)];
+    const int direction = joint.home_search_vel > 0 ? 1 : joint.home_search_vel < 0 ? -1 : 0;
+    set_home_switch(static_cast<int>(i), joint.home_offset, direction);
+  }
   return "";
 }
 
@@ -29,7 +39,10 @@ void SimDriver::read(JointFeedback* feedback, int count) noexcept {
     feedback[i].fault = fault_[k].load(std::memory_order_relaxed);
     if (!feedback[i].stale) position_[k] += (commanded_[k] - position_[k]) * alpha;
     feedback[i].position = position_[k];
-    feedback[i].home_switch = false;
+    const int direction = home_switch_[k].direction.load(std::memory_order_acquire);
+    const double at = home_switch_[k].position.load(std::memory_order_relaxed);
+    feedback[i].home_switch =
+        (direction > 0 && position_[k] >= at) || (direction < 0 && position_[k] <= at);
     feedback[i].min_limit = min_limit_[k].load(std::memory_order_relaxed);
     feedback[i].max_limit = max_limit_[k].load(std::memory_order_relaxed);
   }
@@ -40,17 +53,25 @@ void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
 }
 
 void SimDriver::set_fault(int index, bool fault) noexcept {
-  if (index >= 0 && index < kMaxJoints) fault_[static_cast<std::size_t>(index)].store(fault);
+  if (valid(index)) fault_[static_cast<std::size_t>(index)].store(fault);
+}
+
+void SimDriver::set_stale(int index, bool stale) noexcept {
+  if (valid(index)) stale_[static_cast<std::size_t>(index)].store(stale);
 }
 
 void SimDriver::set_limit(int index, bool min_limit, bool max_limit) noexcept {
-  if (index < 0 || index >= kMaxJoints) return;
+  if (!valid(index)) return;
   min_limit_[static_cast<std::size_t>(index)].store(min_limit);
   max_limit_[static_cast<std::size_t>(index)].store(max_limit);
 }
 
-void SimDriver::set_stale(int index, bool stale) noexcept {
-  if (index >= 0 && index < kMaxJoints) stale_[static_cast<std::size_t>(index)].store(stale);
+void SimDriver::set_home_switch(int index, double position, int direction) noexcept {
+  if (!valid(index)) return;
+  auto& s = home_switch_[static_cast<std::size_t>(index)];
+  // Direction last: a reader that sees the new direction also sees the new position.
+  s.position.store(position);
+  s.direction.store(direction);
 }
 
 }  // namespace cncd::drivers

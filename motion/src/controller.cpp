@@ -73,31 +73,36 @@ struct MotionController::Impl {
     }
   }
 
-  // The servo thread's body: fixed-period absolute sleeps, one cycle per period.
-  void run(bool want_realtime) {
-    bool realtime = false;
-    if (want_realtime) {
-      sched_param param{};
-      param.sched_priority = config.cncd.rt_priority;
-      realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-    }
+  // What the servo thread obtained from the OS before its first cycle.
+  struct RtSetup {
+    int sched_error = 0;     // errno of pthread_setschedparam, 0 = SCHED_FIFO granted
+    int affinity_error = 0;  // errno of pthread_setaffinity_np, 0 = pinned or not asked
+  };
+
+  // Asks for SCHED_FIFO and the configured CPU on the calling thread. Non-RT (runs once on the
+  // servo thread before its loop).
+  RtSetup setup_rt_thread() const {
+    RtSetup setup;
+    sched_param param{};
+    param.sched_priority = config.cncd.rt_priority;
+    setup.sched_error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
     if (config.cncd.rt_cpu >= 0) {
       cpu_set_t set;
       CPU_ZERO(&set);
-      CPU_SET(config.cncd.rt_cpu, &set);
-      pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+      CPU_SET(static_cast<std::size_t>(config.cncd.rt_cpu), &set);
+      setup.affinity_error = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
     }
     prefault_stack();
-    loop->set_rt_flags(realtime, locked);
-    if (want_realtime && !realtime) {
-      Event event;
-      event.level = Event::Level::warning;
-      std::snprintf(event.text, sizeof event.text,
-                    "SCHED_FIFO priority %d refused: the servo thread runs without real-time "
-                    "scheduling and its timing will suffer",
-                    config.cncd.rt_priority);
-      loop->events().push(event);
-    }
+    return setup;
+  }
+
+  // The servo thread's body: fixed-period absolute sleeps, one cycle per period.
+  void run() {
+    const RtSetup setup = setup_rt_thread();
+    loop->set_rt_flags(setup.sched_error == 0, locked);
+    rt_setup = setup;
+    setup_done.store(true, std::memory_order_release);
+
     const std::int64_t period = config.servo_period_ns;
     timespec now{};
     clock_gettime(CLOCK_MONOTONIC, &now);
@@ -115,7 +120,33 @@ struct MotionController::Impl {
     }
   }
 
+  // Waits (non-RT, bounded) for the servo thread to report its scheduling and turns what the
+  // OS refused into warnings.
+  void collect_rt_warnings() {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (!setup_done.load(std::memory_order_acquire)) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        warnings.push_back("the servo thread did not report its scheduling within 2 s");
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (rt_setup.sched_error != 0) {
+      warnings.push_back("SCHED_FIFO priority " + std::to_string(config.cncd.rt_priority) +
+                         " refused (" + std::strerror(rt_setup.sched_error) +
+                         "): the servo thread runs without real-time scheduling and its "
+                         "timing will suffer; grant CAP_SYS_NICE or LimitRTPRIO");
+    }
+    if (rt_setup.affinity_error != 0) {
+      warnings.push_back("pinning the servo thread to CPU " + std::to_string(config.cncd.rt_cpu) +
+                         " refused (" + std::strerror(rt_setup.affinity_error) +
+                         "): it runs on any CPU");
+    }
+  }
+
   bool locked = false;
+  std::atomic<bool> setup_done{false};
+  RtSetup rt_setup;  // written by the servo thread before setup_done, read after it
 };
 
 MotionController::MotionController(const config::MachineConfig& config)
@@ -134,6 +165,8 @@ std::string MotionController::start() {
     by_driver[config.joints[j].driver].push_back(static_cast<int>(j));
   }
   std::vector<DriverBinding> bindings;
+  impl_->loop.reset();
+  impl_->sim = nullptr;
   impl_->drivers.clear();
   for (const auto& [name, joints] : by_driver) {
     std::string error;
@@ -157,10 +190,15 @@ std::string MotionController::start() {
     impl_->locked = true;
   } else {
     impl_->warnings.push_back(std::string("mlockall refused (") + std::strerror(errno) +
-                              "): servo thread memory may be paged out");
+                              "): servo thread memory may be paged out; grant CAP_IPC_LOCK or "
+                              "LimitMEMLOCK=infinity");
   }
+  impl_->enqueued = 0;
+  impl_->plan_end = AxisPose{};
+  impl_->setup_done.store(false);
   impl_->running.store(true);
-  impl_->thread = std::thread([impl = impl_.get()] { impl->run(true); });
+  impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });
+  impl_->collect_rt_warnings();
   return "";
 }
 

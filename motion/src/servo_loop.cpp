@@ -5,68 +5,19 @@
 #include <cstdio>
 #include <cstring>
 
+#include "profile.hpp"
+
 namespace cncd::motion {
 namespace {
 
-// Advances (s, v) along the time-optimal profile that comes to rest exactly at `length`,
-// limited by speed `v_max` (0 = come to a stop and hold) and acceleration `a`, for up to `dt`
-// seconds. The profile is piecewise constant acceleration, so positions sampled from it at any
-// times have second differences within `a`. Returns true when the end is reached; `dt` is then
-// the time left over. RT-safe.
-bool advance_profile(double& s, double& v, double length, double v_max, double a,
-                     double& dt) noexcept {
-  for (int phase = 0; phase < 8 && dt > 0; ++phase) {
-    const double d = length - s;
-    if (d <= 1e-12) {
-      s = length;
-      v = 0;
-      return true;
-    }
-    const double stop_sq = 2.0 * a * d;
-    if (v * v >= stop_sq - 1e-9 * (1.0 + v * v)) {
-      // On the braking curve: brake to rest exactly at the end.
-      if (v <= 0) {
-        s = length;
-        return true;
-      }
-      const double brake = v * v / (2.0 * d);
-      const double t_stop = v / brake;
-      if (t_stop <= dt) {
-        s = length;
-        v = 0;
-        dt -= t_stop;
-        return true;
-      }
-      s += v * dt - 0.5 * brake * dt * dt;
-      v -= brake * dt;
-      dt = 0;
-      return false;
-    }
-    double accel;
-    double duration;
-    if (v > v_max + 1e-12) {
-      accel = -a;  // slow down to the (lowered) limit
-      duration = (v - v_max) / a;
-    } else {
-      const double peak = std::sqrt(0.5 * (stop_sq + v * v));
-      const double target = std::min(v_max, peak);
-      if (target > v + 1e-12) {
-        accel = a;
-        duration = (target - v) / a;
-      } else if (v <= 0) {
-        return false;  // holding at rest
-      } else {
-        accel = 0;  // cruise until the braking curve
-        duration = (d - v * v / (2.0 * a)) / v;
-      }
-    }
-    const double step = std::min(std::max(duration, 0.0), dt);
-    s += v * step + 0.5 * accel * step * step;
-    v = std::max(0.0, v + accel * step);
-    dt -= step;
-    if (s > length) s = length;
+std::uint32_t home_switch_joints(const std::vector<DriverBinding>& drivers) {
+  std::uint32_t mask = 0;
+  for (const auto& binding : drivers) {
+    if (!(binding.driver->capabilities() & drivers::kCapHomeSwitch)) continue;
+    for (int j : binding.joints)
+      mask |= 1u << j;
   }
-  return false;
+  return mask;
 }
 
 }  // namespace
@@ -75,10 +26,12 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
     : config_(config),
       drivers_(std::move(drivers)),
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
-      joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))) {
+      joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
+      homing_(config, period_s_, home_switch_joints(drivers_)) {
+  joint_axis_.fill(-1);
   for (int j = 0; j < joint_count_; ++j) {
-    const int axis = config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
-    joint_axis_[static_cast<std::size_t>(j)] = axis;
+    joint_axis_[static_cast<std::size_t>(j)] =
+        config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
   }
   status_.joint_count = joint_count_;
   published_.store(status_);
@@ -119,10 +72,12 @@ void ServoLoop::flush_queue() noexcept {
 
 void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
   flush_queue();
-  for (auto& h : homing_)
-    h = JointMotion{};
-  home_pending_ = 0;
-  home_sequence_ = -1;
+  homing_.stop_now();
+  // VOLATILE_HOME joints lose their home whenever the drives turn off.
+  for (int j = 0; j < joint_count_; ++j) {
+    if (config_.joints[static_cast<std::size_t>(j)].volatile_home)
+      joints_.homed[static_cast<std::size_t>(j)] = false;
+  }
   status_.machine = next;
   status_.motion = MotionState::idle;
   status_.velocity = 0;
@@ -152,34 +107,12 @@ void ServoLoop::apply(const Command& command) noexcept {
     case Command::Kind::off:
       if (status_.machine == MachineState::on) stop_now(MachineState::off, nullptr);
       break;
-    case Command::Kind::home: {
-      if (status_.machine != MachineState::on || has_active_ || home_pending_ != 0) break;
-      std::uint32_t mask = command.joint_mask;
-      if (mask == 0xFFFFFFFFu) {
-        // "Home all" homes the joints that have a HOME_SEQUENCE, or every joint when none has.
-        std::uint32_t sequenced = 0;
-        for (int j = 0; j < joint_count_; ++j) {
-          if (config_.joints[static_cast<std::size_t>(j)].home_sequence >= 0) sequenced |= 1u << j;
-        }
-        mask = sequenced != 0 ? sequenced : (1u << joint_count_) - 1;
-      }
-      home_pending_ = mask & ((1u << joint_count_) - 1);
-      for (int j = 0; j < joint_count_; ++j) {
-        if (home_pending_ & (1u << j)) status_.homed[static_cast<std::size_t>(j)] = false;
-      }
-      home_sequence_ = -1;
-      start_home_sequence();
+    case Command::Kind::home:
+      start_homing(command.joint_mask);
       break;
-    }
     case Command::Kind::abort:
       if (has_active_ || segments_.size() > 0) abort_requested_ = true;
-      for (auto& h : homing_)
-        h.active = false;
-      if (home_pending_ != 0) {
-        home_pending_ = 0;
-        home_sequence_ = -1;
-        post(Event::Level::warning, "homing aborted");
-      }
+      homing_.abort();
       break;
     case Command::Kind::pause:
       pause_requested_ = true;
@@ -190,72 +123,38 @@ void ServoLoop::apply(const Command& command) noexcept {
   }
 }
 
-void ServoLoop::start_home_sequence() noexcept {
-  // The lowest sequence number among the joints still to home goes next; joints sharing a
-  // number home together.
-  int next = -1;
-  for (int j = 0; j < joint_count_; ++j) {
-    if (!(home_pending_ & (1u << j))) continue;
-    const int seq = std::max(0, config_.joints[static_cast<std::size_t>(j)].home_sequence);
-    if (next < 0 || seq < next) next = seq;
+void ServoLoop::start_homing(std::uint32_t mask) noexcept {
+  if (status_.machine != MachineState::on) {
+    post(Event::Level::warning, "home ignored: the machine is not on");
+  } else if (has_active_ || segments_.size() > 0 || homing_.active()) {
+    post(Event::Level::warning, "home ignored: the machine is moving");
+  } else if (!homing_.start(mask, joints_)) {
+    latch_fault(homing_.error());
+  } else {
+    status_.motion = MotionState::homing;
+    sync_axes_from_joints();
   }
-  home_sequence_ = next;
-  if (next < 0) return;
-  for (int j = 0; j < joint_count_; ++j) {
-    if (!(home_pending_ & (1u << j))) continue;
-    const auto& joint = config_.joints[static_cast<std::size_t>(j)];
-    if (std::max(0, joint.home_sequence) != next) continue;
-    if (joint.home_search_vel != 0 || joint.home_latch_vel != 0) {
-      char text[120];
-      std::snprintf(text, sizeof text,
-                    "joint %d: switch homing needs a home switch input, which driver '%s' lacks", j,
-                    joint.driver.c_str());
-      latch_fault(text);
-      return;
-    }
-    // Immediate homing: the current position becomes HOME_OFFSET, then the joint moves to HOME.
-    auto& h = homing_[static_cast<std::size_t>(j)];
-    joint_cmd_[static_cast<std::size_t>(j)] = joint.home_offset;
-    h.active = true;
-    h.start = joint.home_offset;
-    h.target = joint.home;
-    h.traveled = 0;
-    h.velocity = 0;
-    h.max_velocity = joint.home_final_vel > 0 ? std::min(joint.home_final_vel, joint.max_velocity)
-                                              : joint.max_velocity;
-    h.max_acceleration = joint.max_acceleration;
-  }
-  status_.motion = MotionState::homing;
 }
 
-void ServoLoop::advance_homing(double dt) noexcept {
-  bool sequence_done = true;
-  for (int j = 0; j < joint_count_; ++j) {
-    auto& h = homing_[static_cast<std::size_t>(j)];
-    if (!h.active) continue;
-    double& pos = joint_cmd_[static_cast<std::size_t>(j)];
-    double time = dt;
-    const double length = std::abs(h.target - h.start);
-    if (advance_profile(h.traveled, h.velocity, length, h.max_velocity, h.max_acceleration, time)) {
-      pos = h.target;
-      h = JointMotion{};
-      status_.homed[static_cast<std::size_t>(j)] = true;
-      home_pending_ &= ~(1u << j);
-    } else {
-      pos = h.start + (h.target > h.start ? h.traveled : -h.traveled);
-      sequence_done = false;
-    }
-  }
-  // Axes follow their joints while homing (trivkins: first joint of an axis leads).
-  sync_axes_from_joints();
-  if (sequence_done) {
-    if (home_pending_ != 0) {
-      start_home_sequence();
-    } else {
-      home_sequence_ = -1;
+void ServoLoop::advance_homing() noexcept {
+  switch (homing_.update(joints_)) {
+    case Homing::Result::failed:
+      latch_fault(homing_.error());
+      return;
+    case Homing::Result::aborted:
+      post(Event::Level::warning, "homing aborted");
       status_.motion = MotionState::idle;
-    }
+      break;
+    case Homing::Result::finished:
+    case Homing::Result::idle:
+      status_.motion = MotionState::idle;
+      break;
+    case Homing::Result::running:
+      status_.motion = homing_.stopping() ? MotionState::stopping : MotionState::homing;
+      break;
   }
+  // Axes follow their joints while homing (trivkins: the first joint of an axis leads).
+  sync_axes_from_joints();
 }
 
 void ServoLoop::sync_axes_from_joints() noexcept {
@@ -264,7 +163,7 @@ void ServoLoop::sync_axes_from_joints() noexcept {
     const int axis = joint_axis_[static_cast<std::size_t>(j)];
     if (axis < 0 || seen[static_cast<std::size_t>(axis)]) continue;
     seen[static_cast<std::size_t>(axis)] = true;
-    axis_pose_[static_cast<std::size_t>(axis)] = joint_cmd_[static_cast<std::size_t>(j)];
+    axis_pose_[static_cast<std::size_t>(axis)] = joints_.command[static_cast<std::size_t>(j)];
   }
 }
 
@@ -319,22 +218,20 @@ void ServoLoop::advance_path(double dt) noexcept {
   }
 }
 
-void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
+void ServoLoop::update_stats(std::int64_t wake_error_ns) noexcept {
   histogram_.add(wake_error_ns);
   ++status_.rt.cycles;
   if (wake_error_ns > config_.servo_period_ns) ++status_.rt.overruns;
+  // The percentiles walk the histogram: once a second or so is plenty.
   if ((status_.rt.cycles & 1023) == 1) {
     status_.rt.wake_error_p50_ns = histogram_.quantile_ns(0.5);
     status_.rt.wake_error_p99_ns = histogram_.quantile_ns(0.99);
     status_.rt.wake_error_p999_ns = histogram_.quantile_ns(0.999);
   }
   status_.rt.wake_error_max_ns = histogram_.max_ns();
+}
 
-  Command command;
-  while (commands_.pop(command))
-    apply(command);
-
-  // Feedback and inputs.
+void ServoLoop::read_drivers() noexcept {
   drivers::MachineInputs inputs;
   for (auto& binding : drivers_) {
     drivers::JointFeedback block[kJoints];
@@ -344,12 +241,20 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     for (int k = 0; k < n; ++k)
       feedback_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])] = block[k];
   }
+  for (int j = 0; j < joint_count_; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    joints_.feedback[k] = feedback_[k].position - joints_.motor_offset[k];
+    joints_.home_switch[k] = feedback_[k].home_switch;
+  }
   if (inputs.estop && status_.machine != MachineState::estop) {
     stop_now(MachineState::estop, nullptr);
     latch_fault("estop input asserted");
   }
-  const bool on = status_.machine == MachineState::on;
-  for (int j = 0; j < joint_count_ && on; ++j) {
+}
+
+void ServoLoop::check_joints() noexcept {
+  if (status_.machine != MachineState::on) return;
+  for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback_[k];
     char text[120];
@@ -358,58 +263,42 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
       std::snprintf(text, sizeof text, "joint %d: %s", j,
                     fb.fault ? "drive fault" : "feedback is stale");
       latch_fault(text);
-      break;
+      return;
     }
     // A tripped limit switch stops everything, except while homing a joint configured to
     // ignore its limits (its home switch shares the limit input).
-    const bool ignore_limits = homing_[k].active && config_.joints[k].home_ignore_limits;
-    if ((fb.min_limit || fb.max_limit) && !ignore_limits) {
+    if ((fb.min_limit || fb.max_limit) && !homing_.ignores_limits(j)) {
       status_.joint_fault[k] = true;
       std::snprintf(text, sizeof text, "joint %d: %s limit switch tripped", j,
                     fb.min_limit ? "minimum" : "maximum");
       latch_fault(text);
-      break;
+      return;
     }
+    // LinuxCNC's limit: FERROR at full speed, scaled down with speed, never below MIN_FERROR.
     const auto& joint = config_.joints[k];
     const double speed = std::abs(commands_out_[k].velocity);
     const double limit =
-        joint.min_ferror + (joint.ferror - joint.min_ferror) *
-                               std::min(1.0, speed / std::max(joint.max_velocity, 1e-9));
-    const double error = std::abs(last_written_[k] - fb.position);
+        std::max(joint.min_ferror, joint.ferror * speed / std::max(joint.max_velocity, 1e-9));
+    const double error = std::abs(last_motor_cmd_[k] - fb.position);
     if (error > limit) {
       status_.joint_fault[k] = true;
       std::snprintf(text, sizeof text, "joint %d: following error %.4f exceeds %.4f", j, error,
                     limit);
       latch_fault(text);
-      break;
+      return;
     }
   }
+}
 
-  if (status_.machine == MachineState::on) {
-    if (home_pending_ != 0 || home_sequence_ >= 0) {
-      advance_homing(period_s_);
-    } else {
-      advance_path(period_s_);
-      for (int j = 0; j < joint_count_; ++j) {
-        joint_cmd_[static_cast<std::size_t>(j)] =
-            axis_pose_[static_cast<std::size_t>(joint_axis_[static_cast<std::size_t>(j)])];
-      }
-    }
-  } else {
-    // Drives off: the command follows the machine wherever it is pushed.
-    for (int j = 0; j < joint_count_; ++j)
-      joint_cmd_[static_cast<std::size_t>(j)] = feedback_[static_cast<std::size_t>(j)].position;
-    sync_axes_from_joints();
-  }
-
-  // Commands out.
+void ServoLoop::write_drivers() noexcept {
   const bool enable = status_.machine == MachineState::on;
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
-    commands_out_[k].velocity = (joint_cmd_[k] - last_written_[k]) / period_s_;
-    commands_out_[k].position = joint_cmd_[k];
+    const double motor = joints_.command[k] + joints_.motor_offset[k];
+    commands_out_[k].velocity = (motor - last_motor_cmd_[k]) / period_s_;
+    commands_out_[k].position = motor;
     commands_out_[k].enable = enable;
-    last_written_[k] = joint_cmd_[k];
+    last_motor_cmd_[k] = motor;
   }
   for (auto& binding : drivers_) {
     drivers::JointCommand block[kJoints];
@@ -419,6 +308,34 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
           commands_out_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])];
     binding.driver->write(block, n);
   }
+}
+
+void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
+  update_stats(wake_error_ns);
+  Command command;
+  // Feedback first: a command (homing) may redefine joint positions from it.
+  read_drivers();
+  while (commands_.pop(command))
+    apply(command);
+  check_joints();
+
+  if (status_.machine == MachineState::on) {
+    if (homing_.active()) {
+      advance_homing();
+    } else {
+      advance_path(period_s_);
+      for (int j = 0; j < joint_count_; ++j) {
+        const int axis = joint_axis_[static_cast<std::size_t>(j)];
+        if (axis >= 0)
+          joints_.command[static_cast<std::size_t>(j)] = axis_pose_[static_cast<std::size_t>(axis)];
+      }
+    }
+  } else {
+    // Drives off: the command follows the machine wherever it is pushed.
+    joints_.command = joints_.feedback;
+    sync_axes_from_joints();
+  }
+  write_drivers();
   publish();
 }
 
@@ -426,15 +343,16 @@ void ServoLoop::publish() noexcept {
   status_.sequence = status_.rt.cycles;
   status_.commanded = axis_pose_;
   status_.queued = static_cast<std::uint32_t>(segments_.size() + (has_active_ ? 1 : 0));
+  status_.homed = joints_.homed;
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
-    status_.joint_commanded[k] = joint_cmd_[k];
-    status_.joint_actual[k] = feedback_[k].position;
+    status_.joint_commanded[k] = joints_.command[k];
+    status_.joint_actual[k] = joints_.feedback[k];
     const int axis = joint_axis_[k];
     if (axis >= 0 && !seen[static_cast<std::size_t>(axis)]) {
       seen[static_cast<std::size_t>(axis)] = true;
-      status_.actual[static_cast<std::size_t>(axis)] = feedback_[k].position;
+      status_.actual[static_cast<std::size_t>(axis)] = joints_.feedback[k];
     }
   }
   published_.store(status_);

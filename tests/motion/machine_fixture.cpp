@@ -33,14 +33,28 @@ config::MachineConfig small_mill() {
   return c;
 }
 
-VirtualMachine::VirtualMachine(const config::MachineConfig& config)
+void RecordingDriver::write(const drivers::JointCommand* commands, int count) noexcept {
+  motion::JointArray positions{};
+  for (int i = 0; i < count; ++i)
+    positions[static_cast<std::size_t>(i)] = commands[i].position;
+  written_.push_back(positions);  // test code: allocation is fine here
+  inner_.write(commands, count);
+}
+
+VirtualMachine::VirtualMachine(const config::MachineConfig& config, std::uint32_t capabilities)
     : config_(config), sim_(std::make_unique<drivers::SimDriver>()), planner_(config_) {
   std::vector<int> joints;
   for (std::size_t j = 0; j < config_.joints.size(); ++j)
     joints.push_back(static_cast<int>(j));
   EXPECT_EQ(sim_->configure(config_, joints), "");
+  recorder_ = std::make_unique<RecordingDriver>(*sim_, capabilities);
   loop_ = std::make_unique<motion::ServoLoop>(
-      config_, std::vector<motion::DriverBinding>{{sim_.get(), joints}});
+      config_, std::vector<motion::DriverBinding>{{recorder_.get(), joints}});
+}
+
+double VirtualMachine::motor_position(int j) const {
+  const auto& written = recorder_->written();
+  return written.empty() ? 0.0 : written.back()[static_cast<std::size_t>(j)];
 }
 
 void VirtualMachine::command(motion::Command::Kind kind, std::uint32_t mask) {
@@ -53,7 +67,7 @@ void VirtualMachine::ready() {
   command(motion::Command::Kind::on);
   command(motion::Command::Kind::home, 0xFFFFFFFFu);
   run_until_idle();
-  trajectory_.clear();
+  clear_trajectory();
   plan_end_ = status().commanded;
 }
 

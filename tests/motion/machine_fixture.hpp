@@ -15,9 +15,39 @@ namespace cncd::test {
 // X/Y 200 mm/s and 2000 mm/s², Z 100 mm/s and 1000 mm/s², limits ±1000 (Z -500..500).
 config::MachineConfig small_mill();
 
+// Sits between the servo loop and a driver and keeps every period's motor commands.
+class RecordingDriver final : public drivers::Driver {
+ public:
+  RecordingDriver(drivers::Driver& inner, std::uint32_t capabilities)
+      : inner_(inner), capabilities_(capabilities) {}
+  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
+    return "";
+  }
+  void enable() override {}
+  void disable() override {}
+  void write(const drivers::JointCommand* commands, int count) noexcept override;
+  void read(drivers::JointFeedback* feedback, int count) noexcept override {
+    inner_.read(feedback, count);
+  }
+  void read_inputs(drivers::MachineInputs& inputs) noexcept override { inner_.read_inputs(inputs); }
+  std::uint32_t capabilities() const noexcept override { return capabilities_; }
+  const char* name() const noexcept override { return "recording"; }
+  const std::vector<motion::JointArray>& written() const { return written_; }
+  void clear() { written_.clear(); }
+
+ private:
+  drivers::Driver& inner_;
+  std::uint32_t capabilities_;
+  std::vector<motion::JointArray> written_;
+};
+
 class VirtualMachine {
  public:
-  explicit VirtualMachine(const config::MachineConfig& config);
+  // `capabilities`: what the loop is told the driver can do (the sim's by default).
+  explicit VirtualMachine(const config::MachineConfig& config,
+                          std::uint32_t capabilities = drivers::kCapHomeSwitch |
+                                                       drivers::kCapLimitSwitches |
+                                                       drivers::kCapEstopInput);
   // Machine on and homed.
   void ready();
   // Plans and queues; fails the test when the planner refuses.
@@ -29,7 +59,14 @@ class VirtualMachine {
   void command(motion::Command::Kind kind, std::uint32_t mask = 0);
   motion::Status status() const { return loop_->status(); }
   const std::vector<motion::AxisPose>& trajectory() const { return trajectory_; }
-  void clear_trajectory() { trajectory_.clear(); }
+  // Every recorded period's motor commands (motor coordinates).
+  const std::vector<motion::JointArray>& motor_trajectory() const { return recorder_->written(); }
+  void clear_trajectory() {
+    trajectory_.clear();
+    recorder_->clear();
+  }
+  // The last motor command of joint `j`; with no lag, where the simulated motor stands.
+  double motor_position(int j) const;
   drivers::SimDriver& sim() { return *sim_; }
   motion::ServoLoop& loop() { return *loop_; }
   const config::MachineConfig& config() const { return config_; }
@@ -38,6 +75,7 @@ class VirtualMachine {
  private:
   config::MachineConfig config_;
   std::unique_ptr<drivers::SimDriver> sim_;
+  std::unique_ptr<RecordingDriver> recorder_;
   std::unique_ptr<motion::ServoLoop> loop_;
   motion::Planner planner_;
   motion::AxisPose plan_end_{};

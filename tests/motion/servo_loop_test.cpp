@@ -171,7 +171,8 @@ TEST(ServoLoop, HomesInSequenceToHome) {
 TEST(ServoLoop, SwitchHomingWithoutSwitchIsAFault) {
   auto config = small_mill();
   config.joints[0].home_search_vel = 10;
-  VirtualMachine m(config);
+  config.joints[0].home_latch_vel = 1;
+  VirtualMachine m(config, drivers::kCapEstopInput);
   m.command(Command::Kind::reset_estop);
   m.command(Command::Kind::on);
   m.command(Command::Kind::home, 1);

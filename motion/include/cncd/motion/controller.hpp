@@ -24,10 +24,13 @@ class MotionController {
   MotionController(const MotionController&) = delete;
   MotionController& operator=(const MotionController&) = delete;
 
-  // Creates and configures the drivers and starts the servo thread. Returns "" or an error.
-  // When SCHED_FIFO or mlockall is refused, logs one warning and runs anyway.
+  // Creates and configures the drivers and starts the servo thread at [EMCMOT] SERVO_PERIOD,
+  // SCHED_FIFO priority [CNCD] RT_PRIORITY, pinned to [CNCD] RT_CPU when given, memory locked.
+  // Returns "" or an error. What the OS refuses (SCHED_FIFO, the CPU, mlockall) does not stop
+  // it: start_warnings() then says what, once, for the caller to log. Calling start() again
+  // after stop() starts afresh (estop, unhomed).
   std::string start();
-  // Stops motion, disables the drives, joins the servo thread. Idempotent.
+  // Stops the servo thread (joins it) and disables the drives. Idempotent.
   void stop();
 
   enum class EnqueueResult { queued, full, refused };
@@ -39,13 +42,14 @@ class MotionController {
   // Free slots in the segment queue.
   std::size_t queue_space() const;
 
-  // Priority commands: they bypass queued motion.
+  // Priority commands: they bypass queued motion, and each returns once the servo thread has
+  // applied it (a period or two; at most 1 s), so a status() read afterwards reflects it.
   void estop();                         // latch estop: stop within one period, drives disabled
   void reset_estop();                   // leave estop (machine stays off)
   void machine_on();                    // enable drives (needs estop reset)
-  void machine_off();                   // controlled stop, disable drives
+  void machine_off();                   // stop at once, disable drives
   void home(std::uint32_t joint_mask);  // home these joints (all-ones = all in HOME_SEQUENCE)
-  void abort();                         // controlled stop, flush queued motion
+  void abort();                         // controlled stop, flush queued motion, abort homing
   void pause();                         // feed hold: controlled stop on the path
   void resume();
 

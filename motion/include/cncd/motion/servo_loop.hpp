@@ -9,6 +9,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/motion/homing.hpp"
 #include "cncd/motion/rt_stats.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/seqlock.hpp"
@@ -43,33 +44,35 @@ class ServoLoop {
   using CommandRing = SpscRing<Command, 64>;
   using EventRing = SpscRing<Event, 64>;
 
+  // Non-RT. `config` must outlive the loop; the drivers are configured and enabled by the
+  // caller. Starts in estop.
   ServoLoop(const config::MachineConfig& config, std::vector<DriverBinding> drivers);
 
   // RT: one servo period. `wake_error_ns` is how late this cycle woke (for the statistics).
   void cycle(std::int64_t wake_error_ns) noexcept;
 
+  // Producer: the planner (task thread). Consumer: the servo thread.
   SegmentRing& segments() noexcept { return segments_; }
+  // Producer: the task thread. Consumer: the servo thread.
   CommandRing& commands() noexcept { return commands_; }
+  // Producer: the servo thread. Consumer: the task thread.
   EventRing& events() noexcept { return events_; }
+  // Any thread.
   Status status() const noexcept { return published_.load(); }
+  // Before the first cycle, or on the servo thread.
   void set_rt_flags(bool realtime, bool memory_locked) noexcept;
 
  private:
-  struct JointMotion {  // homing move of one joint
-    bool active = false;
-    double start = 0;
-    double target = 0;
-    double traveled = 0;  // distance covered from start
-    double velocity = 0;
-    double max_velocity = 0;
-    double max_acceleration = 0;
-  };
   void apply(const Command& command) noexcept;
+  void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
   void flush_queue() noexcept;
   void advance_path(double dt) noexcept;
-  void advance_homing(double dt) noexcept;
-  void start_home_sequence() noexcept;
+  void advance_homing() noexcept;
+  void read_drivers() noexcept;
+  void check_joints() noexcept;
+  void write_drivers() noexcept;
+  void update_stats(std::int64_t wake_error_ns) noexcept;
   void latch_fault(const char* reason) noexcept;
   void post(Event::Level level, const char* text) noexcept;
   void sync_axes_from_joints() noexcept;
@@ -79,7 +82,7 @@ class ServoLoop {
   std::vector<DriverBinding> drivers_;
   double period_s_;
   int joint_count_;
-  std::array<int, kJoints> joint_axis_{};  // axis index a joint follows
+  std::array<int, kJoints> joint_axis_{};  // axis index a joint follows, -1 = none
 
   SegmentRing segments_;
   CommandRing commands_;
@@ -95,13 +98,11 @@ class ServoLoop {
   bool pause_requested_ = false;
   bool abort_requested_ = false;
   AxisPose axis_pose_{};
-  JointArray joint_cmd_{};
-  JointArray last_written_{};
-  std::array<JointMotion, kJoints> homing_{};
-  std::uint32_t home_pending_ = 0;  // joints still to home
-  int home_sequence_ = -1;          // sequence being homed, -1 = none
+  JointIo joints_{};
+  Homing homing_;
+  JointArray last_motor_cmd_{};  // what the drivers were told last period (motor coordinates)
   std::array<drivers::JointCommand, kJoints> commands_out_{};
-  std::array<drivers::JointFeedback, kJoints> feedback_{};
+  std::array<drivers::JointFeedback, kJoints> feedback_{};  // motor coordinates
   RtHistogram histogram_;
 };
 

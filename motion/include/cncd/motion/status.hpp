@@ -37,7 +37,7 @@ struct Status {
   std::int32_t line = 0;            // source line of the segment being executed
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
   std::uint64_t segments_done = 0;  // segments completed since start
-  char fault_reason[96] = {};       // latched fault, "" when none
+  char fault_reason[120] = {};      // latched fault, "" when none
   RtStats rt;
 };
 
