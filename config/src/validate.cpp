@@ -73,6 +73,107 @@ void check_repeated_section(TypedReader& r, const IniSection& header, const IniS
   if (!differs) r.warning(header.name, "", "section repeated at " + at_line(header.source));
 }
 
+// Step/dir and Modbus keys: ranges come from the key table; here, what a joint's DRIVER needs.
+// A missing key is a warning, not a problem: the file stays readable (for --check-config and
+// offline tools), and the driver refuses to start with the same message.
+constexpr const char* kRefused = "; the driver will refuse to start";
+
+void check_gpio_joint(TypedReader& r, const MachineConfig& c, const std::string& s,
+                      const JointConfig& j) {
+  for (const char* key : {"STEPLEN", "STEPSPACE", "DIRSETUP", "DIRHOLD"})
+    r.integer(s, key);
+  for (const char* key : {"STEPGEN_MAXVEL", "STEPGEN_MAXACCEL"})
+    r.real(s, key);
+  for (const char* key : {"ENABLE_ACTIVE_LOW", "HOME_SWITCH_ACTIVE_LOW", "MIN_LIMIT_ACTIVE_LOW",
+                          "MAX_LIMIT_ACTIVE_LOW"})
+    r.boolean(s, key);
+  for (const char* key : {"ENABLE_LINE", "HOME_SWITCH_LINE", "MIN_LIMIT_LINE", "MAX_LIMIT_LINE"})
+    r.text(s, key);
+  for (const char* key : {"STEP_LINE", "DIR_LINE"}) {
+    const auto v = r.text(s, key);
+    if (!v || v->empty())
+      r.warning(s, key,
+                std::string("missing: DRIVER = gpio needs a line offset or name") + kRefused);
+  }
+  if (j.scale == 0 && !r.failed(s, "SCALE")) {
+    r.warning(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
+              std::string("DRIVER = gpio needs SCALE (steps per unit), not 0") + kRefused);
+  }
+  if (c.base_period_ns <= 0 && !r.failed("EMCMOT", "BASE_PERIOD")) {
+    r.warning(
+        s, "DRIVER",
+        std::string("DRIVER = gpio needs a base thread: set [EMCMOT] BASE_PERIOD") + kRefused);
+  }
+  const auto chip = r.ini().value("GPIO", "CHIP");
+  if (!chip || chip->empty()) {
+    r.warning(s, "DRIVER",
+              std::string("DRIVER = gpio needs [GPIO] CHIP (gpiochip0, or vcd:FILE)") + kRefused);
+  }
+}
+
+void check_modbus_joint(TypedReader& r, const std::string& s, const JointConfig& j) {
+  for (const char* key :
+       {"TARGET_REGISTER", "CONTROL_REGISTER", "POSITION_REGISTER", "STATUS_REGISTER"})
+    r.integer(s, key);
+  r.choice(s, "REGISTER_WIDTH");
+  r.choice(s, "WORD_ORDER");
+  if (!r.given(s, "SLAVE")) {
+    r.warning(s, "DRIVER", std::string("DRIVER = modbus needs SLAVE (unit id)") + kRefused);
+  }
+  r.integer(s, "SLAVE");
+  if (j.scale == 0 && !r.failed(s, "SCALE")) {
+    r.warning(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
+              std::string("DRIVER = modbus needs SCALE (counts per unit), not 0") + kRefused);
+  }
+  if (!r.given(s, "MODBUS")) {
+    r.warning(
+        s, "DRIVER",
+        std::string("DRIVER = modbus needs MODBUS = n naming a [MODBUS_n] section") + kRefused);
+    return;
+  }
+  const auto bus = r.integer(s, "MODBUS");
+  if (bus && !r.ini().has_section("MODBUS_" + std::to_string(*bus))) {
+    r.problem(s, "MODBUS", "no section [MODBUS_" + std::to_string(*bus) + "] in the file");
+  }
+}
+
+void check_modbus_bus(TypedReader& r, const std::string& s) {
+  const auto transport = r.choice(s, "TRANSPORT");
+  for (const char* key :
+       {"PORT", "BAUD", "DATA_BITS", "STOP_BITS", "TIMEOUT_MS", "UPDATE_PERIOD_MS", "RETRIES"})
+    r.integer(s, key);
+  r.choice(s, "PARITY");
+  const auto host = r.text(s, "HOST");
+  const auto device = r.text(s, "DEVICE");
+  if (transport == "tcp" && (!host || host->empty())) {
+    r.problem(s, "HOST", "missing: TRANSPORT = tcp needs the drive's address");
+  }
+  if (transport == "rtu" && (!device || device->empty())) {
+    r.problem(s, "DEVICE", "missing: TRANSPORT = rtu needs a serial device");
+  }
+}
+
+void check_drivers(TypedReader& r, const MachineConfig& c) {
+  if (r.ini().has_section("GPIO")) {
+    r.text("GPIO", "CHIP");
+    r.text("GPIO", "ESTOP_LINE");
+    r.text("GPIO", "PROBE_LINE");
+    r.boolean("GPIO", "ESTOP_ACTIVE_LOW");
+    r.boolean("GPIO", "PROBE_ACTIVE_LOW");
+    r.integer("GPIO", "DEBOUNCE_NS");
+  }
+  for (const auto& header : r.ini().sections()) {
+    if (header.occurrence == 0 && find_key_spec(header.name, "TRANSPORT") != nullptr) {
+      check_modbus_bus(r, header.name);
+    }
+  }
+  for (std::size_t i = 0; i < c.joints.size(); ++i) {
+    const std::string s = "JOINT_" + std::to_string(i);
+    if (c.joints[i].driver == "gpio") check_gpio_joint(r, c, s, c.joints[i]);
+    if (c.joints[i].driver == "modbus") check_modbus_joint(r, s, c.joints[i]);
+  }
+}
+
 }  // namespace
 
 void validate(TypedReader& r, const MachineConfig& c) {
@@ -91,6 +192,7 @@ void validate(TypedReader& r, const MachineConfig& c) {
   for (std::size_t i = 0; i < c.joints.size(); ++i) {
     check_joint(r, c, static_cast<int>(i), c.joints[i]);
   }
+  check_drivers(r, c);
   if (c.joint_count == 0) return;
   for (const auto& header : r.ini().sections()) {
     const std::string_view name = header.name;

@@ -1,16 +1,14 @@
 #include "cncd/drivers/driver.hpp"
 
+#include "cncd/drivers/gpio_driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
 
 namespace cncd::drivers {
 
 std::unique_ptr<Driver> make_driver(const std::string& name, std::string& error) {
   if (name == "sim") return std::make_unique<SimDriver>();
-  if (name == "gpio" || name == "modbus") {
-    error = "driver '" + name + "' is not available in this build";
-  } else {
-    error = "unknown driver '" + name + "'";
-  }
+  if (name == "gpio") return std::make_unique<GpioDriver>();
+  error = "unknown driver '" + name + "'";
   return nullptr;
 }
 

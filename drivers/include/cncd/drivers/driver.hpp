@@ -4,6 +4,7 @@
 // write()/read() once per servo period (RT) -> disable() -> destructor (non-RT).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -63,6 +64,13 @@ class Driver {
   virtual void read(JointFeedback* feedback, int count) noexcept = 0;
   // RT, servo thread: machine-wide inputs; drivers without inputs leave them alone.
   virtual void read_inputs(MachineInputs& /*inputs*/) noexcept {}
+  // RT-safe, any thread: copies into `out` (NUL-terminated) why the driver last reported a
+  // fault, naming the drive, register or line; returns false (and an empty text) when it has
+  // nothing to say. The text stays until the fault is reset.
+  virtual bool fault_reason(char* out, std::size_t size) const noexcept {
+    if (size > 0) out[0] = '\0';
+    return false;
+  }
   virtual std::uint32_t capabilities() const noexcept = 0;
   virtual const char* name() const noexcept = 0;
 };

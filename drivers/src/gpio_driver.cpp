@@ -1,0 +1,182 @@
+#include "cncd/drivers/gpio_driver.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "stepgen.hpp"
+
+namespace cncd::drivers {
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// Feedback older than this many servo periods means the base thread has stopped.
+constexpr std::int64_t kStaleServoPeriods = 5;
+
+}  // namespace
+
+GpioDriver::GpioDriver() = default;
+
+GpioDriver::~GpioDriver() {
+  disable();
+}
+
+void GpioDriver::enable() {
+  if (backend_) backend_->start();
+  if (manual_clock_ || running_.exchange(true)) return;
+  last_period_ns_.store(monotonic_ns());
+  base_thread_ = std::thread([this] { base_loop(); });
+}
+
+void GpioDriver::disable() {
+  if (running_.exchange(false)) base_thread_.join();
+  if (backend_) backend_->stop();
+}
+
+void GpioDriver::write(const JointCommand* commands, int count) noexcept {
+  CommandBlock block;
+  const int n = std::min(count, static_cast<int>(joints_.size()));
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    block.position[k] = commands[i].position;
+    block.velocity[k] = commands[i].velocity;
+    block.enable[k] = commands[i].enable;
+  }
+  mailbox_.store(block);
+}
+
+void GpioDriver::read(JointFeedback* feedback, int count) noexcept {
+  const bool stale = running_.load(std::memory_order_relaxed) &&
+                     monotonic_ns() - last_period_ns_.load(std::memory_order_relaxed) >
+                         kStaleServoPeriods * std::max(servo_period_ns_, base_period_ns_);
+  const int n = std::min(count, static_cast<int>(joints_.size()));
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const JointLines& jl = joints_[k];
+    JointFeedback& fb = feedback[i];
+    fb.position = static_cast<double>(counts_[k].load(std::memory_order_relaxed)) / jl.scale;
+    fb.home_switch = input(jl.home);
+    fb.min_limit = input(jl.min_limit);
+    fb.max_limit = input(jl.max_limit);
+    fb.fault = false;
+    fb.stale = stale;
+  }
+}
+
+void GpioDriver::read_inputs(MachineInputs& inputs) noexcept {
+  if (input(estop_input_)) inputs.estop = true;
+  if (input(probe_input_)) inputs.probe = true;
+}
+
+std::int64_t GpioDriver::step_count(int index) const noexcept {
+  if (index < 0 || index >= kMaxJoints) return 0;
+  return counts_[static_cast<std::size_t>(index)].load(std::memory_order_relaxed);
+}
+
+bool GpioDriver::input(int index) const noexcept {
+  return index >= 0 &&
+         inputs_[static_cast<std::size_t>(index)].published.load(std::memory_order_relaxed);
+}
+
+GpioDriver::BaseStats GpioDriver::base_stats() const noexcept {
+  BaseStats stats;
+  stats.periods = periods_.load();
+  stats.max_late_ns = max_late_ns_.load();
+  if (stats.periods > 0) {
+    stats.mean_late_ns =
+        static_cast<double>(total_late_ns_.load()) / static_cast<double>(stats.periods);
+  }
+  return stats;
+}
+
+void GpioDriver::sample_inputs() noexcept {
+  if (input_count_ == 0) return;
+  backend_->read_inputs(input_levels_.data());
+  for (std::size_t i = 0; i < input_count_; ++i) {
+    Input& in = inputs_[i];
+    const bool asserted = (input_levels_[i] != 0) != in.active_low;
+    // A new level counts only after it held for the debounce time.
+    if (asserted == in.state) {
+      in.pending_ticks = 0;
+      continue;
+    }
+    if (++in.pending_ticks >= in.debounce_ticks) {
+      in.state = asserted;
+      in.pending_ticks = 0;
+      in.published.store(asserted, std::memory_order_relaxed);
+    }
+  }
+}
+
+void GpioDriver::run_base_period(std::int64_t time_ns) noexcept {
+  const double dt = static_cast<double>(base_period_ns_) * 1e-9;
+  CommandBlock latest;
+  // A command being written right now is picked up next period; the base thread never waits.
+  if (mailbox_.version() != command_version_ && mailbox_.try_load(latest)) {
+    command_ = latest;
+    command_version_ = mailbox_.version();
+    since_command_s_ = 0;
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+      if (primed_[k]) continue;
+      stepgens_[k].prime(std::llround(command_.position[k] * joints_[k].scale));
+      primed_[k] = true;
+    }
+  } else {
+    since_command_s_ += dt;
+  }
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    const JointLines& jl = joints_[k];
+    Stepgen& sg = stepgens_[k];
+    const bool on = primed_[k] && command_.enable[k];
+    sg.tick(command_.position[k] * jl.scale, command_.velocity[k] * jl.scale, since_command_s_, on);
+    output_levels_[static_cast<std::size_t>(jl.step_output)] = sg.step_line() ? 1 : 0;
+    output_levels_[static_cast<std::size_t>(jl.dir_output)] = sg.dir_line() ? 1 : 0;
+    if (jl.enable_output >= 0) {
+      output_levels_[static_cast<std::size_t>(jl.enable_output)] =
+          on != jl.enable_active_low ? 1 : 0;
+    }
+    counts_[k].store(sg.count(), std::memory_order_relaxed);
+  }
+  backend_->write_outputs(output_levels_.data(), time_ns);
+  sample_inputs();
+  periods_.fetch_add(1, std::memory_order_relaxed);
+  last_period_ns_.store(time_ns, std::memory_order_relaxed);
+}
+
+void GpioDriver::base_loop() noexcept {
+  // Above the servo thread, like LinuxCNC's base thread; refused without privileges, and then
+  // it runs at normal priority (the daemon already warns about real-time scheduling).
+  sched_param param{};
+  param.sched_priority = std::min(99, rt_priority_ + 1);
+  pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  while (running_.load(std::memory_order_relaxed)) {
+    next.tv_nsec += base_period_ns_;
+    while (next.tv_nsec >= 1'000'000'000) {
+      next.tv_nsec -= 1'000'000'000;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const std::int64_t now = monotonic_ns();
+    const std::int64_t late =
+        now - (static_cast<std::int64_t>(next.tv_sec) * 1'000'000'000 + next.tv_nsec);
+    total_late_ns_.fetch_add(late, std::memory_order_relaxed);
+    if (late > max_late_ns_.load(std::memory_order_relaxed)) {
+      max_late_ns_.store(late, std::memory_order_relaxed);
+    }
+    run_base_period(now);
+    // After a long stall, catch up with the clock instead of bursting through missed periods.
+    if (late > 10 * base_period_ns_) clock_gettime(CLOCK_MONOTONIC, &next);
+  }
+}
+
+}  // namespace cncd::drivers

@@ -1,0 +1,55 @@
+// Shared helpers of the driver tests: temporary machines and a reader for value change dumps.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cncd/config/machine_config.hpp"
+
+namespace cncd::test {
+
+// A fresh directory under the system temp directory, removed on destruction.
+class ScratchDir {
+ public:
+  ScratchDir();
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path write(const std::string& name, const std::string& text) const;
+
+ private:
+  std::filesystem::path path_;
+};
+
+// A small machine: servo 1 ms, `joints` linear joints (XYZ...), each with `joint_keys` added,
+// plus `extra` sections. Returns the loaded config or fails the test with the problems.
+config::LoadResult load_machine(const ScratchDir& dir, int joints, const std::string& joint_keys,
+                                const std::string& extra, std::int64_t base_period_ns = 0);
+
+struct VcdChange {
+  std::int64_t time_ns;
+  std::string signal;
+  int level;
+};
+
+// Every value change of a VCD file in order (the initial $dumpvars values at time 0 included).
+std::vector<VcdChange> read_vcd(const std::filesystem::path& path);
+
+struct StepStats {
+  std::int64_t net_steps = 0;  // rising edges, signed by the direction line
+  std::int64_t min_high_ns = INT64_MAX;
+  std::int64_t min_low_ns = INT64_MAX;
+  std::int64_t min_dir_setup_ns = INT64_MAX;  // direction change to next rising step edge
+  std::int64_t min_dir_hold_ns = INT64_MAX;   // falling step edge to next direction change
+  std::int64_t rising_edges = 0;
+  std::int64_t direction_changes = 0;
+};
+
+// Step timing of joint `joint` ("j<joint>_step", "j<joint>_dir") in a recording.
+StepStats step_stats(const std::vector<VcdChange>& changes, int joint);
+
+}  // namespace cncd::test
