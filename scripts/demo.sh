@@ -8,10 +8,14 @@ cmake --preset release >/dev/null
 cmake --build --preset release
 
 bin=build/release/daemon
-ini=${CNCD_DEMO_INI:-config/examples/sim_mm.ini}
+example=${CNCD_DEMO_INI:-config/examples/sim_mm.ini}
 program=${CNCD_DEMO_PROGRAM:-examples/g81_example1.ngc}
 rundir=$(mktemp -d)
 sock=$rundir/cncd.sock
+# The machine runs from a copy, so the parameter and position files it writes stay out of
+# the source tree.
+cp "${example%.ini}".* "$rundir"/
+ini=$rundir/$(basename "$example")
 
 "$bin/cncd" --ini "$ini" --socket "$sock" 2>"$rundir/cncd.log" &
 pid=$!
@@ -35,7 +39,7 @@ for _ in $(seq 100); do
 done
 
 ctl=("$bin/cncctl" --socket "$sock")
-echo "== cncd running on $ini"
+echo "== cncd running on $example"
 "${ctl[@]}" reset
 "${ctl[@]}" on
 echo "== homing"

@@ -33,11 +33,26 @@ std::uint64_t count_lines(const std::string& path) {
 }
 }  // namespace
 
+namespace {
+interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
+  interp::InterpOptions options;
+  options.machine_units = machine_units(config);
+  options.parameter_file = config.parameter_file;
+  options.tool_table = config.tool_table;
+  options.subroutine_path = config.subroutine_path;
+  options.startup_code = config.startup_code;
+  return options;
+}
+}  // namespace
+
+// One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
+// from one program to the next.
 Task::Task(const config::MachineConfig& config, EventLog& events)
     : config_(config),
       events_(events),
       motion_(config),
-      feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)) {}
+      feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
+      interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))) {}
 
 Task::~Task() {
   shutdown();
@@ -128,21 +143,12 @@ void Task::run_program() {
   if (!config_.no_force_homing && !all_homed(status)) {
     throw RpcError(kNotHomed, "all joints must be homed before running a program");
   }
-  interp::InterpOptions options;
-  options.machine_units = machine_units(config_);
-  options.parameter_file = config_.parameter_file;
-  options.tool_table = config_.tool_table;
-  options.subroutine_path = config_.subroutine_path;
-  options.startup_code = config_.startup_code;
-  auto interpreter = std::make_unique<interp::Interpreter>(options);
-  if (auto error = interpreter->open(program_path_)) {
+  if (auto error = interp_->open(program_path_)) {
     throw RpcError(kProgramError, error->to_string());
   }
-  // A program starts in the machine's units, so the commanded position needs no conversion.
   interp::Pose position{};
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
-  interpreter->set_position(position);
-  interp_ = std::move(interpreter);
+  interp_->set_machine_position(position);
   feeder_->start_program();
   interp_done_ = false;
   moves_enqueued_ = 0;
@@ -174,7 +180,10 @@ void Task::abort() {
 }
 
 void Task::finish_program(const std::string& result, const std::string& error) {
-  interp_.reset();
+  // Offsets set by the program (G10, G92 ...) survive a crash or power loss.
+  if (const auto save_error = interp_->save_parameters()) {
+    events_.add("error", "parameters", save_error->to_string());
+  }
   feeder_->pending.clear();
   exec_ = ExecState::idle;
   moves_completed_ = motion_.status().segments_done - moves_done_base_;

@@ -69,10 +69,10 @@ class Task {
   EventLog& events_;
   motion::MotionController motion_;
   std::unique_ptr<ProgramFeeder> feeder_;
+  std::unique_ptr<interp::Interpreter> interp_;
   ExecState exec_ = ExecState::idle;
   std::string program_path_;
   std::uint64_t program_lines_ = 0;
-  std::unique_ptr<interp::Interpreter> interp_;
   bool interp_done_ = false;
   std::uint64_t moves_enqueued_ = 0;   // moves handed to motion since the program started
   std::uint64_t moves_done_base_ = 0;  // motion's completed-move count when it started

@@ -78,6 +78,18 @@ std::filesystem::path TempDir::write(const std::string& name, const std::string&
   return file;
 }
 
+std::filesystem::path copy_example_machine(const std::filesystem::path& dir,
+                                           const std::string& name) {
+  const std::filesystem::path examples = std::filesystem::path(CNCD_SOURCE_DIR) / "config/examples";
+  for (const auto& entry : std::filesystem::directory_iterator(examples)) {
+    if (entry.path().stem() == name) {
+      std::filesystem::copy_file(entry.path(), dir / entry.path().filename(),
+                                 std::filesystem::copy_options::overwrite_existing);
+    }
+  }
+  return dir / (name + ".ini");
+}
+
 CommandResult run_command(const std::vector<std::string>& argv) {
   TempDir dir;
   const pid_t pid = spawn(argv, dir.path() / "out", dir.path() / "err");

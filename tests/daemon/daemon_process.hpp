@@ -23,6 +23,11 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// Copies config/examples/<name>.* (INI, parameter and tool files) into `dir`, so that a
+// daemon under test writes its state there and not into the source tree. Returns the INI.
+std::filesystem::path copy_example_machine(const std::filesystem::path& dir,
+                                           const std::string& name = "sim_mm");
+
 struct CommandResult {
   int exit_status = -1;  // exit code, or 128 + signal
   std::string out;

@@ -23,7 +23,8 @@ json result(const json& response) {
 class DaemonTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string error = daemon_.start(dir_.path(), {"--ini", kSimIni});
+    const auto ini = copy_example_machine(dir_.path());
+    const std::string error = daemon_.start(dir_.path(), {"--ini", ini.string()});
     ASSERT_EQ(error, "");
     ASSERT_EQ(client_.connect(daemon_.socket()), "");
   }

@@ -81,6 +81,7 @@ class PermissionTest : public ::testing::Test {
       GTEST_SKIP() << "no users/dialout group";
     // The socket's directory must be reachable by the unprivileged peers.
     chmod(dir_.path().c_str(), 0755);
+    copy_example_machine(dir_.path());
     const auto ini = dir_.write("machine.ini", ini_with_groups());
     ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini.string()}), "");
   }

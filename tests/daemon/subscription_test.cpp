@@ -13,11 +13,12 @@ namespace {
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-const std::string kSimIni = std::string(CNCD_SOURCE_DIR) + "/config/examples/sim_mm.ini";
-
 class SubscriptionTest : public ::testing::Test {
  protected:
-  void SetUp() override { ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", kSimIni}), ""); }
+  void SetUp() override {
+    const auto ini = copy_example_machine(dir_.path());
+    ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini.string()}), "");
+  }
 
   json next_notification(daemon::Client& client, const std::string& method) {
     for (;;) {
