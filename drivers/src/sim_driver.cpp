@@ -1,6 +1,7 @@
 #include "cncd/drivers/sim_driver.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace cncd::drivers {
 
@@ -50,6 +51,17 @@ void SimDriver::read(JointFeedback* feedback, int count) noexcept {
 
 void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
   if (estop_.load(std::memory_order_relaxed)) inputs.estop = true;
+}
+
+bool SimDriver::fault_reason(char* out, std::size_t size) const noexcept {
+  if (size == 0) return false;
+  out[0] = '\0';
+  for (int i = 0; i < kMaxJoints; ++i) {
+    if (!fault_[static_cast<std::size_t>(i)].load(std::memory_order_relaxed)) continue;
+    std::snprintf(out, size, "fault injected on simulated drive %d", i);
+    return true;
+  }
+  return false;
 }
 
 void SimDriver::set_fault(int index, bool fault) noexcept {

@@ -69,6 +69,28 @@ bool Planner::within_limits(const Segment& segment, std::string& error) const {
 
 std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bool check_limits,
                                      std::string& error) const {
+  // A NaN passes every comparison with a limit: refuse it before it reaches a motor.
+  bool finite = std::isfinite(move.feed) && std::isfinite(move.dwell_s) &&
+                std::isfinite(move.center_first) && std::isfinite(move.center_second);
+  for (int i = 0; i < kAxes; ++i)
+    finite = finite && std::isfinite(move.end[i]) && std::isfinite(start[i]);
+  if (!finite) {
+    error = "move has a non-finite coordinate, feed or time";
+    return std::nullopt;
+  }
+  if (move.kind == Move::Kind::arc) {
+    for (int axis : move.plane_axes) {
+      if (axis < 0 || axis >= kAxes) {
+        error = "arc plane names an axis that does not exist";
+        return std::nullopt;
+      }
+    }
+    if (move.plane_axes[0] == move.plane_axes[1] || move.plane_axes[0] == move.plane_axes[2] ||
+        move.plane_axes[1] == move.plane_axes[2]) {
+      error = "arc plane axes must differ";
+      return std::nullopt;
+    }
+  }
   Segment seg;
   seg.start = start;
   seg.end = move.kind == Move::Kind::dwell ? start : move.end;

@@ -33,6 +33,11 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
     joint_axis_[static_cast<std::size_t>(j)] =
         config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
   }
+  for (const auto& binding : drivers_) {
+    for (int j : binding.joints) {
+      if (j >= 0 && j < kJoints) joint_driver_[static_cast<std::size_t>(j)] = binding.driver;
+    }
+  }
   status_.joint_count = joint_count_;
   published_.store(status_);
 }
@@ -257,11 +262,16 @@ void ServoLoop::check_joints() noexcept {
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback_[k];
-    char text[120];
+    char text[200];  // latch_fault() keeps what fits in Status::fault_reason
     if (fb.fault || fb.stale) {
       status_.joint_fault[k] = true;
-      std::snprintf(text, sizeof text, "joint %d: %s", j,
-                    fb.fault ? "drive fault" : "feedback is stale");
+      // The driver may know more (which drive, register or line).
+      char detail[96] = {};
+      if (fb.fault && joint_driver_[k] != nullptr) {
+        joint_driver_[k]->fault_reason(detail, sizeof detail);
+      }
+      std::snprintf(text, sizeof text, "joint %d: %s%s%s", j,
+                    fb.fault ? "drive fault" : "feedback is stale", detail[0] ? ": " : "", detail);
       latch_fault(text);
       return;
     }

@@ -94,14 +94,20 @@ TEST(SimDriver, InjectedFaultsStaleFeedbackLimitsAndEstop) {
   EXPECT_TRUE(feedback[0].stale);
   EXPECT_EQ(feedback[0].position, 1);  // stale feedback does not move
   EXPECT_TRUE(feedback[1].fault);
+  char reason[64];
+  EXPECT_TRUE(sim.fault_reason(reason, sizeof reason));
+  EXPECT_STREQ(reason, "fault injected on simulated drive 1");
   EXPECT_TRUE(feedback[1].max_limit);
   EXPECT_FALSE(feedback[1].min_limit);
   MachineInputs inputs;
   sim.read_inputs(inputs);
   EXPECT_TRUE(inputs.estop);
   sim.set_stale(0, false);
+  sim.set_fault(1, false);
   sim.read(feedback, 2);
   EXPECT_EQ(feedback[0].position, 5);
+  EXPECT_FALSE(sim.fault_reason(reason, sizeof reason));
+  EXPECT_STREQ(reason, "");
 }
 
 TEST(SimDriver, HomeSwitchSitsAtHomeOffsetInTheSearchDirection) {

@@ -1,5 +1,6 @@
 // MotionController with its real servo thread and clock.
 #include <chrono>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -74,6 +75,64 @@ TEST(MotionController, NextMoveStartsWhereAnAbortLeftTheMachine) {
   ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 2; }));
   EXPECT_EQ(motion.status().commanded[0], stopped_at);
   EXPECT_EQ(motion.status().commanded[1], 10);
+}
+
+bool has_warning(const motion::MotionController& motion, const std::string& text) {
+  for (const auto& warning : motion.start_warnings()) {
+    if (warning.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(MotionController, RunsWithoutWhatTheSystemRefusesAndSaysSoOnce) {
+  auto config = small_mill();
+  config.cncd.rt_priority = 0;  // not a SCHED_FIFO priority: refused even for root
+  config.cncd.rt_cpu = 1000;    // no such CPU
+  motion::MotionController motion(config);
+  ASSERT_EQ(motion.start(), "");
+  EXPECT_TRUE(has_warning(motion, "SCHED_FIFO priority 0 refused")) << motion.start_warnings()[0];
+  EXPECT_TRUE(has_warning(motion, "CPU 1000"));
+  EXPECT_FALSE(motion.status().rt.realtime);
+  motion.reset_estop();
+  motion.machine_on();
+  motion.home(0xFFFFFFFFu);
+  ASSERT_TRUE(wait_for([&] { return motion.status().homed[0]; }));
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 2, 0, 0, 50)), Result::queued);
+  ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; }));
+  EXPECT_EQ(motion.status().commanded[0], 2);
+  // Nothing about scheduling goes through the event ring as well.
+  motion::Event event;
+  while (motion.poll_event(event))
+    EXPECT_EQ(std::string(event.text).find("SCHED_FIFO"), std::string::npos);
+}
+
+TEST(MotionController, StartsAfreshAfterStop) {
+  const auto config = small_mill();
+  motion::MotionController motion(config);
+  for (int run = 0; run < 2; ++run) {
+    ASSERT_EQ(motion.start(), "");
+    EXPECT_EQ(motion.status().machine, MachineState::estop);
+    EXPECT_FALSE(motion.status().homed[0]);
+    motion.reset_estop();
+    motion.machine_on();
+    motion.home(0xFFFFFFFFu);
+    ASSERT_TRUE(wait_for([&] { return motion.status().homed[0]; }));
+    ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 3, 1, 0, 50)), Result::queued);
+    ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; })) << "run " << run;
+    EXPECT_EQ(motion.status().commanded[1], 1);
+    ASSERT_NE(motion.sim_driver(), nullptr);
+    motion.stop();
+  }
+}
+
+TEST(MotionController, UnavailableDriverFailsStart) {
+  auto config = small_mill();
+  config.joints[1].driver = "teleporter";
+  motion::MotionController motion(config);
+  EXPECT_NE(motion.start().find("'teleporter'"), std::string::npos);
+  EXPECT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::refused);
+  EXPECT_EQ(motion.status().machine, MachineState::estop);
+  motion.estop();  // harmless without a servo thread
 }
 
 }  // namespace

@@ -30,6 +30,9 @@ class RecordingDriver final : public drivers::Driver {
     inner_.read(feedback, count);
   }
   void read_inputs(drivers::MachineInputs& inputs) noexcept override { inner_.read_inputs(inputs); }
+  bool fault_reason(char* out, std::size_t size) const noexcept override {
+    return inner_.fault_reason(out, size);
+  }
   std::uint32_t capabilities() const noexcept override { return capabilities_; }
   const char* name() const noexcept override { return "recording"; }
   const std::vector<motion::JointArray>& written() const { return written_; }

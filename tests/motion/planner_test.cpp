@@ -139,6 +139,64 @@ TEST(Planner, ExactStopTimeMatchesTheTrapezoid) {
   EXPECT_EQ(m.status().commanded[0], 200);
 }
 
+// Rest-to-rest time of a trapezoid (or triangle) over `length` with limits v and a.
+double trapezoid_time(double length, double v, double a) {
+  if (length >= v * v / a) return length / v + v / a;
+  return 2 * std::sqrt(length / a);
+}
+
+TEST(Planner, ExactStopTimeIsTheAnalyticTrapezoidForRandomMoves) {
+  std::mt19937 rng(4321);
+  std::uniform_real_distribution<double> coordinate(-200, 200);
+  std::uniform_real_distribution<double> feed(0.5, 400);
+  std::bernoulli_distribution tiny(0.2);
+  VirtualMachine m(small_mill());
+  m.ready();
+  const auto& axes = m.config().axes;
+  for (int i = 0; i < 60; ++i) {
+    const auto from = m.status().commanded;
+    motion::AxisPose to = from;
+    const bool short_move = tiny(rng);  // triangles as well as trapezoids
+    for (int axis = 0; axis < 3; ++axis)
+      to[axis] = short_move ? from[axis] + coordinate(rng) * 0.005 : coordinate(rng);
+    const double f = feed(rng);
+    m.queue(line_to(Move::Kind::feed, to[0], to[1], to[2], f));
+    // The path limits: the feed, [TRAJ] MAX_LINEAR_VELOCITY, then each axis's limit over its
+    // share of the direction.
+    const double length = std::hypot(to[0] - from[0], to[1] - from[1], to[2] - from[2]);
+    double v = std::min(f, m.config().max_linear_velocity);
+    double a = 1e300;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double share = std::abs(to[axis] - from[axis]) / length;
+      if (share == 0) continue;
+      v = std::min(v, axes[static_cast<std::size_t>(axis)].max_velocity / share);
+      a = std::min(a, axes[static_cast<std::size_t>(axis)].max_acceleration / share);
+    }
+    const double expected_s = trapezoid_time(length, v, a);
+    const int cycles = m.run_until_idle();
+    // The move ends inside its last period, and the loop reports idle in that same period.
+    EXPECT_NEAR(cycles * m.period_s(), expected_s, m.period_s()) << "move " << i;
+    EXPECT_EQ(m.status().commanded, to);
+  }
+}
+
+TEST(Planner, RefusesNonFiniteMoves) {
+  const auto config = small_mill();
+  motion::Planner planner(config);
+  std::string error;
+  EXPECT_FALSE(planner.plan(line_to(Move::Kind::feed, NAN, 0, 0, 10), {}, false, error));
+  EXPECT_NE(error.find("non-finite"), std::string::npos);
+  EXPECT_FALSE(planner.plan(line_to(Move::Kind::feed, 1, 0, 0, INFINITY), {}, false, error));
+  Move arc;
+  arc.kind = Move::Kind::arc;
+  arc.feed = 10;
+  arc.end = {2, 0, 0};
+  arc.center_first = 1;
+  arc.plane_axes = {0, 0, 2};
+  EXPECT_FALSE(planner.plan(arc, {}, false, error));
+  EXPECT_NE(error.find("differ"), std::string::npos) << error;
+}
+
 TEST(Planner, RefusesImpossibleMoves) {
   const auto config = small_mill();
   motion::Planner planner(config);

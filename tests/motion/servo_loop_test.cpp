@@ -112,7 +112,8 @@ TEST(ServoLoop, DriveFaultAndStaleFeedbackLatch) {
   m.sim().set_fault(2, true);
   m.cycles(2);
   EXPECT_EQ(m.status().machine, MachineState::off);
-  EXPECT_NE(std::strstr(m.status().fault_reason, "joint 2: drive fault"), nullptr);
+  EXPECT_STREQ(m.status().fault_reason,
+               "joint 2: drive fault: fault injected on simulated drive 2");
   m.sim().set_fault(2, false);
   m.command(Command::Kind::on);
   m.sim().set_stale(1, true);

@@ -25,6 +25,8 @@ class SimDriver final : public Driver {
   // RT.
   void read(JointFeedback* feedback, int count) noexcept override;
   void read_inputs(MachineInputs& inputs) noexcept override;
+  // RT-safe, any thread: names the first joint with an injected fault.
+  bool fault_reason(char* out, std::size_t size) const noexcept override;
   std::uint32_t capabilities() const noexcept override {
     return kCapHomeSwitch | kCapLimitSwitches | kCapEstopInput;
   }

@@ -82,7 +82,8 @@ class ServoLoop {
   std::vector<DriverBinding> drivers_;
   double period_s_;
   int joint_count_;
-  std::array<int, kJoints> joint_axis_{};  // axis index a joint follows, -1 = none
+  std::array<int, kJoints> joint_axis_{};                 // axis index a joint follows, -1 = none
+  std::array<drivers::Driver*, kJoints> joint_driver_{};  // the driver a joint belongs to
 
   SegmentRing segments_;
   CommandRing commands_;
