@@ -213,6 +213,7 @@ struct Interpreter::Impl {
   int current_line_ = 0;
   bool preamble_done_ = false;
   bool ended_ = false;
+  bool mdi_ = false;  // executing MDI: the end of the text ends it, no M2 or % needed
   bool opened_ = false;
   bool skipping_percent_ = false;
   bool seen_percent_ = false;

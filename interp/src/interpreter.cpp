@@ -120,6 +120,10 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     line_before_ = source.line_number();
     if (!source.read_line(line_)) {
       current_line_ = source.line_number();
+      if (mdi_ && sources_.size() == 1) {
+        ended_ = true;  // an MDI line needs no program end
+        return Step::end;
+      }
       fail("File ended with no percent sign or program end");
     }
     current_line_ = source.line_number();
@@ -204,6 +208,7 @@ void Interpreter::set_machine_position(const Pose& machine) {
 }
 
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
+  impl_->mdi_ = false;
   impl_->sources_.clear();
   impl_->error_ = impl_->config_error_;  // a new program starts without the last one's error
   impl_->program_name_ = program.string();
@@ -218,7 +223,24 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
   return std::nullopt;
 }
 
+std::optional<InterpError> Interpreter::open_mdi(std::string line) {
+  impl_->sources_.clear();
+  impl_->error_ = impl_->config_error_;
+  impl_->program_name_ = "MDI";
+  LineSource source;
+  source.open_text(std::move(line), "MDI");
+  impl_->sources_.push_back(std::move(source));
+  if (impl_->error_) return impl_->error_;
+  // Modal state carries over from the previous MDI line or program, as in LinuxCNC.
+  impl_->mdi_ = true;
+  impl_->ended_ = false;
+  impl_->control_.clear();
+  impl_->calls_.clear();
+  return std::nullopt;
+}
+
 std::optional<InterpError> Interpreter::open_string(std::string text, std::string name) {
+  impl_->mdi_ = false;
   impl_->sources_.clear();
   impl_->error_ = impl_->config_error_;
   impl_->program_name_ = name;

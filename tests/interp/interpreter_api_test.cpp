@@ -155,6 +155,22 @@ TEST(InterpreterApi, MachinePositionIsSeenThroughTheOffsets) {
   std::filesystem::remove(vars);
 }
 
+TEST(InterpreterApi, MdiKeepsModalStateAndNeedsNoProgramEnd) {
+  Interpreter interp;
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(interp.open_mdi("G21 G91 G1 F100 X1"));
+  ASSERT_FALSE(run_program(interp, printer));
+  ASSERT_FALSE(interp.open_mdi("X2"));  // still G91 G1 at F100
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("STRAIGHT_FEED(3.0000, 0.0000"), std::string::npos) << out.str();
+  ASSERT_FALSE(interp.open_mdi("G1 X"));
+  EXPECT_TRUE(run_program(interp, printer).has_value());
+  // An error does not stick to the next line.
+  ASSERT_FALSE(interp.open_mdi("X1"));
+  EXPECT_FALSE(run_program(interp, printer).has_value());
+}
+
 TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
   for (const char* line :
        {"G41 D1",     "G42.1 D1", "G33 Z-1 K1", "G33.1 Z-1 K1", "G38.3 Z-1 F1", "G5 X1 I1 J1 P1 Q1",

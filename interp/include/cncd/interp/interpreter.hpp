@@ -52,7 +52,10 @@ class Interpreter {
 
   // Opens a program file and resets to the start-of-program modal state.
   std::optional<InterpError> open(const std::filesystem::path& program);
-  // Opens a program held in memory (MDI, tests); `name` is used in messages.
+  // Opens one MDI block: the modal state stays as the last line or program left it, and the
+  // end of the text ends it (no M2 or % needed).
+  std::optional<InterpError> open_mdi(std::string line);
+  // Opens a program held in memory (tests); `name` is used in messages.
   std::optional<InterpError> open_string(std::string text, std::string name = "<mdi>");
 
   enum class Step { block, end, error };
