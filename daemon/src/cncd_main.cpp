@@ -116,15 +116,16 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   }
 
   EventLog events;
-  Task task(config, events);
+  Completions completions;
+  Task task(config, events, completions);
   if (const auto error = task.start(); !error.empty()) {
     spdlog::critical("cannot start motion: {}", error);
     return kExitUnavailable;
   }
   RpcDispatcher dispatcher;
-  register_methods(dispatcher, task, config, events);
+  register_methods(dispatcher, task, config, events, completions);
   Server server(
-      dispatcher, policy, [&task] { return task.status(); }, events);
+      dispatcher, policy, [&task] { return task.status(); }, events, completions);
   std::string serving = socket_path;
   // Socket activation: systemd hands over the listening socket of cncd.socket.
   if (sd_listen_fds(1) == 1 &&

@@ -56,7 +56,7 @@ std::uint32_t joint_mask(const json& params, int joint_count) {
 }  // namespace
 
 void register_methods(RpcDispatcher& dispatcher, Task& task, const config::MachineConfig& config,
-                      const EventLog& events) {
+                      const EventLog& events, Completions& completions) {
   dispatcher.add(
       "errors.list",
       [&events](const json& params) {
@@ -169,9 +169,27 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     task.resume();
     return ok();
   });
-  dispatcher.add("program.abort", [&task](const json&) {
-    task.abort();
-    return ok();
+  dispatcher.add("program.abort", [&task, &completions](const json&, Session& session) {
+    if (session.in_batch) {
+      task.abort();
+      return ok();
+    }
+    const auto token = completions.next_token();
+    task.abort(token);
+    session.defer_token = token;
+    return json();
+  });
+  dispatcher.add("mdi.execute", [&task, &completions](const json& params, Session& session) {
+    if (session.in_batch) throw RpcError(kInvalidRequest, "mdi.execute cannot be part of a batch");
+    const json& p = params_object(params);
+    const auto line = p.find("line");
+    if (line == p.end() || !line->is_string()) {
+      throw RpcError(kInvalidParams, "\"line\" must be a string");
+    }
+    const auto token = completions.next_token();
+    task.mdi(line->get<std::string>(), token);
+    session.defer_token = token;
+    return json();
   });
 }
 

@@ -9,6 +9,6 @@ namespace cncd::daemon {
 
 // Registers every method on `dispatcher`; the handlers call into `task` on the server thread.
 void register_methods(RpcDispatcher& dispatcher, Task& task, const config::MachineConfig& config,
-                      const EventLog& events);
+                      const EventLog& events, Completions& completions);
 
 }  // namespace cncd::daemon

@@ -61,7 +61,13 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
                                               "' needs the control group");
   }
   try {
+    session.defer_token = 0;
     json result = handler->second.handler(params, session);
+    if (session.defer_token != 0) {
+      if (!notification) session.open_requests.emplace_back(session.defer_token, id);
+      session.defer_token = 0;
+      return std::nullopt;
+    }
     if (notification) return std::nullopt;
     return json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}};
   } catch (const RpcError& e) {
@@ -82,9 +88,11 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
   if (request.is_array()) {
     if (request.empty()) return error_response(nullptr, kInvalidRequest, "empty batch").dump();
     json responses = json::array();
+    session.in_batch = true;
     for (const auto& one : request) {
       if (auto response = handle_one(one, session)) responses.push_back(std::move(*response));
     }
+    session.in_batch = false;
     if (responses.empty()) return std::nullopt;
     return responses.dump(-1, ' ', false, json::error_handler_t::replace);
   }

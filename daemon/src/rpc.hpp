@@ -1,11 +1,13 @@
 // JSON-RPC 2.0 dispatch: one request (or batch) in, one response (or none) out.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -40,10 +42,41 @@ class RpcError : public std::runtime_error {
 enum class Access { none, read, control };
 
 // Per-connection state a method may read or change.
+// Answers to requests that finish later (mdi.execute, program.abort): the handler takes a
+// token with defer(), the server keeps the request open, and whoever finishes the work posts
+// the answer with complete(); the server sends it to the client that asked.
+class Completions {
+ public:
+  struct Completion {
+    std::uint64_t token = 0;
+    nlohmann::json result;  // used when error_code == 0
+    int error_code = 0;
+    std::string error_message;
+  };
+  std::uint64_t next_token() { return ++last_token_; }
+  void complete(std::uint64_t token, nlohmann::json result) {
+    done_.push_back(Completion{token, std::move(result), 0, {}});
+  }
+  void fail(std::uint64_t token, int code, std::string message) {
+    done_.push_back(Completion{token, nullptr, code, std::move(message)});
+  }
+  std::vector<Completion> take() { return std::exchange(done_, {}); }
+
+ private:
+  std::uint64_t last_token_ = 0;
+  std::vector<Completion> done_;
+};
+
+// Per-connection state a method may read or change.
 struct Session {
   Access access = Access::control;
   int subscribe_interval_ms = 0;    // 0: not subscribed to status updates
   std::vector<std::string> fields;  // top-level status fields wanted; empty = all
+  // Set by a handler whose answer comes later; the dispatcher then files the request's id
+  // under it in `open_requests` and sends nothing now.
+  std::uint64_t defer_token = 0;
+  std::vector<std::pair<std::uint64_t, nlohmann::json>> open_requests;  // token, request id
+  bool in_batch = false;
 };
 
 class RpcDispatcher {

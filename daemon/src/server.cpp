@@ -32,8 +32,13 @@ bool fill_address(const std::string& path, sockaddr_un& addr) {
 }  // namespace
 
 Server::Server(const RpcDispatcher& dispatcher, AccessPolicy policy,
-               std::function<nlohmann::json()> status, const EventLog& events)
-    : dispatcher_(dispatcher), policy_(policy), status_(std::move(status)), events_(events) {}
+               std::function<nlohmann::json()> status, const EventLog& events,
+               Completions& completions)
+    : dispatcher_(dispatcher),
+      policy_(policy),
+      status_(std::move(status)),
+      events_(events),
+      completions_(completions) {}
 
 Server::~Server() {
   close();
@@ -277,6 +282,29 @@ void Server::push_updates(Clock::time_point now) {
   }
 }
 
+void Server::deliver_completions() {
+  for (auto& done : completions_.take()) {
+    for (auto& client : clients_) {
+      auto& open = client.session.open_requests;
+      const auto it = std::find_if(open.begin(), open.end(),
+                                   [&](const auto& entry) { return entry.first == done.token; });
+      if (it == open.end()) continue;
+      nlohmann::json response = {{"jsonrpc", "2.0"}, {"id", it->second}};
+      if (done.error_code == 0) {
+        response["result"] = std::move(done.result);
+      } else {
+        response["error"] = RpcDispatcher::error_object(done.error_code, done.error_message);
+      }
+      open.erase(it);
+      if (client.closing) break;
+      client.out += response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      client.out += '\n';
+      write_client(client);
+      break;
+    }
+  }
+}
+
 void Server::push_events() {
   const std::uint64_t last = events_.last_seq();
   for (auto& client : clients_) {
@@ -314,6 +342,7 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
     }
     if (fds[0].revents & POLLIN) accept_clients();
   }
+  deliver_completions();
   push_events();
   push_updates(Clock::now());
   std::erase_if(clients_, [](const Client& client) {

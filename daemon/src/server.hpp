@@ -29,8 +29,9 @@ class Server {
 
   // `status` produces the full status object for subscriptions (called at most once a loop);
   // every entry added to `events` is pushed to every client as an "event" notification.
+  // Answers posted to `completions` go to the clients whose requests are waiting for them.
   Server(const RpcDispatcher& dispatcher, AccessPolicy policy,
-         std::function<nlohmann::json()> status, const EventLog& events);
+         std::function<nlohmann::json()> status, const EventLog& events, Completions& completions);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -64,12 +65,14 @@ class Server {
   void write_client(Client& client);
   void push_updates(Clock::time_point now);
   void push_events();
+  void deliver_completions();
   int next_update_in_ms(Clock::time_point now) const;
 
   const RpcDispatcher& dispatcher_;
   AccessPolicy policy_;
   std::function<nlohmann::json()> status_;
   const EventLog& events_;
+  Completions& completions_;
   int listen_fd_ = -1;
   std::string path_;  // empty when the socket was handed over
   std::vector<Client> clients_;

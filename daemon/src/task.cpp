@@ -47,9 +47,10 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
 
 // One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
 // from one program to the next.
-Task::Task(const config::MachineConfig& config, EventLog& events)
+Task::Task(const config::MachineConfig& config, EventLog& events, Completions& completions)
     : config_(config),
       events_(events),
+      completions_(completions),
       motion_(config),
       feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
       interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))) {}
@@ -146,6 +147,35 @@ void Task::run_program() {
   if (auto error = interp_->open(program_path_)) {
     throw RpcError(kProgramError, error->to_string());
   }
+  start_run(Mode::automatic, status);
+  started_at_ = Clock::now();
+  elapsed_s_ = 0;
+  last_result_.clear();
+  last_error_.clear();
+  events_.add("info", "program", program_path_ + " started");
+  feed();
+}
+
+void Task::mdi(const std::string& line, std::uint64_t token) {
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  const auto status = motion_.status();
+  if (status.machine != motion::MachineState::on) throw RpcError(kWrongState, "machine is not on");
+  if (status.motion != motion::MotionState::idle) throw RpcError(kBusy, "the machine is moving");
+  if (!config_.no_force_homing && !all_homed(status)) {
+    throw RpcError(kNotHomed, "all joints must be homed before MDI");
+  }
+  if (line.find('\n') != std::string::npos || line.size() > 4096) {
+    throw RpcError(kInvalidParams, "\"line\" must be one block of at most 4096 characters");
+  }
+  if (auto error = interp_->open_mdi(line)) {
+    throw RpcError(kProgramError, error->to_string());
+  }
+  start_run(Mode::mdi, status);
+  mdi_token_ = token;
+  feed();
+}
+
+void Task::start_run(Mode mode, const motion::Status& status) {
   interp::Pose position{};
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
   interp_->set_machine_position(position);
@@ -153,13 +183,8 @@ void Task::run_program() {
   interp_done_ = false;
   moves_enqueued_ = 0;
   moves_done_base_ = status.segments_done;
+  mode_ = mode;
   exec_ = ExecState::running;
-  started_at_ = Clock::now();
-  elapsed_s_ = 0;
-  last_result_.clear();
-  last_error_.clear();
-  events_.add("info", "program", program_path_ + " started");
-  feed();
 }
 
 void Task::pause() {
@@ -174,12 +199,27 @@ void Task::resume() {
   exec_ = ExecState::running;
 }
 
-void Task::abort() {
+void Task::abort(std::uint64_t token) {
   motion_.abort();
   if (exec_ != ExecState::idle) finish_program("aborted", "aborted by request");
+  if (token != 0) abort_tokens_.push_back(token);
 }
 
 void Task::finish_program(const std::string& result, const std::string& error) {
+  if (mode_ == Mode::mdi) {
+    exec_ = ExecState::idle;
+    mode_ = Mode::manual;
+    if (result == "done") {
+      completions_.complete(mdi_token_, nlohmann::json{{"ok", true}});
+    } else {
+      events_.add(result == "error" ? "error" : "warning", "mdi",
+                  error.empty() ? result : result + ": " + error);
+      completions_.fail(mdi_token_, result == "error" ? kProgramError : kWrongState,
+                        result + (error.empty() ? "" : ": " + error));
+    }
+    mdi_token_ = 0;
+    return;
+  }
   // Offsets set by the program (G10, G92 ...) survive a crash or power loss.
   if (const auto save_error = interp_->save_parameters()) {
     events_.add("error", "parameters", save_error->to_string());
@@ -231,6 +271,12 @@ void Task::feed() {
 void Task::poll() {
   drain_servo_events();
   const auto status = motion_.status();
+  // program.abort answers once the machine has come to rest.
+  if (!abort_tokens_.empty() && status.motion == motion::MotionState::idle && status.queued == 0) {
+    for (const auto token : abort_tokens_)
+      completions_.complete(token, nlohmann::json{{"ok", true}});
+    abort_tokens_.clear();
+  }
   if (exec_ == ExecState::idle) return;
   if (status.machine != motion::MachineState::on) {
     finish_program("aborted", status.fault_reason[0] != '\0' ? status.fault_reason

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -18,14 +19,17 @@
 #include "cncd/motion/controller.hpp"
 #include "event_log.hpp"
 #include "feeder.hpp"
+#include "rpc.hpp"
 
 namespace cncd::daemon {
 
 enum class ExecState { idle, running, paused };
+enum class Mode { manual, automatic, mdi };
 
 class Task {
  public:
-  Task(const config::MachineConfig& config, EventLog& events);
+  // `completions` receives the answers of mdi.execute and program.abort once they finish.
+  Task(const config::MachineConfig& config, EventLog& events, Completions& completions);
   ~Task();
   Task(const Task&) = delete;
   Task& operator=(const Task&) = delete;
@@ -45,7 +49,10 @@ class Task {
   void run_program();
   void pause();
   void resume();
-  void abort();
+  // Stops under control; the answer under `token` (if not 0) is posted once at rest.
+  void abort(std::uint64_t token = 0);
+  // Executes one MDI block; the answer under `token` is posted when it has finished.
+  void mdi(const std::string& line, std::uint64_t token);
 
   // Feeds the planner from the interpreter, notices the end of a program, logs servo events.
   // Called every loop iteration.
@@ -61,16 +68,21 @@ class Task {
 
  private:
   void feed();
+  void start_run(Mode mode, const motion::Status& status);
   void drain_servo_events();
   void finish_program(const std::string& result, const std::string& error);
   bool all_homed(const motion::Status& status) const;
 
   const config::MachineConfig& config_;
   EventLog& events_;
+  Completions& completions_;
   motion::MotionController motion_;
   std::unique_ptr<ProgramFeeder> feeder_;
   std::unique_ptr<interp::Interpreter> interp_;
   ExecState exec_ = ExecState::idle;
+  Mode mode_ = Mode::manual;
+  std::uint64_t mdi_token_ = 0;
+  std::vector<std::uint64_t> abort_tokens_;
   std::string program_path_;
   std::uint64_t program_lines_ = 0;
   bool interp_done_ = false;

@@ -91,6 +91,9 @@ json Task::status() const {
   return json{
       {"state", machine_state_name(s.machine)},
       {"exec", exec_state_name(exec_)},
+      {"mode", mode_ == Mode::mdi         ? "mdi"
+               : mode_ == Mode::automatic ? "auto"
+                                          : "manual"},
       {"motion", motion_state_name(s.motion)},
       {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
       {"homed", homed},

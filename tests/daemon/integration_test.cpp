@@ -139,6 +139,45 @@ TEST_F(DaemonTest, EstopDuringMotionStopsTheProgram) {
   EXPECT_LT(x, 200.0);
 }
 
+TEST_F(DaemonTest, MdiAnswersOnceTheLineHasFinished) {
+  ready_machine();
+  const json r = client_.call("mdi.execute", {{"line", "G21 G90 G1 F1200 X10 Y-2"}}, 20000);
+  ASSERT_TRUE(r.contains("result")) << r.dump();
+  // Answered after the move: the machine is already there and at rest.
+  const json s = result(client_.call("status.get"));
+  EXPECT_EQ(s["position"]["commanded"]["x"], 10.0);
+  EXPECT_EQ(s["position"]["commanded"]["y"], -2.0);
+  EXPECT_EQ(s["motion"], "idle");
+  EXPECT_EQ(s["exec"], "idle");
+  // Modal state carries over from one MDI line to the next, as in LinuxCNC.
+  ASSERT_TRUE(client_.call("mdi.execute", {{"line", "G91 X1"}}, 20000).contains("result"));
+  EXPECT_EQ(result(client_.call("status.get"))["position"]["commanded"]["x"], 11.0);
+}
+
+TEST_F(DaemonTest, MdiErrorsComeBackAsErrors) {
+  ready_machine();
+  const json r = client_.call("mdi.execute", {{"line", "G1 X5"}});  // no feed rate yet
+  ASSERT_TRUE(r.contains("error")) << r.dump();
+  EXPECT_EQ(r["error"]["code"], 1003);
+  const json batch = client_.call("mdi.execute", {{"line", "G0 X1\nG0 X2"}});
+  EXPECT_EQ(batch["error"]["code"], -32602);
+}
+
+TEST_F(DaemonTest, AbortAnswersOnceTheMachineHasStopped) {
+  ready_machine();
+  const auto program = dir_.write("long.ngc", "G21 G90 G1 F3000 X250\nM2\n");
+  result(client_.call("program.open", {{"path", program.string()}}));
+  result(client_.call("program.run"));
+  wait_until([](const json& s) { return s["velocity"].get<double>() > 40.0; });
+  ASSERT_TRUE(client_.call("program.abort").contains("result"));
+  const json s = result(client_.call("status.get"));
+  EXPECT_EQ(s["motion"], "idle");
+  EXPECT_EQ(s["velocity"], 0.0);
+  EXPECT_EQ(s["exec"], "idle");
+  EXPECT_EQ(s["program"]["result"], "aborted");
+  EXPECT_LT(s["position"]["commanded"]["x"].get<double>(), 250.0);
+}
+
 TEST_F(DaemonTest, MalformedLineKeepsConnectionUsable) {
   client_.send_raw("{this is not json\n");
   const json error = json::parse(client_.read_line());
