@@ -1,0 +1,58 @@
+// Joints on Modbus TCP/RTU drives (DRIVER = modbus). Each [MODBUS_n] bus has its own I/O
+// thread; the servo thread only swaps setpoints and readbacks through lock-free mailboxes, so
+// a slow or dead drive makes feedback stale (a fault), never a late servo period.
+//
+// Faults (timeout, exception reply, lost connection, the drive's fault bit, stale feedback)
+// latch: the drive gets no further setpoints and reports JointFeedback::fault until the servo
+// turns the drives on again (a rising edge of JointCommand::enable), which also pulses the
+// drive's fault-reset bit. The bus reconnects by itself meanwhile.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "cncd/drivers/driver.hpp"
+
+namespace cncd::drivers {
+
+class ModbusBus;
+
+class ModbusDriver final : public Driver {
+ public:
+  ModbusDriver();
+  ~ModbusDriver() override;
+
+  std::string configure(const config::MachineConfig& machine,
+                        const std::vector<int>& joints) override;
+  // Non-RT: starts the bus threads and waits (up to 1 s) for a first readback, so the servo
+  // starts from the drives' real positions.
+  void enable() override;
+  void disable() override;
+  void write(const JointCommand* commands, int count) noexcept override;
+  void read(JointFeedback* feedback, int count) noexcept override;
+  bool fault_reason(char* out, std::size_t size) const noexcept override;
+  std::uint32_t capabilities() const noexcept override { return kCapPositionFeedback; }
+  const char* name() const noexcept override { return "modbus"; }
+
+  // Any thread: update cycles completed by the bus serving the joint at `index`.
+  std::uint64_t bus_cycles(int index) const noexcept;
+
+ private:
+  struct Slot {
+    ModbusBus* bus = nullptr;
+    std::size_t drive = 0;
+    double scale = 1;
+    std::int64_t stale_ns = 0;
+    bool enabled = false;  // servo thread: enable of the last write
+    std::uint32_t reset_request = 0;
+    std::int64_t counts = 0;  // last readback, kept when the mailbox is busy
+    std::int64_t time_ns = 0;
+    std::uint32_t reset_ack = 0;
+    bool fault = false;
+  };
+  std::vector<std::unique_ptr<ModbusBus>> buses_;
+  std::vector<Slot> slots_;
+};
+
+}  // namespace cncd::drivers

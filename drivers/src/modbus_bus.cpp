@@ -1,0 +1,216 @@
+#include "modbus_bus.hpp"
+
+#include <modbus/modbus.h>
+#include <time.h>
+
+#include <cerrno>
+#include <cstdio>
+
+namespace cncd::drivers {
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+modbus_t* as_ctx(void* p) {
+  return static_cast<modbus_t*>(p);
+}
+
+void encode(std::int64_t counts, const DriveSettings& d, std::uint16_t* regs) {
+  if (!d.wide) {
+    regs[0] = static_cast<std::uint16_t>(static_cast<std::int16_t>(counts));
+    return;
+  }
+  const auto value = static_cast<std::uint32_t>(static_cast<std::int32_t>(counts));
+  const auto high = static_cast<std::uint16_t>(value >> 16);
+  const auto low = static_cast<std::uint16_t>(value & 0xffffu);
+  regs[0] = d.high_first ? high : low;
+  regs[1] = d.high_first ? low : high;
+}
+
+std::int64_t decode(const std::uint16_t* regs, const DriveSettings& d) {
+  if (!d.wide) return static_cast<std::int16_t>(regs[0]);
+  const std::uint32_t high = d.high_first ? regs[0] : regs[1];
+  const std::uint32_t low = d.high_first ? regs[1] : regs[0];
+  return static_cast<std::int32_t>((high << 16) | low);
+}
+
+// An exception reply: the drive answered, the request was wrong; the link itself is fine.
+bool is_exception(int error) {
+  return error >= EMBXILFUN && error <= EMBXGTAR;
+}
+
+}  // namespace
+
+ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives)
+    : bus_(std::move(bus)),
+      drives_(std::move(drives)),
+      setpoints_(std::make_unique<Seqlock<Setpoint>[]>(drives_.size())),
+      readbacks_(std::make_unique<Seqlock<Readback>[]>(drives_.size())),
+      state_(drives_.size()) {}
+
+ModbusBus::~ModbusBus() {
+  stop();
+}
+
+void ModbusBus::start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void ModbusBus::stop() {
+  if (running_.exchange(false)) thread_.join();
+  disconnect();
+}
+
+bool ModbusBus::connect() {
+  modbus_t* ctx = bus_.rtu ? modbus_new_rtu(bus_.device.c_str(), bus_.baud, bus_.parity,
+                                            bus_.data_bits, bus_.stop_bits)
+                           : modbus_new_tcp(bus_.host.c_str(), bus_.port);
+  if (ctx == nullptr) return false;
+  const auto timeout_us = static_cast<std::uint32_t>(bus_.timeout_ms) * 1000u;
+  modbus_set_response_timeout(ctx, timeout_us / 1'000'000u, timeout_us % 1'000'000u);
+  if (modbus_connect(ctx) != 0) {
+    modbus_free(ctx);
+    return false;
+  }
+  ctx_ = ctx;
+  link_failed_ = false;
+  return true;
+}
+
+void ModbusBus::disconnect() {
+  if (ctx_ == nullptr) return;
+  modbus_close(as_ctx(ctx_));
+  modbus_free(as_ctx(ctx_));
+  ctx_ = nullptr;
+}
+
+void ModbusBus::fail(std::size_t index, const char* what, int first, int count, bool drop_link) {
+  const int error = errno;
+  drop_link = drop_link && !is_exception(error);
+  DriveState& s = state_[index];
+  const DriveSettings& d = drives_[index];
+  if (!s.latched) {
+    char text[kFaultReasonSize];
+    const char* why = error == ETIMEDOUT ? "timeout" : modbus_strerror(error);
+    if (first < 0) {
+      std::snprintf(text, sizeof text, "modbus %s slave %d (joint %d): %s", bus_.section.c_str(),
+                    d.slave, d.joint, what);
+    } else {
+      std::snprintf(text, sizeof text, "modbus %s slave %d (joint %d): %s %d-%d: %s",
+                    bus_.section.c_str(), d.slave, d.joint, what, first, first + count - 1, why);
+    }
+    FaultText current;
+    reason_.copy(current.text.data(), current.text.size());
+    if (current.text[0] == '\0') reason_.set(text);
+  }
+  s.latched = true;
+  // A reply that is an exception or a fault bit leaves the link usable; anything else
+  // (timeout, reset, garbage) means start over with a fresh connection.
+  if (drop_link) link_failed_ = true;
+}
+
+bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
+  const DriveSettings& d = drives_[index];
+  DriveState& s = state_[index];
+  modbus_t* ctx = as_ctx(ctx_);
+  modbus_set_slave(ctx, d.slave);
+  const int width = d.wide ? 2 : 1;
+  const auto attempt = [&](auto&& request) {
+    for (int tries = 0; tries <= bus_.retries; ++tries) {
+      if (request() != -1) return true;
+      if (is_exception(errno)) return false;
+    }
+    return false;
+  };
+  std::uint16_t control = 0;
+  if (setpoint.enable && !s.latched) control |= kControlEnable;
+  if (s.pulse_reset) control |= kControlFaultReset;
+  std::uint16_t out[3] = {};
+  encode(setpoint.counts, d, out);
+  bool ok = true;
+  if (!s.latched && d.control_register == d.target_register + width) {
+    out[width] = control;
+    ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width + 1, out); });
+    if (!ok) fail(index, "writing holding registers", d.target_register, width + 1, true);
+  } else {
+    if (!s.latched) {
+      ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width, out); });
+      if (!ok) fail(index, "writing holding registers", d.target_register, width, true);
+    }
+    if (ok) {
+      ok = attempt([&] { return modbus_write_register(ctx, d.control_register, control); });
+      if (!ok) fail(index, "writing holding register", d.control_register, 1, true);
+    }
+  }
+  if (ok) s.pulse_reset = false;
+  std::uint16_t in[3] = {};
+  if (ok && d.status_register == d.position_register + width) {
+    ok = attempt(
+        [&] { return modbus_read_input_registers(ctx, d.position_register, width + 1, in); });
+    if (!ok) fail(index, "reading input registers", d.position_register, width + 1, true);
+  } else if (ok) {
+    ok =
+        attempt([&] { return modbus_read_input_registers(ctx, d.position_register, width, in); }) &&
+        attempt([&] { return modbus_read_input_registers(ctx, d.status_register, 1, in + width); });
+    if (!ok) fail(index, "reading input registers", d.position_register, width, true);
+  }
+  if (!ok) return false;
+  s.last.counts = decode(in, d);
+  s.last.status = in[width];
+  s.last.time_ns = monotonic_ns();
+  if ((s.last.status & kStatusFault) != 0 && !s.latched) {
+    fail(index, "drive reports a fault (status bit 2)", -1, 0, false);
+  }
+  return true;
+}
+
+void ModbusBus::loop() {
+  const std::int64_t period_ns = static_cast<std::int64_t>(bus_.update_period_ms) * 1'000'000;
+  std::int64_t next_ns = monotonic_ns();
+  while (running_.load(std::memory_order_relaxed)) {
+    if (ctx_ != nullptr && link_failed_) disconnect();
+    const bool connected = ctx_ != nullptr || connect();
+    for (std::size_t i = 0; i < drives_.size(); ++i) {
+      DriveState& s = state_[i];
+      Setpoint setpoint{};
+      setpoints_[i].try_load(setpoint);
+      if (setpoint.reset_request != s.reset_ack) {
+        // An explicit reset (the servo turned the drives on again): forget the latched fault,
+        // ask the drive to clear its own, and let setpoints through again.
+        s.reset_ack = setpoint.reset_request;
+        if (s.latched) s.pulse_reset = true;
+        s.latched = false;
+        reason_.clear();
+      }
+      if (!connected) {
+        if (!s.latched) {
+          errno = 0;
+          fail(i, bus_.rtu ? "cannot open the serial line" : "cannot connect", -1, 0, true);
+        }
+      } else if (!link_failed_) {
+        exchange(i, setpoint);
+      } else if (!s.latched) {
+        fail(i, "link lost while talking to another drive", -1, 0, true);
+      }
+      s.last.reset_ack = s.reset_ack;
+      s.last.fault = s.latched;
+      readbacks_[i].store(s.last);
+    }
+    cycles_.fetch_add(1, std::memory_order_relaxed);
+    next_ns += period_ns;
+    const std::int64_t now = monotonic_ns();
+    // Behind by more than a period (a timeout, a reconnect): restart the schedule from now
+    // rather than firing a burst of late updates.
+    if (now - next_ns > period_ns) next_ns = now;
+    timespec wake{static_cast<time_t>(next_ns / 1'000'000'000),
+                  static_cast<long>(next_ns % 1'000'000'000)};
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
+  }
+}
+
+}  // namespace cncd::drivers

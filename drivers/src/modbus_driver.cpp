@@ -1,0 +1,187 @@
+#include "cncd/drivers/modbus_driver.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <thread>
+
+#include "ini_lookup.hpp"
+#include "modbus_bus.hpp"
+
+namespace cncd::drivers {
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+std::string upper(std::string text) {
+  for (char& c : text)
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return text;
+}
+
+BusSettings read_bus(IniLookup& ini, int number) {
+  BusSettings b;
+  b.section = "MODBUS_" + std::to_string(number);
+  const std::string& s = b.section;
+  const std::string transport = upper(ini.text(s, "TRANSPORT").value_or("tcp"));
+  if (transport != "TCP" && transport != "RTU") ini.fail(s, "TRANSPORT", "must be tcp or rtu");
+  b.rtu = transport == "RTU";
+  b.host = ini.text(s, "HOST").value_or("");
+  b.port = static_cast<int>(ini.integer(s, "PORT", 502, 1, 65535));
+  b.device = ini.text(s, "DEVICE").value_or("");
+  b.baud = static_cast<int>(ini.integer(s, "BAUD", 19200, 300, 4'000'000));
+  const std::string parity = upper(ini.text(s, "PARITY").value_or("N"));
+  if (parity != "N" && parity != "E" && parity != "O") ini.fail(s, "PARITY", "must be N, E or O");
+  b.parity = parity.empty() ? 'N' : parity[0];
+  b.data_bits = static_cast<int>(ini.integer(s, "DATA_BITS", 8, 5, 8));
+  b.stop_bits = static_cast<int>(ini.integer(s, "STOP_BITS", 1, 1, 2));
+  b.timeout_ms = static_cast<int>(ini.integer(s, "TIMEOUT_MS", 50, 1, 10'000));
+  b.update_period_ms = static_cast<int>(ini.integer(s, "UPDATE_PERIOD_MS", 10, 1, 10'000));
+  b.retries = static_cast<int>(ini.integer(s, "RETRIES", 1, 0, 10));
+  if (!b.rtu && b.host.empty()) ini.fail(s, "HOST", "missing: TRANSPORT = tcp needs HOST");
+  if (b.rtu && b.device.empty()) ini.fail(s, "DEVICE", "missing: TRANSPORT = rtu needs DEVICE");
+  return b;
+}
+
+}  // namespace
+
+ModbusDriver::ModbusDriver() = default;
+
+ModbusDriver::~ModbusDriver() {
+  disable();
+}
+
+std::string ModbusDriver::configure(const config::MachineConfig& machine,
+                                    const std::vector<int>& joints) {
+  if (joints.size() > static_cast<std::size_t>(kMaxJoints)) return "too many joints for one driver";
+  if (!machine.ini) return "needs the machine's INI file for its [MODBUS_n] settings";
+  IniLookup ini(machine);
+  std::map<int, std::vector<std::pair<std::size_t, DriveSettings>>> by_bus;
+  slots_.assign(joints.size(), Slot{});
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const int j = joints[k];
+    const std::string s = joint_section(j);
+    if (!ini.has(s, "MODBUS")) ini.fail(s, "MODBUS", "missing: the number n of its [MODBUS_n]");
+    if (!ini.has(s, "SLAVE")) ini.fail(s, "SLAVE", "missing: the drive's unit id");
+    const int bus = static_cast<int>(ini.integer(s, "MODBUS", 0, 0, 99));
+    DriveSettings d;
+    d.joint = j;
+    d.slave = static_cast<int>(ini.integer(s, "SLAVE", 1, 1, 247));
+    d.target_register = static_cast<int>(ini.integer(s, "TARGET_REGISTER", 0, 0, 65535));
+    d.control_register = static_cast<int>(ini.integer(s, "CONTROL_REGISTER", 2, 0, 65535));
+    d.position_register = static_cast<int>(ini.integer(s, "POSITION_REGISTER", 0, 0, 65535));
+    d.status_register = static_cast<int>(ini.integer(s, "STATUS_REGISTER", 2, 0, 65535));
+    const std::string width = ini.text(s, "REGISTER_WIDTH").value_or("32");
+    if (width != "16" && width != "32") ini.fail(s, "REGISTER_WIDTH", "must be 16 or 32");
+    d.wide = width != "16";
+    const std::string order = upper(ini.text(s, "WORD_ORDER").value_or("HIGH_FIRST"));
+    if (order != "HIGH_FIRST" && order != "LOW_FIRST") {
+      ini.fail(s, "WORD_ORDER", "must be HIGH_FIRST or LOW_FIRST");
+    }
+    d.high_first = order != "LOW_FIRST";
+    slots_[k].scale = machine.joints[static_cast<std::size_t>(j)].scale;
+    if (slots_[k].scale == 0) ini.fail(s, "SCALE", "modbus joints need SCALE (counts per unit)");
+    if (!machine.ini->has_section("MODBUS_" + std::to_string(bus))) {
+      ini.fail(s, "MODBUS", "no section [MODBUS_" + std::to_string(bus) + "]");
+    }
+    by_bus[bus].emplace_back(k, d);
+  }
+  if (!ini.error().empty()) return ini.error();
+  buses_.clear();
+  for (auto& [number, members] : by_bus) {
+    BusSettings settings = read_bus(ini, number);
+    if (!ini.error().empty()) return ini.error();
+    // Feedback older than a few update periods plus one slow reply is stale.
+    const std::int64_t stale_ns =
+        (5LL * settings.update_period_ms + 2LL * settings.timeout_ms) * 1'000'000;
+    std::vector<DriveSettings> drives;
+    for (const auto& member : members)
+      drives.push_back(member.second);
+    buses_.push_back(std::make_unique<ModbusBus>(settings, std::move(drives)));
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      Slot& slot = slots_[members[i].first];
+      slot.bus = buses_.back().get();
+      slot.drive = i;
+      slot.stale_ns = stale_ns;
+    }
+  }
+  return "";
+}
+
+void ModbusDriver::enable() {
+  for (auto& bus : buses_)
+    bus->start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  for (Slot& slot : slots_) {
+    Readback rb;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (slot.bus->get_readback(slot.drive, rb) && rb.time_ns != 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+}
+
+void ModbusDriver::disable() {
+  for (auto& bus : buses_)
+    bus->stop();
+}
+
+void ModbusDriver::write(const JointCommand* commands, int count) noexcept {
+  const int n = std::min(count, static_cast<int>(slots_.size()));
+  for (int i = 0; i < n; ++i) {
+    Slot& slot = slots_[static_cast<std::size_t>(i)];
+    if (commands[i].enable && !slot.enabled) ++slot.reset_request;
+    slot.enabled = commands[i].enable;
+    const double counts = std::clamp(std::round(commands[i].position * slot.scale),
+                                     double{std::numeric_limits<std::int32_t>::min()},
+                                     double{std::numeric_limits<std::int32_t>::max()});
+    slot.bus->put_setpoint(
+        slot.drive, Setpoint{static_cast<std::int64_t>(counts), slot.reset_request, slot.enabled});
+  }
+}
+
+void ModbusDriver::read(JointFeedback* feedback, int count) noexcept {
+  const std::int64_t now = monotonic_ns();
+  const int n = std::min(count, static_cast<int>(slots_.size()));
+  for (int i = 0; i < n; ++i) {
+    Slot& slot = slots_[static_cast<std::size_t>(i)];
+    Readback rb;
+    if (slot.bus->get_readback(slot.drive, rb)) {
+      slot.counts = rb.counts;
+      slot.time_ns = rb.time_ns;
+      slot.reset_ack = rb.reset_ack;
+      slot.fault = rb.fault;
+    }
+    JointFeedback& fb = feedback[i];
+    fb = JointFeedback{};
+    fb.position = static_cast<double>(slot.counts) / slot.scale;
+    // A fault from before the latest reset request is history until the bus has seen it.
+    fb.fault = slot.fault && slot.reset_ack == slot.reset_request;
+    fb.stale = slot.time_ns == 0 || now - slot.time_ns > slot.stale_ns;
+  }
+}
+
+bool ModbusDriver::fault_reason(char* out, std::size_t size) const noexcept {
+  if (size == 0) return false;
+  out[0] = '\0';
+  for (const auto& bus : buses_) {
+    bus->reason().copy(out, size);
+    if (out[0] != '\0') return true;
+  }
+  return false;
+}
+
+std::uint64_t ModbusDriver::bus_cycles(int index) const noexcept {
+  if (index < 0 || static_cast<std::size_t>(index) >= slots_.size()) return 0;
+  return slots_[static_cast<std::size_t>(index)].bus->cycles();
+}
+
+}  // namespace cncd::drivers

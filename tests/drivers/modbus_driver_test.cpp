@@ -1,0 +1,180 @@
+// The modbus driver end to end over loopback TCP (and RTU on a pseudo-terminal pair) against
+// real libmodbus servers: the simulated drives of cncd-drive-sim, run in-process.
+#include <chrono>
+#include <memory>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "cncd/drivers/drive_sim.hpp"
+#include "cncd/drivers/fault_reason.hpp"
+#include "cncd/drivers/modbus_driver.hpp"
+#include "test_util.hpp"
+
+namespace cncd::test {
+namespace {
+
+using drivers::DriveSim;
+using drivers::DriveSimOptions;
+using drivers::JointCommand;
+using drivers::JointFeedback;
+using drivers::ModbusDriver;
+
+std::string bus_section(const std::string& transport_keys) {
+  return "[MODBUS_0]\n" + transport_keys + "TIMEOUT_MS = 40\nUPDATE_PERIOD_MS = 5\nRETRIES = 1\n";
+}
+
+constexpr const char* kJointKeys = "DRIVER = modbus\nMODBUS = 0\nSLAVE = 1{j}\nSCALE = 1000\n";
+
+class ModbusDriverTest : public ::testing::Test {
+ protected:
+  void start_sim(int port = 0) {
+    DriveSimOptions options;
+    options.port = port;
+    options.first_slave = 10;
+    options.drives = 2;
+    options.lag_s = 0;
+    sim_ = std::make_unique<DriveSim>(options);
+    ASSERT_EQ(sim_->start(), "");
+  }
+  void start_driver() {
+    loaded_ = load_machine(dir_, 2, kJointKeys,
+                           bus_section("TRANSPORT = tcp\nHOST = 127.0.0.1\nPORT = " +
+                                       std::to_string(sim_->port()) + "\n"));
+    ASSERT_TRUE(loaded_.ok());
+    ASSERT_EQ(driver_.configure(*loaded_.config, {0, 1}), "");
+    driver_.enable();
+  }
+  // Plays the servo thread for `ms` periods of 1 ms; returns the last feedback.
+  void servo(int ms, double x, double y, bool enable) {
+    for (int i = 0; i < ms; ++i) {
+      driver_.read(feedback_, 2);
+      JointCommand c[2] = {{x, 0, enable}, {y, 0, enable}};
+      driver_.write(c, 2);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    driver_.read(feedback_, 2);
+  }
+  bool faulted(int joint) const { return feedback_[joint].fault || feedback_[joint].stale; }
+  std::string reason() const {
+    char text[drivers::kFaultReasonSize];
+    driver_.fault_reason(text, sizeof text);
+    return text;
+  }
+
+  ScratchDir dir_;
+  config::LoadResult loaded_;
+  std::unique_ptr<DriveSim> sim_;
+  ModbusDriver driver_;
+  JointFeedback feedback_[2];
+};
+
+TEST_F(ModbusDriverTest, SetpointsArriveAsRegisterCountsAndPositionsComeBack) {
+  start_sim();
+  start_driver();
+  servo(20, 0, 0, false);
+  EXPECT_FALSE(faulted(0) || faulted(1)) << reason();
+  servo(60, 1.234, -0.5, true);
+  EXPECT_EQ(sim_->target(10), 1234);
+  EXPECT_EQ(sim_->target(11), -500);
+  EXPECT_EQ(sim_->control(10) & 1u, 1u);
+  EXPECT_DOUBLE_EQ(feedback_[0].position, 1.234);
+  EXPECT_DOUBLE_EQ(feedback_[1].position, -0.5);
+  EXPECT_FALSE(faulted(0) || faulted(1)) << reason();
+  EXPECT_EQ(reason(), "");
+  servo(20, 1.234, -0.5, false);
+  EXPECT_EQ(sim_->control(10) & 1u, 0u);
+}
+
+TEST_F(ModbusDriverTest, KilledDriveLatchesAFaultAndWorksAgainOnlyAfterReset) {
+  start_sim();
+  const int port = sim_->port();
+  start_driver();
+  servo(40, 0.1, 0.2, true);
+  ASSERT_FALSE(faulted(0)) << reason();
+  sim_.reset();  // power cut
+  int periods = 0;
+  while (!faulted(0) && periods < 500) {
+    servo(1, 0.1, 0.2, true);
+    ++periods;
+  }
+  EXPECT_TRUE(feedback_[0].fault);
+  EXPECT_LT(periods, 100) << "a dead drive must fault within a few update periods";
+  EXPECT_NE(reason().find("slave 1"), std::string::npos) << reason();
+
+  start_sim(port);  // the drive comes back; the bus reconnects by itself
+  servo(100, 0.3, 0.4, true);
+  EXPECT_EQ(sim_->target_writes(10), 0u) << "no setpoints before an explicit reset";
+  EXPECT_EQ(sim_->control(10) & 1u, 0u);
+  EXPECT_TRUE(feedback_[0].fault) << "the fault stays latched";
+
+  servo(20, 0.3, 0.4, false);  // machine off ...
+  servo(60, 0.3, 0.4, true);   // ... and on again
+  EXPECT_FALSE(faulted(0) || faulted(1)) << reason();
+  EXPECT_EQ(sim_->target(10), 300);
+  EXPECT_EQ(sim_->target(11), 400);
+  EXPECT_EQ(reason(), "");
+}
+
+TEST_F(ModbusDriverTest, DriveFaultBitLatchesAndIsResetThroughTheControlWord) {
+  start_sim();
+  start_driver();
+  servo(30, 0, 0, true);
+  sim_->set_fault(11, true);
+  servo(40, 0, 0, true);
+  EXPECT_TRUE(feedback_[1].fault);
+  EXPECT_FALSE(feedback_[0].fault);
+  EXPECT_NE(reason().find("slave 11 (joint 1): drive reports a fault"), std::string::npos)
+      << reason();
+  sim_->set_fault(11, false);
+  servo(20, 0, 0, false);
+  servo(40, 0, 0, true);
+  EXPECT_FALSE(feedback_[1].fault) << reason();
+  EXPECT_EQ(sim_->status(11) & 4u, 0u);
+}
+
+TEST_F(ModbusDriverTest, ExceptionRepliesAndSilenceFault) {
+  start_sim();
+  start_driver();
+  servo(30, 0, 0, true);
+  sim_->set_exception(true);
+  servo(40, 0, 0, true);
+  EXPECT_TRUE(feedback_[0].fault);
+  EXPECT_NE(reason().find("Illegal data address"), std::string::npos) << reason();
+  sim_->set_exception(false);
+  servo(20, 0, 0, false);
+  servo(40, 0, 0, true);
+  EXPECT_FALSE(faulted(0)) << reason();
+  sim_->set_silent(true);
+  servo(300, 0, 0, true);
+  EXPECT_TRUE(feedback_[0].fault);
+  EXPECT_NE(reason().find("timeout"), std::string::npos) << reason();
+}
+
+TEST_F(ModbusDriverTest, RtuOverAPseudoTerminalPair) {
+  DriveSimOptions options;
+  options.rtu = true;
+  options.first_slave = 10;
+  options.lag_s = 0;
+  sim_ = std::make_unique<DriveSim>(options);
+  if (const auto error = sim_->start(); !error.empty()) GTEST_SKIP() << error;
+  loaded_ = load_machine(
+      dir_, 1, kJointKeys,
+      bus_section("TRANSPORT = rtu\nDEVICE = " + sim_->device() + "\nBAUD = 115200\nPARITY = N\n"));
+  ASSERT_TRUE(loaded_.ok());
+  ASSERT_EQ(driver_.configure(*loaded_.config, {0}), "");
+  driver_.enable();
+  for (int i = 0; i < 150; ++i) {
+    driver_.read(feedback_, 1);
+    JointCommand c{-2.5, 0, true};
+    driver_.write(&c, 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  driver_.read(feedback_, 1);
+  EXPECT_EQ(sim_->target(10), -2500);
+  EXPECT_DOUBLE_EQ(feedback_[0].position, -2.5);
+  EXPECT_FALSE(feedback_[0].fault || feedback_[0].stale) << reason();
+}
+
+}  // namespace
+}  // namespace cncd::test
