@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -37,7 +38,10 @@ void usage(std::FILE* out) {
       "  on | off         turn the machine on or off\n"
       "  home [JOINT...]  home all joints (or the given ones) and wait until homed\n"
       "  run FILE         open FILE, run it and follow it to the end\n"
-      "  abort            stop the running program\n"
+      "  pause | resume   feed hold and continue\n"
+      "  abort            stop the running program; returns once the machine is at rest\n"
+      "  mdi LINE         execute one block; returns when it has finished\n"
+      "  errors           list recent errors and events\n"
       "\n"
       "The socket defaults to $CNCD_SOCKET, else /run/cncd/cncd.sock.\n"
       "Exit status: 0 done, 1 failed, 2 refused, 64 usage, 69 cncd not reachable.\n",
@@ -170,7 +174,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     return kDone;
   }
-  if (args.size() > 1 && command != "home" && command != "run") {
+  if (args.size() > 1 && command != "home" && command != "run" && command != "mdi") {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
     return kUsage;
   }
@@ -179,6 +183,42 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "on") return simple("machine.on");
   if (command == "off") return simple("machine.off");
   if (command == "abort") return simple("program.abort");
+  if (command == "pause") return simple("program.pause");
+  if (command == "resume") return simple("program.resume");
+  if (command == "mdi") {
+    std::string line;
+    for (std::size_t i = 1; i < args.size(); ++i)
+      line += (i > 1 ? " " : "") + args[i];
+    if (line.empty()) {
+      std::fprintf(stderr, "cncctl: mdi needs a block, e.g. cncctl mdi G0 X10\n");
+      return kUsage;
+    }
+    const json response = client.call("mdi.execute", json{{"line", line}}, 24 * 3600 * 1000);
+    if (response.contains("error") && response["error"].value("code", 0) == 1003) {
+      std::fprintf(stderr, "cncctl: mdi failed: %s\n",
+                   response["error"].value("message", "").c_str());
+      return kFailed;
+    }
+    result_of(response);
+    if (json_output) std::printf("%s\n", response["result"].dump().c_str());
+    return kDone;
+  }
+  if (command == "errors") {
+    const json list = result_of(client.call("errors.list", json{{"since", 0}}));
+    if (json_output) {
+      std::printf("%s\n", list.dump(2).c_str());
+      return kDone;
+    }
+    for (const auto& e : list["events"]) {
+      const auto when = static_cast<std::time_t>(e.value("time", 0.0));
+      char stamp[32];
+      std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M:%S", std::localtime(&when));
+      std::printf("%6llu %s %-7s %-8s %s\n", static_cast<unsigned long long>(e.value("seq", 0ULL)),
+                  stamp, e.value("level", "").c_str(), e.value("kind", "").c_str(),
+                  e.value("message", "").c_str());
+    }
+    return kDone;
+  }
   if (command == "home") {
     std::vector<int> joints;
     for (std::size_t i = 1; i < args.size(); ++i) {

@@ -206,6 +206,12 @@ TEST_F(DaemonTest, CncctlRunsTheDemoSequence) {
   const auto status = cncctl({"status", "--json"});
   EXPECT_EQ(status.exit_status, 0);
   EXPECT_EQ(json::parse(status.out)["state"], "on");
+  EXPECT_EQ(cncctl({"mdi", "G0", "X1"}).exit_status, 0);
+  EXPECT_EQ(json::parse(cncctl({"status", "--json"}).out)["position"]["commanded"]["x"], 1.0);
+  EXPECT_EQ(cncctl({"mdi", "G1", "X"}).exit_status, 1);
+  const auto errors = cncctl({"errors"});
+  EXPECT_EQ(errors.exit_status, 0);
+  EXPECT_NE(errors.out.find("g81_example1.ngc finished"), std::string::npos) << errors.out;
   // A refused request exits 2, a failed program 1.
   EXPECT_EQ(cncctl({"estop"}).exit_status, 0);
   EXPECT_EQ(cncctl({"on"}).exit_status, 2);
