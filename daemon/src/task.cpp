@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 
@@ -78,7 +79,24 @@ void Task::drain_servo_events() {
 
 void Task::shutdown() {
   if (exec_ != ExecState::idle) finish_program("aborted", "daemon shutting down");
+  // Come to rest on the path before the drives go off, then keep the offsets.
+  const auto status = motion_.status();
+  if (status.motion != motion::MotionState::idle || status.queued != 0) {
+    motion_.abort();
+    const auto deadline = Clock::now() + std::chrono::seconds(5);
+    while (motion_.status().motion != motion::MotionState::idle && Clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+  motion_.machine_off();
   motion_.stop();
+  save_parameters();
+}
+
+void Task::save_parameters() {
+  if (const auto error = interp_->save_parameters()) {
+    events_.add("error", "parameters", error->to_string());
+  }
 }
 
 void Task::estop() {
@@ -206,6 +224,8 @@ void Task::abort(std::uint64_t token) {
 }
 
 void Task::finish_program(const std::string& result, const std::string& error) {
+  // Offsets set by the program or MDI (G10, G92 ...) survive a crash or power loss.
+  save_parameters();
   if (mode_ == Mode::mdi) {
     exec_ = ExecState::idle;
     mode_ = Mode::manual;
@@ -219,10 +239,6 @@ void Task::finish_program(const std::string& result, const std::string& error) {
     }
     mdi_token_ = 0;
     return;
-  }
-  // Offsets set by the program (G10, G92 ...) survive a crash or power loss.
-  if (const auto save_error = interp_->save_parameters()) {
-    events_.add("error", "parameters", save_error->to_string());
   }
   feeder_->pending.clear();
   exec_ = ExecState::idle;

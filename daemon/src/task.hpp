@@ -70,6 +70,7 @@ class Task {
   void feed();
   void start_run(Mode mode, const motion::Status& status);
   void drain_servo_events();
+  void save_parameters();
   void finish_program(const std::string& result, const std::string& error);
   bool all_homed(const motion::Status& status) const;
 

@@ -1,5 +1,7 @@
 // The real cncd process, started on a temporary socket with the simulated machine.
 #include <chrono>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
