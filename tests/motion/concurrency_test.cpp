@@ -10,21 +10,34 @@
 namespace cncd::motion {
 namespace {
 
+// Two words a slot, so a torn copy would show as a mismatch.
+struct Item {
+  std::uint64_t value;
+  std::uint64_t complement;
+};
+
 TEST(SpscRing, DeliversEverythingInOrderAcrossThreads) {
-  SpscRing<std::uint64_t, 64> ring;
+  SpscRing<Item, 64> ring;
   constexpr std::uint64_t kCount = 200'000;
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < kCount;) {
-      if (ring.push(i)) ++i;
+      if (ring.push(Item{i, ~i})) {
+        ++i;
+      } else {
+        std::this_thread::yield();
+      }
     }
   });
   std::uint64_t expected = 0;
   while (expected < kCount) {
-    std::uint64_t value;
-    if (ring.pop(value)) {
-      ASSERT_EQ(value, expected);
-      ++expected;
+    Item item;
+    if (!ring.pop(item)) {
+      std::this_thread::yield();
+      continue;
     }
+    ASSERT_EQ(item.value, expected);
+    ASSERT_EQ(item.complement, ~expected);
+    ++expected;
   }
   producer.join();
   EXPECT_EQ(ring.size(), 0u);

@@ -2,6 +2,7 @@
 // redefined without moving the motor, sequences and synchronised final moves, aborts.
 #include <cmath>
 #include <cstring>
+#include <ostream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -59,6 +60,10 @@ struct SwitchCase {
   double latch_vel;
   double home_offset;  // also where the sim's switch sits (motor position)
 };
+
+void PrintTo(const SwitchCase& c, std::ostream* os) {
+  *os << c.name;
+}
 
 class SwitchHoming : public ::testing::TestWithParam<SwitchCase> {};
 
