@@ -128,8 +128,11 @@ std::optional<SessionOutput> run_rs274(const std::filesystem::path& program,
   }
   command += " " + quote(program.string());
   const auto errors_file = work / "stderr";
-  const std::string canon_raw = run_command("cd " + quote(work.string()) + " && " + command +
-                                            " 2>" + quote(errors_file.string()));
+  // rs274 keeps its tool data in a memory-mapped file under $HOME; runs in parallel would
+  // share (and truncate) it, so each run gets its own.
+  const std::string canon_raw =
+      run_command("cd " + quote(work.string()) + " && HOME=" + quote(work.string()) + " " +
+                  command + " 2>" + quote(errors_file.string()));
   const std::string err_raw = read_file(errors_file);
   std::filesystem::remove_all(work);
 
