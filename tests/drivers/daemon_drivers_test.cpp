@@ -1,0 +1,172 @@
+// The real cncd process runs the G81 example on the simulated, the step/dir (recorded) and the
+// Modbus machine (against the cncd-drive-sim executable); all must end at the same place.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "client.hpp"
+#include "daemon_process.hpp"
+#include "test_util.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+
+const std::string kExamples = std::string(CNCD_SOURCE_DIR) + "/config/examples/";
+const std::string kProgram = std::string(CNCD_SOURCE_DIR) + "/examples/g81_example1.ngc";
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// cncd-drive-sim on a free loopback port, stopped on destruction.
+class DriveSimProcess {
+ public:
+  std::string start() {
+    int out[2];
+    if (pipe(out) != 0) return "pipe failed";
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(out[1], STDOUT_FILENO);
+      close(out[0]);
+      execl(DRIVE_SIM_BINARY, DRIVE_SIM_BINARY, "--port", "0", "--drives", "3", "--lag", "0.005",
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(out[1]);
+    std::string line;
+    char c = 0;
+    while (read(out[0], &c, 1) == 1 && c != '\n')
+      line += c;
+    close(out[0]);
+    std::smatch m;
+    if (!std::regex_search(line, m, std::regex(":([0-9]+)$"))) return "no port in: " + line;
+    port_ = std::stoi(m[1]);
+    return "";
+  }
+  ~DriveSimProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  int port() const { return port_; }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+json result(const json& response) {
+  EXPECT_TRUE(response.contains("result")) << response.dump();
+  return response.value("result", json());
+}
+
+// Runs the example program on `ini` (already adapted) and returns the final status.
+json run_example(const TempDir& dir, const std::string& ini) {
+  DaemonProcess daemon;
+  const std::string error = daemon.start(dir.path(), {"--ini", ini});
+  EXPECT_EQ(error, "");
+  if (!error.empty()) return json();
+  daemon::Client client;
+  EXPECT_EQ(client.connect(daemon.socket()), "");
+  const auto wait_until = [&](auto done) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    json s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      s = result(client.call("status.get"));
+      if (done(s)) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
+    return s;
+  };
+  result(client.call("machine.reset"));
+  result(client.call("machine.on"));
+  result(client.call("machine.home"));
+  wait_until([](const json& s) {
+    for (const auto& h : s["homed"])
+      if (!h.get<bool>()) return false;
+    return s["motion"] == "idle";
+  });
+  result(client.call("program.open", {{"path", kProgram}}));
+  result(client.call("program.run"));
+  wait_until([](const json& s) { return s["exec"] == "idle"; });
+  // Let the drives settle onto the last command.
+  return wait_until([](const json& s) {
+    const auto& a = s["position"]["actual"];
+    const auto& c = s["position"]["commanded"];
+    for (const char* axis : {"x", "y", "z"}) {
+      if (std::abs(a[axis].get<double>() - c[axis].get<double>()) > 1e-3) return false;
+    }
+    return true;
+  });
+}
+
+// The example INI with its files redirected into `dir`.
+std::string adapt(const TempDir& dir, const std::string& name,
+                  const std::vector<std::pair<std::string, std::string>>& replace) {
+  std::string text = slurp(kExamples + name);
+  for (const auto& [from, to] : replace) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  }
+  dir.write("sim_mm.tbl", slurp(kExamples + "sim_mm.tbl"));
+  dir.write("sim_mm.var", slurp(kExamples + "sim_mm.var"));
+  return dir.write(name, text).string();
+}
+
+void expect_end(const json& s, const char* driver) {
+  SCOPED_TRACE(driver);
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  for (const auto& [axis, end] : {std::pair{"x", 4.0}, {"y", 5.0}, {"z", 3.0}}) {
+    EXPECT_NEAR(s["position"]["commanded"][axis].get<double>(), end, 1e-9) << axis;
+    EXPECT_NEAR(s["position"]["actual"][axis].get<double>(), end, 1e-3) << axis;
+  }
+}
+
+TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
+  {
+    TempDir dir;
+    expect_end(run_example(dir, adapt(dir, "sim_mm.ini", {})), "sim");
+  }
+  {
+    TempDir dir;
+    const std::string vcd = (dir.path() / "steps.vcd").string();
+    const json s = run_example(
+        dir,
+        adapt(dir, "gpio_vcd_mill.ini", {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd}}));
+    expect_end(s, "gpio");
+    // cncd has stopped and flushed the recording: the pulses add up to the end position.
+    const auto changes = read_vcd(vcd);
+    EXPECT_EQ(step_stats(changes, 0).net_steps, 4 * 320);
+    EXPECT_EQ(step_stats(changes, 1).net_steps, 5 * 320);
+    EXPECT_EQ(step_stats(changes, 2).net_steps, 3 * 320);
+    EXPECT_GE(step_stats(changes, 0).min_high_ns, 5000);
+  }
+  {
+    DriveSimProcess sim;
+    ASSERT_EQ(sim.start(), "");
+    TempDir dir;
+    const json s = run_example(
+        dir,
+        adapt(dir, "modbus_sim.ini", {{"PORT = 1502", "PORT = " + std::to_string(sim.port())}}));
+    expect_end(s, "modbus");
+  }
+}
+
+}  // namespace
+}  // namespace cncd::test
