@@ -227,6 +227,14 @@ MotionController::EnqueueResult MotionController::enqueue(const Move& move) {
     impl_->enqueue_error = "machine is not on";
     return EnqueueResult::refused;
   }
+  // Homing moves the joints and an abort flushes whatever is queued: a move planned now would
+  // start from the wrong place or vanish.
+  if (status.motion == MotionState::homing || status.motion == MotionState::stopping) {
+    impl_->enqueue_error = status.motion == MotionState::homing
+                               ? "the machine is homing"
+                               : "the machine is stopping after an abort";
+    return EnqueueResult::refused;
+  }
   // With every queued segment done, the commanded position is where the next move starts
   // (after homing, an abort or a jog it differs from the last planned end).
   if (status.segments_done == impl_->enqueued) impl_->plan_end = status.commanded;

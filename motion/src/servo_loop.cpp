@@ -172,6 +172,13 @@ void ServoLoop::sync_axes_from_joints() noexcept {
   }
 }
 
+bool ServoLoop::starts_here(const Segment& segment) const noexcept {
+  for (int i = 0; i < kAxes; ++i) {
+    if (std::abs(segment.start[i] - axis_pose_[i]) > 1e-6) return false;
+  }
+  return true;
+}
+
 void ServoLoop::advance_path(double dt) noexcept {
   const bool holding = pause_requested_ || abort_requested_;
   // A period may finish one move and go on with the next: the profile's leftover time is
@@ -180,6 +187,11 @@ void ServoLoop::advance_path(double dt) noexcept {
     if (!has_active_) {
       if (abort_requested_ || !segments_.pop(active_)) break;
       has_active_ = true;
+      if (!starts_here(active_)) {
+        // Following it would jump the motors to its start: the planner is out of step.
+        latch_fault("a queued move does not start where the machine stands");
+        return;
+      }
       path_s_ = 0;
       path_v_ = 0;
       dwell_elapsed_s_ = 0;

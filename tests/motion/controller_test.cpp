@@ -125,6 +125,29 @@ TEST(MotionController, StartsAfreshAfterStop) {
   }
 }
 
+TEST(MotionController, RefusesMovesWhileHoming) {
+  auto config = small_mill();
+  config.joints[0].home_search_vel = 100;
+  config.joints[0].home_latch_vel = 10;
+  config.joints[0].home_offset = 5;  // the sim's switch: about half a second of homing
+  motion::MotionController motion(config);
+  ASSERT_EQ(motion.start(), "");
+  motion.reset_estop();
+  motion.machine_on();
+  motion.home(0xFFFFFFFFu);
+  EXPECT_EQ(motion.status().motion, motion::MotionState::homing);
+  EXPECT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::refused);
+  EXPECT_EQ(motion.enqueue_error(), "the machine is homing");
+  ASSERT_TRUE(wait_for([&] {
+    const auto s = motion.status();
+    return s.homed[0] && s.homed[1] && s.homed[2] && s.motion == motion::MotionState::idle;
+  }));
+  EXPECT_EQ(motion.status().fault_reason[0], '\0') << motion.status().fault_reason;
+  ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::queued);
+  ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; }));
+  EXPECT_EQ(motion.status().commanded[0], 1);
+}
+
 TEST(MotionController, UnavailableDriverFailsStart) {
   auto config = small_mill();
   config.joints[1].driver = "teleporter";

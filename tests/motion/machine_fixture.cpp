@@ -69,14 +69,20 @@ void VirtualMachine::ready() {
   run_until_idle();
   clear_trajectory();
   plan_end_ = status().commanded;
+  queued_ = status().segments_done;
 }
 
 void VirtualMachine::queue(const motion::Move& move) {
+  // As MotionController does: with every queued move done, the next one starts where the
+  // machine stands (after an abort that is short of the last planned end).
+  const auto s = status();
+  if (s.segments_done == queued_) plan_end_ = s.commanded;
   std::string error;
   const auto segment = planner_.plan(move, plan_end_, true, error);
   ASSERT_TRUE(segment.has_value()) << error;
   ASSERT_TRUE(loop_->segments().push(*segment));
   plan_end_ = segment->end;
+  ++queued_;
 }
 
 void VirtualMachine::cycles(int n) {

@@ -82,6 +82,7 @@ class VirtualMachine {
   std::unique_ptr<motion::ServoLoop> loop_;
   motion::Planner planner_;
   motion::AxisPose plan_end_{};
+  std::uint64_t queued_ = 0;  // moves queued since the loop started
   std::vector<motion::AxisPose> trajectory_;
 };
 

@@ -181,6 +181,22 @@ TEST(ServoLoop, SwitchHomingWithoutSwitchIsAFault) {
       << m.status().fault_reason;
 }
 
+TEST(ServoLoop, AMoveThatDoesNotStartHereIsAFaultNotAJump) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  motion::Planner planner(m.config());
+  std::string error;
+  const auto segment =
+      planner.plan(line_to(Move::Kind::feed, 10, 0, 0, 100), {5, 0, 0}, true, error);
+  ASSERT_TRUE(segment.has_value()) << error;
+  ASSERT_TRUE(m.loop().segments().push(*segment));
+  m.cycles(1);
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::off);
+  EXPECT_STREQ(s.fault_reason, "a queued move does not start where the machine stands");
+  EXPECT_EQ(s.commanded[0], 0);
+}
+
 TEST(ServoLoop, DwellTakesItsTime) {
   VirtualMachine m(small_mill());
   m.ready();

@@ -68,6 +68,7 @@ class ServoLoop {
   void stop_now(MachineState next, const char* reason) noexcept;
   void flush_queue() noexcept;
   void advance_path(double dt) noexcept;
+  bool starts_here(const Segment& segment) const noexcept;
   void advance_homing() noexcept;
   void read_drivers() noexcept;
   void check_joints() noexcept;
