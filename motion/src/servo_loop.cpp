@@ -275,6 +275,12 @@ void ServoLoop::check_joints() noexcept {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback_[k];
     char text[200];  // latch_fault() keeps what fits in Status::fault_reason
+    if (!std::isfinite(fb.position)) {
+      status_.joint_fault[k] = true;
+      std::snprintf(text, sizeof text, "joint %d: feedback position is not a number", j);
+      latch_fault(text);
+      return;
+    }
     if (fb.fault || fb.stale) {
       status_.joint_fault[k] = true;
       // The driver may know more (which drive, register or line).
@@ -304,8 +310,9 @@ void ServoLoop::check_joints() noexcept {
     const double error = std::abs(last_motor_cmd_[k] - fb.position);
     if (error > limit) {
       status_.joint_fault[k] = true;
-      std::snprintf(text, sizeof text, "joint %d: following error %.4f exceeds %.4f", j, error,
-                    limit);
+      // Clamped: printing a huge number with %f would need a large buffer.
+      std::snprintf(text, sizeof text, "joint %d: following error %.4f exceeds %.4f", j,
+                    std::min(error, 1e9), std::min(limit, 1e9));
       latch_fault(text);
       return;
     }

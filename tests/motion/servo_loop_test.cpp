@@ -197,6 +197,40 @@ TEST(ServoLoop, AMoveThatDoesNotStartHereIsAFaultNotAJump) {
   EXPECT_EQ(s.commanded[0], 0);
 }
 
+// Reports a position that is not a number, as a broken drive might.
+class NanDriver final : public drivers::Driver {
+ public:
+  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
+    return "";
+  }
+  void enable() override {}
+  void disable() override {}
+  void write(const drivers::JointCommand*, int) noexcept override {}
+  void read(drivers::JointFeedback* feedback, int count) noexcept override {
+    for (int i = 0; i < count; ++i)
+      feedback[i] = drivers::JointFeedback{};
+    if (broken) feedback[1].position = std::nan("");
+  }
+  std::uint32_t capabilities() const noexcept override { return 0; }
+  const char* name() const noexcept override { return "nan"; }
+  bool broken = false;
+};
+
+TEST(ServoLoop, FeedbackThatIsNotANumberLatches) {
+  const auto config = small_mill();
+  NanDriver driver;
+  motion::ServoLoop loop(config, {{&driver, {0, 1, 2}}});
+  for (auto kind : {Command::Kind::reset_estop, Command::Kind::on}) {
+    ASSERT_TRUE(loop.commands().push(Command{kind, 0}));
+    loop.cycle(0);
+  }
+  ASSERT_EQ(loop.status().machine, MachineState::on);
+  driver.broken = true;
+  loop.cycle(0);
+  EXPECT_EQ(loop.status().machine, MachineState::off);
+  EXPECT_STREQ(loop.status().fault_reason, "joint 1: feedback position is not a number");
+}
+
 TEST(ServoLoop, DwellTakesItsTime) {
   VirtualMachine m(small_mill());
   m.ready();
