@@ -38,6 +38,7 @@ void RecordingDriver::write(const drivers::JointCommand* commands, int count) no
   for (int i = 0; i < count; ++i)
     positions[static_cast<std::size_t>(i)] = commands[i].position;
   written_.push_back(positions);  // test code: allocation is fine here
+  enabled_ = count > 0 && commands[0].enable;
   inner_.write(commands, count);
 }
 

@@ -36,12 +36,15 @@ class RecordingDriver final : public drivers::Driver {
   std::uint32_t capabilities() const noexcept override { return capabilities_; }
   const char* name() const noexcept override { return "recording"; }
   const std::vector<motion::JointArray>& written() const { return written_; }
+  // Whether the last write enabled the drives.
+  bool enabled() const { return enabled_; }
   void clear() { written_.clear(); }
 
  private:
   drivers::Driver& inner_;
   std::uint32_t capabilities_;
   std::vector<motion::JointArray> written_;
+  bool enabled_ = false;
 };
 
 class VirtualMachine {
@@ -68,6 +71,7 @@ class VirtualMachine {
     trajectory_.clear();
     recorder_->clear();
   }
+  bool drives_enabled() const { return recorder_->enabled(); }
   // The last motor command of joint `j`; with no lag, where the simulated motor stands.
   double motor_position(int j) const;
   drivers::SimDriver& sim() { return *sim_; }

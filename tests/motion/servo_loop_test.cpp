@@ -32,7 +32,9 @@ TEST(ServoLoop, EstopStopsWithinOnePeriodAndFlushes) {
   m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
   m.queue(line_to(Move::Kind::feed, 100, 100, 0, 100));
   m.cycles(300);
+  EXPECT_TRUE(m.drives_enabled());
   m.command(Command::Kind::estop);
+  EXPECT_FALSE(m.drives_enabled());
   const auto stopped = m.status();
   EXPECT_EQ(stopped.machine, MachineState::estop);
   EXPECT_EQ(stopped.queued, 0u);
@@ -229,6 +231,55 @@ TEST(ServoLoop, FeedbackThatIsNotANumberLatches) {
   loop.cycle(0);
   EXPECT_EQ(loop.status().machine, MachineState::off);
   EXPECT_STREQ(loop.status().fault_reason, "joint 1: feedback position is not a number");
+}
+
+config::MachineConfig gantry_mill() {
+  auto config = small_mill();
+  config.coordinates = "XYYZ";
+  config.joints.insert(config.joints.begin() + 2, config.joints[1]);
+  config.joint_count = 4;
+  return config;
+}
+
+TEST(ServoLoop, GantryJointsFollowTheirAxis) {
+  VirtualMachine m(gantry_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 10, 40, -5, 100));
+  m.run_until_idle();
+  m.cycles(1);  // feedback trails the command by a period
+  const auto s = m.status();
+  EXPECT_EQ(s.joint_commanded[0], 10);
+  EXPECT_EQ(s.joint_commanded[1], 40);
+  EXPECT_EQ(s.joint_commanded[2], 40);
+  EXPECT_EQ(s.joint_commanded[3], -5);
+  EXPECT_EQ(s.actual[1], 40);
+}
+
+TEST(ServoLoop, AGantryJointHomedApartFaultsInsteadOfJumping) {
+  auto config = gantry_mill();
+  config.joints[2].home = 3;  // the twin homes elsewhere
+  VirtualMachine m(config);
+  m.ready();
+  EXPECT_EQ(m.status().joint_commanded[2], 3);
+  m.queue(line_to(Move::Kind::feed, 0, 10, 0, 100));
+  m.cycles(1);
+  EXPECT_EQ(m.status().machine, MachineState::off);
+  EXPECT_NE(std::strstr(m.status().fault_reason, "joint 2 stands apart from axis Y"), nullptr)
+      << m.status().fault_reason;
+  EXPECT_EQ(m.motor_position(2), 3);
+}
+
+TEST(ServoLoop, MachineOffStopsAtOnceAndDisables) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
+  m.cycles(200);
+  m.command(Command::Kind::off);
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::off);
+  EXPECT_EQ(s.queued, 0u);
+  EXPECT_FALSE(m.drives_enabled());
+  EXPECT_TRUE(s.homed[0]);  // not VOLATILE_HOME
 }
 
 TEST(ServoLoop, DwellTakesItsTime) {

@@ -67,8 +67,9 @@ class ServoLoop {
   void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
   void flush_queue() noexcept;
-  void advance_path(double dt) noexcept;
-  bool starts_here(const Segment& segment) const noexcept;
+  bool advance_path(double dt) noexcept;  // true: a move ran this period
+  bool starts_here(const Segment& segment) noexcept;  // false: fault latched
+  bool joints_on_their_axes() noexcept;               // false: fault latched
   void advance_homing() noexcept;
   void read_drivers() noexcept;
   void check_joints() noexcept;
