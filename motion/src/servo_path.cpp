@@ -1,0 +1,101 @@
+// The path part of the servo loop: taking queued segments and sampling them in time.
+#include "cncd/motion/servo_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "profile.hpp"
+
+namespace cncd::motion {
+
+bool ServoLoop::starts_here(const Segment& segment) noexcept {
+  for (int i = 0; i < kAxes; ++i) {
+    if (std::abs(segment.start[i] - axis_pose_[i]) > 1e-6) {
+      // Following it would jump the motors to its start: the planner is out of step.
+      latch_fault("a queued move does not start where the machine stands");
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ServoLoop::joints_on_their_axes() noexcept {
+  // Path motion drives every joint of an axis to the axis position: a gantry joint homed
+  // apart from its twin (or to another HOME) would jump.
+  for (int j = 0; j < joint_count_; ++j) {
+    const int axis = joint_axis_[static_cast<std::size_t>(j)];
+    if (axis < 0) continue;
+    if (std::abs(joints_.command[static_cast<std::size_t>(j)] -
+                 axis_pose_[static_cast<std::size_t>(axis)]) > 1e-6) {
+      char text[120];
+      std::snprintf(text, sizeof text,
+                    "joint %d stands apart from axis %c: home the joints of an axis together, "
+                    "to the same HOME",
+                    j, config::kAxisLetters[static_cast<std::size_t>(axis)]);
+      latch_fault(text);
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ServoLoop::advance_path(double dt) noexcept {
+  const bool holding = pause_requested_ || abort_requested_;
+  // Joints and axes agree at the start of a period (not between two moves inside one).
+  bool resting = !has_active_;
+  bool moved = has_active_;
+  // A period may finish one move and go on with the next: the profile's leftover time is
+  // spent on the following segment, so short moves are not slowed to one a period.
+  while (dt > 0) {
+    if (!has_active_) {
+      if (abort_requested_ || !segments_.pop(active_)) break;
+      has_active_ = true;
+      if ((resting && !joints_on_their_axes()) || !starts_here(active_)) return false;
+      resting = false;
+      moved = true;
+      path_s_ = 0;
+      path_v_ = 0;
+      dwell_elapsed_s_ = 0;
+    }
+    status_.line = active_.line;
+    bool done;
+    if (active_.kind == Segment::Kind::dwell) {
+      if (abort_requested_) {
+        done = true;
+      } else if (pause_requested_) {
+        done = false;
+        dt = 0;
+      } else {
+        const double left = active_.dwell_s - dwell_elapsed_s_;
+        done = left <= dt + 1e-12;
+        dwell_elapsed_s_ += done ? left : dt;
+        dt = done ? std::max(0.0, dt - left) : 0;
+      }
+    } else {
+      done = advance_profile(path_s_, path_v_, active_.length, holding ? 0.0 : active_.max_velocity,
+                             active_.max_acceleration, dt);
+      axis_pose_ = done ? active_.end : active_.point_at(path_s_);
+    }
+    if (!done) break;
+    has_active_ = false;
+    path_v_ = 0;
+    ++status_.segments_done;
+  }
+  status_.velocity = path_v_;
+  if (abort_requested_ && path_v_ == 0) {
+    flush_queue();
+    status_.motion = MotionState::idle;
+    return moved;
+  }
+  if (!has_active_ && segments_.size() == 0) {
+    status_.motion = MotionState::idle;
+  } else if (pause_requested_) {
+    status_.motion = path_v_ == 0 ? MotionState::paused : MotionState::pausing;
+  } else {
+    status_.motion = abort_requested_ ? MotionState::stopping : MotionState::moving;
+  }
+  return moved;
+}
+
+}  // namespace cncd::motion
