@@ -65,6 +65,29 @@ TEST(ServoLoop, PauseHoldsOnThePathAndResumeFinishes) {
   EXPECT_EQ(m.status().commanded[1], 50);
 }
 
+TEST(ServoLoop, PauseOnAnArcStaysOnTheCircle) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  Move arc;
+  arc.kind = Move::Kind::arc;
+  arc.center_first = -50;  // from (0,0) counterclockwise around (-50,0) to (-100,0)
+  arc.center_second = 0;
+  arc.end = {-100, 0, 0, 0, 0, 0, 0, 0, 0};
+  arc.turns = 1;
+  arc.feed = 100;
+  m.queue(arc);
+  m.cycles(700);
+  m.command(Command::Kind::pause);
+  m.cycles(300);
+  EXPECT_EQ(m.status().motion, MotionState::paused);
+  m.command(Command::Kind::resume);
+  m.run_until_idle();
+  for (const auto& p : m.trajectory())
+    ASSERT_NEAR(std::hypot(p[0] + 50, p[1]), 50, 1e-9);
+  EXPECT_EQ(m.status().commanded[0], -100);
+  EXPECT_EQ(m.status().commanded[1], 0);
+}
+
 TEST(ServoLoop, AbortStopsUnderControlAndFlushes) {
   VirtualMachine m(small_mill());
   m.ready();
