@@ -20,11 +20,12 @@ class Seqlock {
   void store(const T& value) noexcept {
     std::array<std::uint64_t, kWords> buffer{};
     std::memcpy(buffer.data(), &value, sizeof(T));
-    const std::uint64_t seq = seq_.load(std::memory_order_relaxed);
-    seq_.store(seq + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
+    // The acquire read-modify-write keeps the payload stores after the odd count; the release
+    // stores let a reader that sees any new word also see that count (no fences: they are
+    // invisible to ThreadSanitizer).
+    const std::uint64_t seq = seq_.fetch_add(1, std::memory_order_acquire);
     for (std::size_t i = 0; i < kWords; ++i)
-      words_[i].store(buffer[i], std::memory_order_relaxed);
+      words_[i].store(buffer[i], std::memory_order_release);
     seq_.store(seq + 2, std::memory_order_release);
   }
 
@@ -34,8 +35,7 @@ class Seqlock {
     if ((before & 1u) != 0) return false;
     std::array<std::uint64_t, kWords> buffer{};
     for (std::size_t i = 0; i < kWords; ++i)
-      buffer[i] = words_[i].load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
+      buffer[i] = words_[i].load(std::memory_order_acquire);
     if (seq_.load(std::memory_order_relaxed) != before) return false;
     std::memcpy(static_cast<void*>(&out), buffer.data(), sizeof(T));
     return true;
