@@ -171,6 +171,7 @@ void Server::read_client(Client& client) {
       start = newline + 1;
       if (!line.empty() && line.back() == '\r') line.pop_back();
       if (line.find_first_not_of(" \t") == std::string::npos) continue;
+      requests_handled_ = true;
       if (auto response = dispatcher_.handle_line(line, client.session)) {
         client.out += *response;
         client.out += '\n';
@@ -251,8 +252,13 @@ void Server::push_updates(Clock::time_point now) {
       client.last_sent = nullptr;
       continue;
     }
-    if (client.closing || now < client.next_update) continue;
-    client.next_update = now + std::chrono::milliseconds(interval);
+    // Besides the periodic check, a request that may have changed the state is followed at
+    // once by an update to every client whose interval has passed since its last one.
+    const auto period = std::chrono::milliseconds(interval);
+    const bool due =
+        now >= client.next_update || (requests_handled_ && now - client.last_update >= period);
+    if (client.closing || !due) continue;
+    client.next_update = now + period;
     // A client still holding unsent output gets the changes coalesced into a later update.
     if (!client.out.empty()) continue;
     if (status.is_null()) status = status_();
@@ -276,6 +282,7 @@ void Server::push_updates(Clock::time_point now) {
                                      {"full", client.last_sent.is_null()},
                                      {"changed", std::move(changed)}}}};
     client.last_sent = std::move(view);
+    client.last_update = now;
     client.out += update.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     client.out += '\n';
     write_client(client);
@@ -345,6 +352,7 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   deliver_completions();
   push_events();
   push_updates(Clock::now());
+  requests_handled_ = false;
   std::erase_if(clients_, [](const Client& client) {
     if (client.closing && client.out.empty()) {
       ::close(client.fd);

@@ -57,6 +57,7 @@ class Server {
     bool closing = false;           // close once `out` is flushed
     nlohmann::json last_sent;       // status as this client last saw it
     Clock::time_point next_update;  // when the next status update is due
+    Clock::time_point last_update;  // when the last one was sent
     std::uint64_t update_seq = 0;
     std::uint64_t event_seq = 0;  // last event pushed to this client
   };
@@ -76,6 +77,7 @@ class Server {
   int listen_fd_ = -1;
   std::string path_;  // empty when the socket was handed over
   std::vector<Client> clients_;
+  bool requests_handled_ = false;  // a request was served in this poll_once
 };
 
 // {"a":1,"b":{"c":2}} vs {"a":1,"b":{"c":3}} gives {"b":{"c":3}}: a JSON merge patch (RFC 7386)
