@@ -9,14 +9,10 @@
 
 #include "stepgen.hpp"
 
+#include "monotonic_clock.hpp"
+
 namespace cncd::drivers {
 namespace {
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 // Feedback older than this many servo periods means the base thread has stopped.
 constexpr std::int64_t kStaleServoPeriods = 5;

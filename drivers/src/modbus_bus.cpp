@@ -6,14 +6,10 @@
 #include <cerrno>
 #include <cstdio>
 
+#include "monotonic_clock.hpp"
+
 namespace cncd::drivers {
 namespace {
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 modbus_t* as_ctx(void* p) {
   return static_cast<modbus_t*>(p);

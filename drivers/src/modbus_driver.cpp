@@ -12,14 +12,10 @@
 #include "ini_lookup.hpp"
 #include "modbus_bus.hpp"
 
+#include "monotonic_clock.hpp"
+
 namespace cncd::drivers {
 namespace {
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 std::string upper(std::string text) {
   for (char& c : text)
