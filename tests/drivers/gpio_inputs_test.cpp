@@ -55,7 +55,7 @@ class GpioInputs : public ::testing::Test {
     return in;
   }
 
-  ScratchDir dir_;
+  TempDir dir_;
   config::LoadResult loaded_;
   GpioDriver driver_;
   drivers::VcdBackend* vcd_ = nullptr;
@@ -110,7 +110,7 @@ TEST_F(GpioInputs, ActiveLowInputsAssertWhenTheLoopOpens) {
 }
 
 TEST(GpioConfig, BadKeysAreReportedWithFileAndLine) {
-  ScratchDir dir;
+  TempDir dir;
   const auto ini =
       dir.write("bad.ini",
                 "[EMCMOT]\nSERVO_PERIOD = 1000000\n[KINS]\nKINEMATICS = trivkins\nJOINTS = 1\n"
@@ -136,7 +136,7 @@ TEST(GpioConfig, BadKeysAreReportedWithFileAndLine) {
 }
 
 TEST(GpioConfig, UnknownLinesAndDoubleUseFailConfigure) {
-  ScratchDir dir;
+  TempDir dir;
   const auto loaded =
       load_machine(dir, 1, "DRIVER = gpio\nSCALE = 10\nSTEP_LINE = 5\nDIR_LINE = GPIO5\n",
                    "[GPIO]\nCHIP = vcd:" + (dir.path() / "x.vcd").string() + "\n", kBaseNs);

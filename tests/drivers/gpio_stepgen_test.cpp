@@ -26,7 +26,7 @@ std::string stepgen_keys(const std::string& extra = "") {
          extra;
 }
 
-std::string gpio_section(const ScratchDir& dir) {
+std::string gpio_section(const TempDir& dir) {
   return "[GPIO]\nCHIP = vcd:" + (dir.path() / "steps.vcd").string() + "\n";
 }
 
@@ -53,7 +53,7 @@ double ramp(double from, double to, double t, double seconds) {
 }
 
 TEST(GpioStepgen, PulseCountsAndTimingInVirtualTime) {
-  ScratchDir dir;
+  TempDir dir;
   const auto loaded = load_machine(dir, 2, stepgen_keys(), gpio_section(dir), kBaseNs);
   ASSERT_TRUE(loaded.ok());
   GpioDriver driver;
@@ -101,7 +101,7 @@ TEST(GpioStepgen, PulseCountsAndTimingInVirtualTime) {
 }
 
 TEST(GpioStepgen, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
-  ScratchDir dir;
+  TempDir dir;
   const auto loaded = load_machine(dir, 1, stepgen_keys(), gpio_section(dir), kBaseNs);
   ASSERT_TRUE(loaded.ok());
   GpioDriver driver;
@@ -133,7 +133,7 @@ TEST(GpioStepgen, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
 }
 
 TEST(GpioStepgen, StepgenLimitsBoundTheStepRate) {
-  ScratchDir dir;
+  TempDir dir;
   const auto loaded =
       load_machine(dir, 1, stepgen_keys("STEPGEN_MAXVEL = 10\nSTEPGEN_MAXACCEL = 200\n"),
                    gpio_section(dir), kBaseNs);
@@ -161,7 +161,7 @@ TEST(GpioStepgen, StepgenLimitsBoundTheStepRate) {
 }
 
 TEST(GpioStepgen, RealTimeBaseThreadReachesTheCommand) {
-  ScratchDir dir;
+  TempDir dir;
   const auto loaded = load_machine(dir, 1, stepgen_keys(), gpio_section(dir), 20'000);
   ASSERT_TRUE(loaded.ok());
   GpioDriver driver;

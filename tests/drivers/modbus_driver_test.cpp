@@ -62,7 +62,7 @@ class ModbusDriverTest : public ::testing::Test {
     return text;
   }
 
-  ScratchDir dir_;
+  TempDir dir_;
   config::LoadResult loaded_;
   std::unique_ptr<DriveSim> sim_;
   ModbusDriver driver_;

@@ -9,24 +9,7 @@
 
 namespace cncd::test {
 
-ScratchDir::ScratchDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "cncd-drivers-XXXXXX").string();
-  if (mkdtemp(pattern.data()) == nullptr) ADD_FAILURE() << "mkdtemp failed";
-  path_ = pattern;
-}
-
-ScratchDir::~ScratchDir() {
-  std::error_code ignored;
-  std::filesystem::remove_all(path_, ignored);
-}
-
-std::filesystem::path ScratchDir::write(const std::string& name, const std::string& text) const {
-  const auto file = path_ / name;
-  std::ofstream(file) << text;
-  return file;
-}
-
-config::LoadResult load_machine(const ScratchDir& dir, int joints, const std::string& joint_keys,
+config::LoadResult load_machine(const TempDir& dir, int joints, const std::string& joint_keys,
                                 const std::string& extra, std::int64_t base_period_ns) {
   const std::string letters = std::string(config::kAxisLetters).substr(0, joints);
   std::ostringstream ini;

@@ -8,26 +8,13 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "daemon_process.hpp"
 
 namespace cncd::test {
 
-// A fresh directory under the system temp directory, removed on destruction.
-class ScratchDir {
- public:
-  ScratchDir();
-  ~ScratchDir();
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path write(const std::string& name, const std::string& text) const;
-
- private:
-  std::filesystem::path path_;
-};
-
 // A small machine: servo 1 ms, `joints` linear joints (XYZ...), each with `joint_keys` added,
 // plus `extra` sections. Returns the loaded config or fails the test with the problems.
-config::LoadResult load_machine(const ScratchDir& dir, int joints, const std::string& joint_keys,
+config::LoadResult load_machine(const TempDir& dir, int joints, const std::string& joint_keys,
                                 const std::string& extra, std::int64_t base_period_ns = 0);
 
 struct VcdChange {

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 namespace cncd::test {
@@ -63,7 +64,7 @@ bool socket_accepts(const std::string& path) {
 
 TempDir::TempDir() {
   std::string pattern = (std::filesystem::temp_directory_path() / "cncd-test-XXXXXX").string();
-  if (mkdtemp(pattern.data()) == nullptr) std::abort();
+  if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed for " + pattern);
   path_ = pattern;
 }
 
