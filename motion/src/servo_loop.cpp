@@ -45,16 +45,25 @@ void ServoLoop::set_rt_flags(bool realtime, bool memory_locked) noexcept {
   status_.rt.memory_locked = memory_locked;
 }
 
+namespace {
+// Copies `text` into a fixed buffer, cut to fit. RT-safe.
+void copy_text(char* out, std::size_t size, const char* text) noexcept {
+  const std::size_t n = strnlen(text, size - 1);
+  std::memcpy(out, text, n);
+  out[n] = '\0';
+}
+}  // namespace
+
 void ServoLoop::post(Event::Level level, const char* text) noexcept {
   Event event;
   event.level = level;
-  std::snprintf(event.text, sizeof event.text, "%s", text);
+  copy_text(event.text, sizeof event.text, text);
   events_.push(event);  // a full ring drops the event rather than wait
 }
 
 void ServoLoop::latch_fault(const char* reason) noexcept {
   if (status_.fault_reason[0] == '\0') {
-    std::snprintf(status_.fault_reason, sizeof status_.fault_reason, "%s", reason);
+    copy_text(status_.fault_reason, sizeof status_.fault_reason, reason);
     post(Event::Level::fault, reason);
   }
   stop_now(status_.machine == MachineState::estop ? MachineState::estop : MachineState::off,
