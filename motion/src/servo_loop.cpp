@@ -214,7 +214,10 @@ void ServoLoop::read_drivers() noexcept {
 }
 
 void ServoLoop::check_joints() noexcept {
-  if (status_.machine != MachineState::on) return;
+  // Feedback counts once the drives have been sent the enable: a fault latched while they were
+  // off is cleared by that enable edge, so judging it in the cycle that turns the machine on
+  // would trip over the old fault again.
+  if (status_.machine != MachineState::on || !drives_enabled_) return;
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback_[k];
@@ -265,6 +268,7 @@ void ServoLoop::check_joints() noexcept {
 
 void ServoLoop::write_drivers() noexcept {
   const bool enable = status_.machine == MachineState::on;
+  drives_enabled_ = enable;
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const double motor = joints_.command[k] + joints_.motor_offset[k];

@@ -67,7 +67,7 @@ class ServoLoop {
   void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
   void flush_queue() noexcept;
-  bool advance_path(double dt) noexcept;  // true: a move ran this period
+  bool advance_path(double dt) noexcept;              // true: a move ran this period
   bool starts_here(const Segment& segment) noexcept;  // false: fault latched
   bool joints_on_their_axes() noexcept;               // false: fault latched
   void advance_homing() noexcept;
@@ -93,6 +93,7 @@ class ServoLoop {
   Seqlock<Status> published_;
 
   Status status_{};
+  bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
   Segment active_{};
   bool has_active_ = false;
   double path_s_ = 0;
