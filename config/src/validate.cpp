@@ -74,9 +74,7 @@ void check_repeated_section(TypedReader& r, const IniSection& header, const IniS
 }
 
 // Step/dir and Modbus keys: ranges come from the key table; here, what a joint's DRIVER needs.
-// A missing key is a warning, not a problem: the file stays readable (for --check-config and
-// offline tools), and the driver refuses to start with the same message.
-constexpr const char* kRefused = "; the driver will refuse to start";
+// A machine whose driver could not start is an invalid configuration, found at load time.
 
 void check_gpio_joint(TypedReader& r, const MachineConfig& c, const std::string& s,
                       const JointConfig& j) {
@@ -91,23 +89,18 @@ void check_gpio_joint(TypedReader& r, const MachineConfig& c, const std::string&
     r.text(s, key);
   for (const char* key : {"STEP_LINE", "DIR_LINE"}) {
     const auto v = r.text(s, key);
-    if (!v || v->empty())
-      r.warning(s, key,
-                std::string("missing: DRIVER = gpio needs a line offset or name") + kRefused);
+    if (!v || v->empty()) r.problem(s, key, "missing: DRIVER = gpio needs a line offset or name");
   }
   if (j.scale == 0 && !r.failed(s, "SCALE")) {
-    r.warning(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
-              std::string("DRIVER = gpio needs SCALE (steps per unit), not 0") + kRefused);
+    r.problem(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
+              "DRIVER = gpio needs SCALE (steps per unit), not 0");
   }
   if (c.base_period_ns <= 0 && !r.failed("EMCMOT", "BASE_PERIOD")) {
-    r.warning(
-        s, "DRIVER",
-        std::string("DRIVER = gpio needs a base thread: set [EMCMOT] BASE_PERIOD") + kRefused);
+    r.problem(s, "DRIVER", "DRIVER = gpio needs a base thread: set [EMCMOT] BASE_PERIOD");
   }
   const auto chip = r.ini().value("GPIO", "CHIP");
   if (!chip || chip->empty()) {
-    r.warning(s, "DRIVER",
-              std::string("DRIVER = gpio needs [GPIO] CHIP (gpiochip0, or vcd:FILE)") + kRefused);
+    r.problem(s, "DRIVER", "DRIVER = gpio needs [GPIO] CHIP (gpiochip0, or vcd:FILE)");
   }
 }
 
@@ -118,17 +111,15 @@ void check_modbus_joint(TypedReader& r, const std::string& s, const JointConfig&
   r.choice(s, "REGISTER_WIDTH");
   r.choice(s, "WORD_ORDER");
   if (!r.given(s, "SLAVE")) {
-    r.warning(s, "DRIVER", std::string("DRIVER = modbus needs SLAVE (unit id)") + kRefused);
+    r.problem(s, "DRIVER", "DRIVER = modbus needs SLAVE (unit id)");
   }
   r.integer(s, "SLAVE");
   if (j.scale == 0 && !r.failed(s, "SCALE")) {
-    r.warning(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
-              std::string("DRIVER = modbus needs SCALE (counts per unit), not 0") + kRefused);
+    r.problem(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
+              "DRIVER = modbus needs SCALE (counts per unit), not 0");
   }
   if (!r.given(s, "MODBUS")) {
-    r.warning(
-        s, "DRIVER",
-        std::string("DRIVER = modbus needs MODBUS = n naming a [MODBUS_n] section") + kRefused);
+    r.problem(s, "DRIVER", "DRIVER = modbus needs MODBUS = n naming a [MODBUS_n] section");
     return;
   }
   const auto bus = r.integer(s, "MODBUS");

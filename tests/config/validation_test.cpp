@@ -170,9 +170,14 @@ TEST_F(ValidationTest, UnknownDriver) {
               ": [JOINT_1] DRIVER: unknown value 'ethercat'; expected one of sim, gpio, modbus",
           at(44) +
               ": [JOINT_2] DRIVER: unknown value 'ethercat'; expected one of sim, gpio, modbus"}));
-  const auto ok = load_machine_config(write("ok.ini", minimal_ini("DRIVER = GPIO\n")));
+  // Names are case-insensitive, as LinuxCNC's values are.
+  const auto ok = load_machine_config(write("ok.ini", minimal_ini("DRIVER = Sim\n")));
   ASSERT_TRUE(ok.ok());
-  EXPECT_EQ(ok.config->joints[2].driver, "gpio");
+  EXPECT_EQ(ok.config->joints[2].driver, "sim");
+  // A step/dir joint without its lines, scale, base thread and chip cannot run: refused.
+  const auto gpio = load_machine_config(write("gpio.ini", minimal_ini("DRIVER = GPIO\n")));
+  EXPECT_FALSE(gpio.ok());
+  EXPECT_FALSE(gpio.problems.empty());
 }
 
 TEST_F(ValidationTest, UnsupportedKinematics) {
