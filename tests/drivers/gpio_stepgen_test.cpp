@@ -167,6 +167,13 @@ TEST(GpioStepgen, RealTimeBaseThreadReachesTheCommand) {
   GpioDriver driver;
   ASSERT_EQ(driver.configure(*loaded.config, {0}), "");
   driver.enable();
+  // The step generator takes the first command it sees as where the motor stands; hold still at
+  // 0 until the base thread has certainly seen it, however loaded the machine is.
+  const JointCommand rest{0, 0, true};
+  while (driver.base_stats().periods < 100) {
+    driver.write(&rest, 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   auto next = std::chrono::steady_clock::now();
   double previous = 0;
   for (int i = 0; i <= 400; ++i) {
