@@ -24,6 +24,9 @@
 namespace cncd::daemon {
 
 enum class ExecState { idle, running, paused };
+
+// "G54" .. "G59.3" for coordinate system 1..9.
+std::string coord_system_name(int system);
 enum class Mode { manual, automatic, mdi };
 
 class Task {

@@ -1,5 +1,8 @@
 // Task::status(): the status snapshot as the control protocol's JSON object.
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include "task.hpp"
@@ -51,7 +54,8 @@ const char* exec_state_name(ExecState state) {
   return "idle";
 }
 
-json axes_object(const config::MachineConfig& config, const motion::AxisPose& pose) {
+template <typename Pose>
+json axes_object(const config::MachineConfig& config, const Pose& pose) {
   json out = json::object();
   for (std::size_t i = 0; i < config::kAxisLetters.size(); ++i) {
     if (!config.axes[i].present) continue;
@@ -60,7 +64,54 @@ json axes_object(const config::MachineConfig& config, const motion::AxisPose& po
   }
   return out;
 }
+
+// Machine coordinates -> work coordinates, all in machine units: the inverse of LinuxCNC's
+// machine = rotate_xy(work + g92, rotation) + g5x + tool.
+motion::AxisPose work_pose(const motion::AxisPose& machine, const interp::InterpState& st) {
+  motion::AxisPose p = machine;
+  for (std::size_t a = 0; a < p.size() && a < st.g5x_offset.size(); ++a)
+    p[a] -= st.g5x_offset[a] + st.tool_offset[a];
+  if (st.rotation_deg != 0.0) {
+    const double angle = -st.rotation_deg * std::numbers::pi / 180.0;
+    const double x = p[0] * std::cos(angle) - p[1] * std::sin(angle);
+    const double y = p[0] * std::sin(angle) + p[1] * std::cos(angle);
+    p[0] = x;
+    p[1] = y;
+  }
+  for (std::size_t a = 0; a < p.size() && a < st.g92_offset.size(); ++a)
+    p[a] -= st.g92_offset[a];
+  return p;
+}
+
+// 593 -> "G59.3": LinuxCNC's codes are ten times the number.
+std::string code_name(char letter, int code) {
+  std::string out(1, letter);
+  out += std::to_string(code / 10);
+  if (code % 10 != 0) out += "." + std::to_string(code % 10);
+  return out;
+}
+
+// The active codes in LinuxCNC's modal-group order, without the line number and empty groups.
+json active_g_codes(const interp::InterpState& st) {
+  json out = json::array();
+  for (std::size_t i = 1; i < st.gcodes.size(); ++i) {
+    if (st.gcodes[i] >= 0) out.push_back(code_name('G', st.gcodes[i]));
+  }
+  return out;
+}
+
+json active_m_codes(const interp::InterpState& st) {
+  json out = json::array();
+  for (std::size_t i = 1; i < st.mcodes.size(); ++i) {
+    if (st.mcodes[i] >= 0) out.push_back("M" + std::to_string(st.mcodes[i]));
+  }
+  return out;
+}
 }  // namespace
+
+std::string coord_system_name(int system) {
+  return code_name('G', system < 7 ? 530 + 10 * system : 584 + system);
+}
 
 std::string Task::summary() const {
   const motion::Status s = motion_.status();
@@ -88,6 +139,18 @@ json Task::status() const {
   const int line = exec_ == ExecState::idle ? 0 : s.line;
   const std::uint64_t moves =
       exec_ == ExecState::idle ? moves_completed_ : s.segments_done - moves_done_base_;
+  const double progress =
+      exec_ != ExecState::idle
+          ? (program_lines_ == 0 ? 0.0 : std::min(1.0, static_cast<double>(line) / program_lines_))
+      : last_result_ == "done" ? 1.0
+                               : 0.0;
+  const interp::InterpState st = interp_->state();
+  json tool_entry = nullptr;
+  for (const auto& entry : interp_->tools()) {
+    if (entry.number == st.tool_in_spindle && st.tool_in_spindle != 0) {
+      tool_entry = {{"diameter", entry.diameter}, {"comment", entry.comment}};
+    }
+  }
   return json{
       {"state", machine_state_name(s.machine)},
       {"exec", exec_state_name(exec_)},
@@ -102,18 +165,35 @@ json Task::status() const {
       {"position",
        {{"commanded", axes_object(config_, s.commanded)},
         {"actual", axes_object(config_, s.actual)}}},
+      {"work_position",
+       {{"commanded", axes_object(config_, work_pose(s.commanded, st))},
+        {"actual", axes_object(config_, work_pose(s.actual, st))}}},
       {"velocity", s.velocity},
       {"program",
        {{"path", program_path_},
         {"line", line},
         {"total_lines", program_lines_},
+        {"progress", progress},
         {"moves", moves},
         {"elapsed_s", elapsed},
         {"result", last_result_},
         {"error", last_error_}}},
       {"spindle", {{"direction", feeder_->spindle_direction}, {"speed", feeder_->spindle_speed}}},
       {"coolant", {{"mist", feeder_->mist}, {"flood", feeder_->flood}}},
-      {"tool", feeder_->tool},
+      {"tool",
+       {{"number", st.tool_in_spindle},
+        {"prepared", st.tool_prepared},
+        {"length_offset", axes_object(config_, st.tool_offset)},
+        {"entry", tool_entry}}},
+      {"offsets",
+       {{"coord_system", coord_system_name(st.coord_system)},
+        {"index", st.coord_system},
+        {"g5x", axes_object(config_, st.g5x_offset)},
+        {"rotation", st.rotation_deg},
+        {"g92", axes_object(config_, st.g92_offset)}}},
+      {"gcodes", active_g_codes(st)},
+      {"mcodes", active_m_codes(st)},
+      {"feed_rate", st.feed_rate},
       {"rt",
        {{"cycles", s.rt.cycles},
         {"overruns", s.rt.overruns},

@@ -225,7 +225,8 @@ struct Interpreter::Impl {
   Pose g5x_offset_{};  // active coordinate system origin, program units
   Pose g92_offset_{};
   double rotation_deg_ = 0;
-  Pose tool_offset_{};  // tool length offset, program units
+  Pose tool_offset_{};  // tool length offset, in the units it was set in (as LinuxCNC keeps it)
+  Pose tool_offset_machine_{};  // the same in machine units, for status
   int tool_in_spindle_ = 0;
   int tool_prepped_ = -1;
   std::vector<ControlFrame> control_;

@@ -16,6 +16,7 @@ std::string InterpError::to_string() const {
 }
 
 Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
+  block_.clear();  // no block has run yet: state() reports no group 0 code
   parameters_.set_predefined([this](std::string_view name) { return predefined_parameter(name); });
   if (!options_.parameter_file.empty()) {
     if (auto problem = parameters_.load(options_.parameter_file)) {

@@ -138,6 +138,10 @@ void Interpreter::Impl::apply_tool_length(int code) {
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     pos_[axis] += tool_offset_[axis] - offset[axis];
   tool_offset_ = offset;
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    tool_offset_machine_[a] = is_linear_axis(axis) ? to_machine_units(offset[a]) : offset[a];
+  }
   modal_.tool_length_code = code;
   CanonCommand& command = make(CanonKind::use_tool_length_offset);
   command.pos = tool_offset_;

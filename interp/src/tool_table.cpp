@@ -13,9 +13,15 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
   int line_number = 0;
   while (std::getline(in, text)) {
     ++line_number;
-    const auto semicolon = text.find(';');
-    if (semicolon != std::string::npos) text.resize(semicolon);
     ToolEntry entry;
+    const auto semicolon = text.find(';');
+    if (semicolon != std::string::npos) {
+      const auto first = text.find_first_not_of(" \t", semicolon + 1);
+      const auto last = text.find_last_not_of(" \t\r");
+      if (first != std::string::npos && last >= first)
+        entry.comment = text.substr(first, last - first + 1);
+      text.resize(semicolon);
+    }
     bool has_tool = false;
     std::size_t i = 0;
     while (i < text.size()) {

@@ -7,19 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "cncd/interp/canon.hpp"
+#include "cncd/interp/tool_entry.hpp"
 
 namespace cncd::interp {
-
-struct ToolEntry {
-  int number = 0;
-  int pocket = 0;
-  Pose offset{};
-  double diameter = 0;
-  double front_angle = 0;
-  double back_angle = 0;
-  int orientation = 0;
-};
 
 class ToolTable {
  public:
@@ -27,6 +17,7 @@ class ToolTable {
   std::optional<std::string> load(const std::filesystem::path& path);
   const ToolEntry* find(int number) const;
   void set(const ToolEntry& entry) { tools_[entry.number] = entry; }
+  const std::map<int, ToolEntry>& entries() const { return tools_; }
 
  private:
   std::map<int, ToolEntry> tools_;

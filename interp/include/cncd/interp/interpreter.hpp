@@ -3,6 +3,8 @@
 // CanonSink block by block.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -10,7 +12,8 @@
 #include <vector>
 
 #include "cncd/interp/canon.hpp"
-#include "cncd/interp/to_machine.hpp"  // MachineTracker, which every user of the stream needs
+#include "cncd/interp/to_machine.hpp"
+#include "cncd/interp/tool_entry.hpp"  // MachineTracker, which every user of the stream needs
 
 namespace cncd::interp {
 
@@ -33,6 +36,32 @@ struct InterpOptions {
   std::vector<std::filesystem::path> subroutine_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'
+};
+
+// What the interpreter holds between blocks, for status displays. Lengths in machine units,
+// angles in degrees. The interpreter reads ahead of motion: during a program this is the state
+// after the last block it has read, not the one the machine is executing.
+struct InterpState {
+  int line = 0;  // line of the block last executed
+  // LinuxCNC's active_g_codes: ten times the code (G59.3 -> 593), -1 = none; index 0 holds
+  // the line, 1 motion, 2 the last block's group 0 code, 3 plane, 4 cutter compensation,
+  // 5 units, 6 distance mode, 7 feed mode, 8 coordinate system, 9 tool length offset,
+  // 10 retract mode, 11 path control, 12 rotation (G68, unsupported), 13 spindle mode,
+  // 14 arc distance mode, 15 lathe diameter mode, 16 G92.3 while G92 offsets are kept.
+  std::array<int, 17> gcodes{};
+  // LinuxCNC's active_m_codes: 0 line, 1 the last block's stop code, 2 spindle, 3 the last
+  // block's tool change, 4 mist (M9 when no coolant), 5 flood, 6 overrides, 7 adaptive feed,
+  // 8 feed hold, 9 unused (-1).
+  std::array<int, 10> mcodes{};
+  int coord_system = 1;  // 1..9 = G54..G59.3
+  Pose g5x_offset{};
+  double rotation_deg = 0;  // XY rotation of the coordinate system (G10 L2 R)
+  Pose g92_offset{};
+  Pose tool_offset{};
+  int tool_in_spindle = 0;
+  int tool_prepared = -1;  // -1 = none
+  double feed_rate = 0;    // program units per minute (F)
+  double speed = 0;        // rpm (S)
 };
 
 class Interpreter {
@@ -65,6 +94,22 @@ class Interpreter {
   const std::optional<InterpError>& error() const;
   // Line number of the block last executed.
   int current_line() const;
+
+  InterpState state() const;
+  // Coordinate system `system` (1..9 = G54..G59.3) from the parameters, machine units.
+  Pose coord_system_origin(int system, double* rotation_deg = nullptr) const;
+  // Sets the origin of coordinate system `system` (1..9) for the axes in the `axes` mask
+  // (bit 0 = X), in machine units, and its XY rotation when given, as G10 L2 does. The
+  // machine stays where it is; a program position in the active system moves with it. Call
+  // between programs only.
+  void set_coord_system_origin(int system, const Pose& origin, std::uint32_t axes,
+                               std::optional<double> rotation_deg);
+
+  // The tool table as the interpreter holds it (offsets in the table's units), by number.
+  std::vector<ToolEntry> tools() const;
+  // Adds or replaces one entry, as G10 L1 does: the tool in the spindle takes a new length at
+  // its next G43. Call between programs only.
+  void set_tool(const ToolEntry& entry);
 
   // Writes the persistent parameters (coordinate systems, G28/G30 points, G92 offsets) to
   // InterpOptions::parameter_file, as LinuxCNC does when its interpreter shuts down: temp file,

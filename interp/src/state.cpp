@@ -1,0 +1,130 @@
+// What the interpreter reports of itself (active codes, offsets, tools) and the changes an
+// operator makes between programs (coordinate system origins, tool table entries).
+#include "interp_state.hpp"
+
+namespace cncd::interp {
+
+namespace {
+int plane_code(Plane plane) {
+  switch (plane) {
+    case Plane::yz:
+      return 190;
+    case Plane::xz:
+      return 180;
+    case Plane::xy:
+    default:
+      return 170;
+  }
+}
+
+int path_control_code(MotionMode mode) {
+  switch (mode) {
+    case MotionMode::exact_stop:
+      return 611;
+    case MotionMode::exact_path:
+      return 610;
+    case MotionMode::continuous:
+    default:
+      return 640;
+  }
+}
+
+bool any_nonzero(const Pose& pose) {
+  for (const double v : pose) {
+    if (v != 0.0) return true;
+  }
+  return false;
+}
+}  // namespace
+
+InterpState Interpreter::state() const {
+  const Impl& s = *impl_;
+  const ModalState& m = s.modal_;
+  InterpState out;
+  out.line = s.current_line_;
+  auto& g = out.gcodes;
+  g.fill(-1);
+  g[0] = s.current_line_;
+  g[1] = m.motion;
+  g[2] = s.block_.g_code(GGroup::non_modal);
+  g[3] = plane_code(m.plane);
+  g[4] = 400;  // cutter radius compensation is not supported: always off
+  g[5] = m.units == Units::inches ? 200 : 210;
+  g[6] = m.incremental ? 910 : 900;
+  g[7] = m.feed_mode == FeedMode::inverse_time       ? 930
+         : m.feed_mode == FeedMode::units_per_minute ? 940
+                                                     : 950;
+  g[8] = m.coord_system < 7 ? 530 + 10 * m.coord_system : 584 + m.coord_system;
+  // LinuxCNC shows G43 whenever a length offset is in force, G49 otherwise.
+  g[9] = m.tool_length_code != 490 || any_nonzero(s.tool_offset_) ? 430 : 490;
+  g[10] = m.retract_r_plane ? 990 : 980;
+  g[11] = path_control_code(m.control);
+  g[13] = 970;  // constant surface speed (G96) is not supported
+  g[14] = m.arc_incremental ? 911 : 901;
+  g[15] = 80;  // lathe diameter mode (G7) is not supported
+  if (s.parameters_.get(5210) == 1.0) g[16] = 923;
+
+  auto& mc = out.mcodes;
+  mc.fill(-1);
+  mc[0] = s.current_line_;
+  mc[1] = s.block_.m_code(MGroup::stopping);
+  mc[2] = m.spindle == SpindleDir::stopped ? 5 : m.spindle == SpindleDir::clockwise ? 3 : 4;
+  mc[3] = s.block_.m_code(MGroup::tool_change);
+  mc[4] = m.mist ? 7 : m.flood ? -1 : 9;
+  mc[5] = m.flood ? 8 : -1;
+  mc[6] = m.feed_override ? (m.speed_override ? 48 : 50) : (m.speed_override ? 51 : 49);
+  mc[7] = m.adaptive_feed ? 52 : -1;
+  mc[8] = m.feed_hold ? 53 : -1;
+
+  out.coord_system = m.coord_system;
+  out.rotation_deg = s.rotation_deg_;
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    const bool linear = is_linear_axis(axis);
+    out.g5x_offset[a] = linear ? s.to_machine_units(s.g5x_offset_[a]) : s.g5x_offset_[a];
+    out.g92_offset[a] = linear ? s.to_machine_units(s.g92_offset_[a]) : s.g92_offset_[a];
+  }
+  out.tool_offset = s.tool_offset_machine_;
+  out.tool_in_spindle = s.tool_in_spindle_;
+  out.tool_prepared = s.tool_prepped_;
+  out.feed_rate = m.feed_rate;
+  out.speed = m.speed;
+  return out;
+}
+
+Pose Interpreter::coord_system_origin(int system, double* rotation_deg) const {
+  const int base = kG5xBase + 20 * (system - 1);
+  Pose origin{};
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    origin[axis] = impl_->parameters_.get(base + static_cast<int>(axis));
+  if (rotation_deg != nullptr) *rotation_deg = impl_->parameters_.get(base + 9);
+  return origin;
+}
+
+void Interpreter::set_coord_system_origin(int system, const Pose& origin, std::uint32_t axes,
+                                          std::optional<double> rotation_deg) {
+  Impl& s = *impl_;
+  const int base = kG5xBase + 20 * (system - 1);
+  const Pose machine = s.program_to_machine(s.pos_);
+  for (int axis = 0; axis < kAxes; ++axis) {
+    if (((axes >> axis) & 1U) != 0)
+      s.parameters_.set(base + axis, origin[static_cast<std::size_t>(axis)]);
+  }
+  if (rotation_deg) s.parameters_.set(base + 9, *rotation_deg);
+  if (system != s.modal_.coord_system) return;
+  s.load_coord_system(system);
+  s.pos_ = s.machine_to_program(machine);
+}
+
+std::vector<ToolEntry> Interpreter::tools() const {
+  std::vector<ToolEntry> out;
+  for (const auto& [number, entry] : impl_->tools_.entries())
+    out.push_back(entry);
+  return out;
+}
+
+void Interpreter::set_tool(const ToolEntry& entry) {
+  impl_->tools_.set(entry);
+}
+
+}  // namespace cncd::interp

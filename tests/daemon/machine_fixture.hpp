@@ -1,0 +1,76 @@
+// A real cncd on the simulated mill, in a temporary directory of its own, with a connected
+// client and helpers to bring the machine up and wait on its status.
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "client.hpp"
+#include "daemon_process.hpp"
+
+namespace cncd::test {
+
+inline nlohmann::json result_of(const nlohmann::json& response) {
+  EXPECT_TRUE(response.contains("result")) << response.dump();
+  return response.value("result", nlohmann::json());
+}
+
+inline int error_code(const nlohmann::json& response) {
+  EXPECT_TRUE(response.contains("error")) << response.dump();
+  return response.contains("error") ? response["error"].value("code", 0) : 0;
+}
+
+class MachineTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ini_ = copy_example_machine(dir_.path());
+    ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini_.string()}), "");
+    ASSERT_EQ(client_.connect(daemon_.socket()), "");
+  }
+
+  nlohmann::json call(const std::string& method, const nlohmann::json& params = nullptr) {
+    return client_.call(method, params, 30000);
+  }
+  nlohmann::json status() { return result_of(call("status.get")); }
+
+  // Out of estop, on and homed.
+  void ready_machine() {
+    result_of(call("machine.reset"));
+    result_of(call("machine.on"));
+    result_of(call("machine.home"));
+    wait_until([](const nlohmann::json& s) {
+      for (const auto& h : s["homed"]) {
+        if (!h.get<bool>()) return false;
+      }
+      return s["motion"] == "idle";
+    });
+  }
+
+  void mdi(const std::string& line) {
+    const auto r = call("mdi.execute", {{"line", line}});
+    ASSERT_TRUE(r.contains("result")) << line << ": " << r.dump();
+  }
+
+  template <typename Predicate>
+  nlohmann::json wait_until(Predicate done, std::chrono::seconds limit = std::chrono::seconds(60)) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    nlohmann::json s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      s = status();
+      if (done(s)) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "condition not reached; last status: " << s.dump();
+    return s;
+  }
+
+  TempDir dir_;
+  std::filesystem::path ini_;
+  DaemonProcess daemon_;
+  daemon::Client client_;
+};
+
+}  // namespace cncd::test
