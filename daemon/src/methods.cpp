@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "server.hpp"
+#include "setup_methods.hpp"
 #include "version.hpp"
 
 namespace cncd::daemon {
@@ -191,6 +192,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     session.defer_token = token;
     return json();
   });
+  register_setup_methods(dispatcher, task, config);
 }
 
 }  // namespace cncd::daemon

@@ -27,6 +27,7 @@ enum RpcCode : int {
   kBusy = 1004,          // something else is running
   kPermissionDenied = 1005,
   kRequestTooLarge = 1006,
+  kFileError = 1007,  // a file (tool table, parameter file) could not be written
 };
 
 class RpcError : public std::runtime_error {

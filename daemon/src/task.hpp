@@ -63,6 +63,18 @@ class Task {
   // True while a program is being fed or motion is under way: the loop should poll often.
   bool busy() const;
 
+  // Tool table and coordinate systems (task_setup.cpp). The setters throw RpcError while a
+  // program or MDI command runs, and when the file cannot be written (nothing changes then).
+  nlohmann::json tool_list() const;
+  std::optional<interp::ToolEntry> find_tool(int number) const;
+  // Replaces or adds the entry and rewrites [EMCIO] TOOL_TABLE atomically.
+  void set_tool(const interp::ToolEntry& entry);
+  nlohmann::json offsets() const;
+  // Sets the origin of coordinate system `system` (1..9 = G54..G59.3) for the axes in `axes`
+  // (bit 0 = X), machine units, as G10 L2 does, and saves the parameter file.
+  void set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,
+                   std::optional<double> rotation_deg);
+
   nlohmann::json status() const;
   // The servo thread's cycle counter: it advances while the servo loop is alive.
   std::uint64_t servo_heartbeat() const { return motion_.status().sequence; }

@@ -217,6 +217,7 @@ struct Interpreter::Impl {
   bool opened_ = false;
   bool skipping_percent_ = false;
   bool seen_percent_ = false;
+  bool resend_g5x_ = false;  // set_coord_system_origin() changed the active system's origin
 
   ModalState modal_;
   int previous_motion_ = -1;  // the motion mode before the current block

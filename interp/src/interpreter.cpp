@@ -115,7 +115,12 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     if (!preamble_done_) {
       emit_preamble();
       run_startup_code();
+    } else if (resend_g5x_) {
+      // The active origin was changed between programs: the canon layer learns it first.
+      emit_g5x();
+      emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
     }
+    resend_g5x_ = false;
     LineSource& source = sources_.back();
     line_offset_ = source.tell();
     line_before_ = source.line_number();

@@ -114,6 +114,7 @@ void Interpreter::set_coord_system_origin(int system, const Pose& origin, std::u
   if (system != s.modal_.coord_system) return;
   s.load_coord_system(system);
   s.pos_ = s.machine_to_program(machine);
+  s.resend_g5x_ = true;
 }
 
 std::vector<ToolEntry> Interpreter::tools() const {

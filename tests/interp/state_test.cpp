@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include <unistd.h>
@@ -69,6 +70,16 @@ TEST(InterpreterState, SetCoordSystemOriginActsLikeG10L2) {
   run(interp, "G55");
   EXPECT_EQ(interp.state().g5x_offset[0], 5.0);
   EXPECT_EQ(interp.state().rotation_deg, 30.0);
+  // A change to the active system reaches the canonical stream before the next block's moves.
+  interp.set_coord_system_origin(2, Pose{8}, 0b1, std::nullopt);
+  ASSERT_FALSE(interp.open_mdi("G0 X0"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  const std::string canon = out.str();
+  const auto g5x = canon.find("SET_G5X_OFFSET(2, 8.0000");
+  EXPECT_NE(g5x, std::string::npos) << canon;
+  EXPECT_LT(g5x, canon.find("STRAIGHT_TRAVERSE")) << canon;
 }
 
 TEST(InterpreterState, ToolTableKeepsCommentsAndTakesNewEntries) {

@@ -1,0 +1,98 @@
+// The operator's setup between programs: the tool table (tool.list / tool.set) and the
+// coordinate system origins (offsets.get / offsets.set).
+#include <algorithm>
+
+#include "persist.hpp"
+#include "task.hpp"
+#include "tool_file.hpp"
+
+namespace cncd::daemon {
+
+using nlohmann::json;
+
+namespace {
+json pose_object(const config::MachineConfig& config, const interp::Pose& pose) {
+  json out = json::object();
+  for (std::size_t i = 0; i < config::kAxisLetters.size() && i < pose.size(); ++i) {
+    if (!config.axes[i].present) continue;
+    out[std::string(1, static_cast<char>(config::kAxisLetters[i] - 'A' + 'a'))] = pose[i];
+  }
+  return out;
+}
+}  // namespace
+
+json Task::tool_list() const {
+  json tools = json::array();
+  for (const auto& tool : interp_->tools()) {
+    tools.push_back({{"number", tool.number},
+                     {"pocket", tool.pocket},
+                     {"offset", pose_object(config_, tool.offset)},
+                     {"diameter", tool.diameter},
+                     {"front_angle", tool.front_angle},
+                     {"back_angle", tool.back_angle},
+                     {"orientation", tool.orientation},
+                     {"comment", tool.comment}});
+  }
+  return json{{"path", config_.tool_table.string()},
+              {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
+              {"tools", tools}};
+}
+
+std::optional<interp::ToolEntry> Task::find_tool(int number) const {
+  for (const auto& tool : interp_->tools()) {
+    if (tool.number == number) return tool;
+  }
+  return std::nullopt;
+}
+
+void Task::set_tool(const interp::ToolEntry& entry) {
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  if (config_.tool_table.empty()) {
+    throw RpcError(kWrongState, "the machine has no tool table ([EMCIO] TOOL_TABLE)");
+  }
+  auto tools = interp_->tools();
+  const auto it = std::find_if(tools.begin(), tools.end(),
+                               [&](const auto& t) { return t.number == entry.number; });
+  if (it != tools.end()) {
+    *it = entry;
+  } else {
+    tools.push_back(entry);
+    std::sort(tools.begin(), tools.end(),
+              [](const auto& a, const auto& b) { return a.number < b.number; });
+  }
+  // The file first: when it cannot be written, nothing has changed.
+  const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
+  if (!error.empty()) throw RpcError(kFileError, error);
+  interp_->set_tool(entry);
+  events_.add("info", "tools", "tool " + std::to_string(entry.number) + " changed");
+}
+
+json Task::offsets() const {
+  const interp::InterpState st = interp_->state();
+  json systems = json::array();
+  for (int system = 1; system <= 9; ++system) {
+    double rotation = 0;
+    const interp::Pose origin = interp_->coord_system_origin(system, &rotation);
+    systems.push_back({{"name", coord_system_name(system)},
+                       {"index", system},
+                       {"origin", pose_object(config_, origin)},
+                       {"rotation", rotation}});
+  }
+  return json{{"active", coord_system_name(st.coord_system)},
+              {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
+              {"systems", systems},
+              {"g92", pose_object(config_, st.g92_offset)}};
+}
+
+void Task::set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,
+                       std::optional<double> rotation_deg) {
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  interp_->set_coord_system_origin(system, origin, axes, rotation_deg);
+  if (const auto error = interp_->save_parameters()) {
+    events_.add("error", "parameters", error->to_string());
+    throw RpcError(kFileError, error->to_string());
+  }
+  events_.add("info", "offsets", coord_system_name(system) + " origin changed");
+}
+
+}  // namespace cncd::daemon
