@@ -158,8 +158,21 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     task.open_program(path->get<std::string>());
     return json{{"path", path->get<std::string>()}};
   });
-  dispatcher.add("program.run", [&task](const json&) {
-    task.run_program();
+  dispatcher.add("program.run", [&task](const json& params) {
+    const json& p = params_object(params);
+    int from_line = 0;
+    if (const auto it = p.find("from_line"); it != p.end() && !it->is_null()) {
+      if (!it->is_number_integer() || it->get<std::int64_t>() < 1 ||
+          it->get<std::int64_t>() > 100'000'000) {
+        throw RpcError(kInvalidParams, "\"from_line\" must be a line number from 1");
+      }
+      from_line = it->get<int>();
+    }
+    task.run_program(from_line);
+    return ok();
+  });
+  dispatcher.add("program.step", [&task](const json&) {
+    task.step();
     return ok();
   });
   dispatcher.add("program.pause", [&task](const json&) {

@@ -153,9 +153,13 @@ bool Task::all_homed(const motion::Status& status) const {
   return true;
 }
 
-void Task::run_program() {
+void Task::run_program(int from_line, bool step) {
   if (program_path_.empty()) throw RpcError(kProgramError, "no program is open");
   if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is already running");
+  if (from_line < 0 || static_cast<std::uint64_t>(from_line) > program_lines_) {
+    throw RpcError(kInvalidParams, "\"from_line\" must be from 1 to " +
+                                       std::to_string(program_lines_) + ", the program's length");
+  }
   const auto status = motion_.status();
   if (status.machine != motion::MachineState::on) throw RpcError(kWrongState, "machine is not on");
   if (status.motion != motion::MotionState::idle) throw RpcError(kBusy, "the machine is moving");
@@ -166,11 +170,17 @@ void Task::run_program() {
     throw RpcError(kProgramError, error->to_string());
   }
   start_run(Mode::automatic, status);
+  skip_to_line_ = from_line > 1 ? from_line : 0;
+  skip_moved_ = false;
+  stepping_ = step;
+  step_budget_ = step ? 1 : 0;
   started_at_ = Clock::now();
   elapsed_s_ = 0;
   last_result_.clear();
   last_error_.clear();
-  events_.add("info", "program", program_path_ + " started");
+  events_.add("info", "program",
+              program_path_ + (skip_to_line_ > 0 ? " started from line " + std::to_string(from_line)
+                                                 : std::string(" started")));
   feed();
 }
 
@@ -203,6 +213,9 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   moves_done_base_ = status.segments_done;
   mode_ = mode;
   exec_ = ExecState::running;
+  stepping_ = false;
+  step_budget_ = 0;
+  skip_to_line_ = 0;
 }
 
 void Task::pause() {
@@ -213,6 +226,7 @@ void Task::pause() {
 
 void Task::resume() {
   if (exec_ != ExecState::paused) throw RpcError(kWrongState, "the program is not paused");
+  stepping_ = false;
   motion_.resume();
   exec_ = ExecState::running;
 }
@@ -242,6 +256,8 @@ void Task::finish_program(const std::string& result, const std::string& error) {
   }
   feeder_->pending.clear();
   exec_ = ExecState::idle;
+  stepping_ = false;
+  skip_to_line_ = 0;
   moves_completed_ = motion_.status().segments_done - moves_done_base_;
   elapsed_s_ = std::chrono::duration<double>(Clock::now() - started_at_).count();
   last_result_ = result;
@@ -273,6 +289,7 @@ void Task::feed() {
       ++moves_enqueued_;
     }
     if (interp_done_ || feeder_->stop_seen) return;
+    if (stepping_ && step_budget_ == 0) return;
     const auto step = interp_->step(*feeder_);
     if (step == interp::Interpreter::Step::error) {
       const auto& error = interp_->error();
@@ -280,6 +297,8 @@ void Task::feed() {
       finish_program("error", error ? error->to_string() : "interpreter error");
       return;
     }
+    if (stepping_) --step_budget_;
+    if (skip_to_line_ > 0 && !skip_before_start(step == interp::Interpreter::Step::end)) return;
     if (step == interp::Interpreter::Step::end) interp_done_ = true;
   }
 }
@@ -320,7 +339,11 @@ void Task::poll() {
                 fmt::format("stopped by M0/M1/M60 at line {}", interp_->current_line()));
     return;
   }
-  if (interp_done_) finish_program("done", "");
+  if (interp_done_) {
+    finish_program("done", "");
+  } else if (stepping_ && step_budget_ == 0) {
+    exec_ = ExecState::paused;  // program.step: the line has been carried out
+  }
 }
 
 bool Task::busy() const {

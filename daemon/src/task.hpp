@@ -49,7 +49,11 @@ class Task {
   void machine_off();
   void home(std::uint32_t joint_mask);
   void open_program(const std::string& path);
-  void run_program();
+  // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
+  // `step` runs its first line only, as program.step does.
+  void run_program(int from_line = 0, bool step = false);
+  // Runs one more line of the program (from idle: the first), then pauses; resume runs on.
+  void step();
   void pause();
   void resume();
   // Stops under control; the answer under `token` (if not 0) is posted once at rest.
@@ -88,6 +92,11 @@ class Task {
   void save_parameters();
   void finish_program(const std::string& result, const std::string& error);
   bool all_homed(const motion::Status& status) const;
+  // Run from line: called after each block while lines before skip_to_line_ are read. Drops
+  // their motion (modal state, offsets and tool stay as they left them) and, at the first
+  // block of the wanted line, puts a traverse from where the machine stands to where that
+  // line starts in front of its moves. Returns false when the run has ended.
+  bool skip_before_start(bool program_ended);
 
   const config::MachineConfig& config_;
   EventLog& events_;
@@ -107,6 +116,11 @@ class Task {
   std::uint64_t moves_completed_ = 0;  // moves the last finished run completed
   std::string last_result_;            // "done" | "aborted" | "error" | "" (never ran)
   std::string last_error_;
+  int skip_to_line_ = 0;     // run from line: first line that moves, 0 = none
+  bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
+  motion::AxisPose skip_end_{};
+  bool stepping_ = false;  // program.step: one line, then pause
+  int step_budget_ = 0;    // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
 };

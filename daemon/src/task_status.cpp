@@ -174,6 +174,7 @@ json Task::status() const {
         {"line", line},
         {"total_lines", program_lines_},
         {"progress", progress},
+        {"stepping", stepping_},
         {"moves", moves},
         {"elapsed_s", elapsed},
         {"result", last_result_},

@@ -1,0 +1,50 @@
+// Running a program other than from the top: run from line and single steps.
+#include "task.hpp"
+
+namespace cncd::daemon {
+
+bool Task::skip_before_start(bool program_ended) {
+  if (interp_->current_line() < skip_to_line_) {
+    if (program_ended) {
+      motion_.abort();
+      finish_program("error", program_path_ + ": the program ends at line " +
+                                  std::to_string(interp_->current_line()) + ", before line " +
+                                  std::to_string(skip_to_line_));
+      return false;
+    }
+    for (const auto& move : feeder_->pending) {
+      if (move.kind == motion::Move::Kind::dwell) continue;
+      skip_end_ = move.end;
+      skip_moved_ = true;
+    }
+    feeder_->pending.clear();
+    feeder_->stop_seen = false;  // M0/M1 before the line do not stop a run from line
+    return true;
+  }
+  if (skip_moved_) {
+    motion::Move approach;
+    approach.kind = motion::Move::Kind::traverse;
+    approach.end = skip_end_;
+    approach.line = interp_->current_line();
+    feeder_->pending.push_front(approach);
+  }
+  skip_to_line_ = 0;
+  return true;
+}
+
+void Task::step() {
+  if (exec_ == ExecState::running) {
+    throw RpcError(kBusy, stepping_ ? "the last step is still running" : "the program is running");
+  }
+  if (exec_ == ExecState::idle) {
+    run_program(0, true);
+    return;
+  }
+  motion_.resume();
+  exec_ = ExecState::running;
+  stepping_ = true;
+  step_budget_ = 1;
+  feed();
+}
+
+}  // namespace cncd::daemon

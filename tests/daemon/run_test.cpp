@@ -1,0 +1,93 @@
+// program.run {from_line} and program.step against the real daemon.
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+
+TEST_F(MachineTest, RunFromLineKeepsModalStateOffsetsAndSkipsMotion) {
+  ready_machine();
+  const auto program = dir_.write("part.ngc",
+                                  "G21 G90\n"
+                                  "G10 L2 P1 X10\n"
+                                  "G0 X5 Y5\n"
+                                  "G91 M0\n"
+                                  "G1 F1200 X1 Y1\n"
+                                  "G90 G0 X0\n"
+                                  "M2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run", {{"from_line", 5}}));
+  const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  // The traverse to where line 5 starts (X15 Y5 in machine coordinates), line 5 (G91 kept:
+  // to X16 Y6), line 6 (G54 X0 with the origin set on line 2: machine X10). The skipped
+  // G0 of line 3 and the M0 of line 4 did nothing.
+  EXPECT_EQ(s["program"]["moves"], 3);
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), 6.0, 1e-9);
+  EXPECT_EQ(s["offsets"]["g5x"]["x"], 10.0);
+}
+
+TEST_F(MachineTest, RunFromLineOutsideTheProgramIsRefused) {
+  ready_machine();
+  const auto program = dir_.write("short.ngc", "G21 G90\nG0 X1\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  const json past = call("program.run", {{"from_line", 4}});
+  EXPECT_EQ(error_code(past), -32602);
+  EXPECT_NE(past["error"].value("message", "").find("from 1 to 3"), std::string::npos)
+      << past.dump();
+  EXPECT_EQ(error_code(call("program.run", {{"from_line", 0}})), -32602);
+  EXPECT_EQ(error_code(call("program.run", {{"from_line", "2"}})), -32602);
+  EXPECT_EQ(status()["exec"], "idle");
+}
+
+TEST_F(MachineTest, RunFromALineAfterTheProgramEndFails) {
+  ready_machine();
+  const auto program = dir_.write("ends.ngc", "G21 G90\nM2\nG0 X5\nG0 X6\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run", {{"from_line", 4}}));
+  const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "error");
+  EXPECT_NE(s["program"]["error"].get<std::string>().find("ends at line 2, before line 4"),
+            std::string::npos)
+      << s.dump();
+  EXPECT_EQ(s["position"]["commanded"]["x"], 0.0);
+}
+
+TEST_F(MachineTest, StepRunsOneLineAtATimeAndResumeRunsOn) {
+  ready_machine();
+  const auto program = dir_.write("steps.ngc", "G21 G90 G0 X1\nG0 X2\nG0 X3\nG0 X4\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.step"));
+  json s = wait_until([](const json& st) { return st["exec"] == "paused"; });
+  EXPECT_EQ(s["position"]["commanded"]["x"], 1.0);
+  EXPECT_EQ(s["program"]["stepping"], true);
+  EXPECT_EQ(s["motion"], "idle");
+  // Still there a moment later: nothing more was read.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(status()["position"]["commanded"]["x"], 1.0);
+  result_of(call("program.step"));
+  s = wait_until([](const json& st) {
+    return st["exec"] == "paused" && st["position"]["commanded"]["x"] == 2.0;
+  });
+  EXPECT_EQ(s["program"]["moves"], 2);
+  result_of(call("program.resume"));
+  s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done");
+  EXPECT_EQ(s["program"]["stepping"], false);
+  EXPECT_EQ(s["position"]["commanded"]["x"], 4.0);
+}
+
+TEST_F(MachineTest, StepWhileAStepRunsIsRefused) {
+  ready_machine();
+  const auto program = dir_.write("long.ngc", "G21 G90 G1 F600 X50\nG0 X0\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.step"));
+  EXPECT_EQ(error_code(call("program.step")), 1004);
+  result_of(call("program.abort"));
+  EXPECT_EQ(status()["program"]["result"], "aborted");
+}
+
+}  // namespace
+}  // namespace cncd::test
