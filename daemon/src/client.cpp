@@ -5,6 +5,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -50,6 +51,18 @@ void Client::send_raw(const std::string& bytes) {
 std::string Client::read_line(int timeout_ms) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          deadline - std::chrono::steady_clock::now())
+                          .count();
+    if (auto line = try_read_line(static_cast<int>(std::max<long long>(left, 0)))) return *line;
+    if (std::chrono::steady_clock::now() >= deadline)
+      throw std::runtime_error("no answer from cncd in time");
+  }
+}
+
+std::optional<std::string> Client::try_read_line(int timeout_ms) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  for (;;) {
     const std::size_t newline = buffer_.find('\n');
     if (newline != std::string::npos) {
       std::string line = buffer_.substr(0, newline);
@@ -59,10 +72,10 @@ std::string Client::read_line(int timeout_ms) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
                           deadline - std::chrono::steady_clock::now())
                           .count();
-    if (left <= 0) throw std::runtime_error("no answer from cncd in time");
+    if (left <= 0) return std::nullopt;
     pollfd pfd{fd_, POLLIN, 0};
     const int ready = ::poll(&pfd, 1, static_cast<int>(left));
-    if (ready < 0 && errno == EINTR) continue;
+    if (ready < 0 && errno == EINTR) return std::nullopt;
     if (ready <= 0) continue;
     char chunk[65536];
     const ssize_t n = ::read(fd_, chunk, sizeof chunk);

@@ -1,6 +1,7 @@
 // A blocking JSON-RPC client for the control socket (cncctl, tests).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -25,6 +26,9 @@ class Client {
   void send_raw(const std::string& bytes);
   // Reads one line, waiting up to timeout_ms. Throws std::runtime_error on failure.
   std::string read_line(int timeout_ms = 10000);
+  // The same, but returns nullopt when no line came within timeout_ms (or a signal
+  // interrupted the wait).
+  std::optional<std::string> try_read_line(int timeout_ms);
 
  private:
   int fd_ = -1;

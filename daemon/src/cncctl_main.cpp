@@ -1,7 +1,4 @@
-// cncctl: command-line client for cncd's control socket.
-//
-// Exit status: 0 done, 1 failed (the program or the machine reported a failure),
-// 2 refused (cncd declined the request), 64 usage, 69 cncd not reachable.
+// cncctl: command-line client for cncd's control socket. Exit status: see cncctl.hpp.
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,89 +12,46 @@
 #include <vector>
 
 #include "client.hpp"
+#include "cncctl.hpp"
 #include "version.hpp"
 
 namespace {
 
 using nlohmann::json;
-
-constexpr int kDone = 0;
-constexpr int kFailed = 1;
-constexpr int kRefused = 2;
-constexpr int kUsage = 64;
-constexpr int kUnavailable = 69;
+using namespace cncd::cncctl;
 
 void usage(std::FILE* out) {
   std::fputs(
       "usage: cncctl [--socket PATH] [--json] COMMAND [ARGS]\n"
       "\n"
       "commands:\n"
-      "  status           show the machine's state, position and program\n"
-      "  estop            latch emergency stop\n"
-      "  reset            leave emergency stop (the machine stays off)\n"
-      "  on | off         turn the machine on or off\n"
-      "  home [JOINT...]  home all joints (or the given ones) and wait until homed\n"
-      "  run FILE         open FILE, run it and follow it to the end\n"
-      "  pause | resume   feed hold and continue\n"
-      "  abort            stop the running program; returns once the machine is at rest\n"
-      "  mdi LINE         execute one block; returns when it has finished\n"
-      "  errors           list recent errors and events\n"
+      "  status              show the machine's state, positions, tool, codes and program\n"
+      "  watch [--interval MS] [--count N]\n"
+      "                      live status view, redrawn in place until Ctrl-C\n"
+      "  estop               latch emergency stop\n"
+      "  reset               leave emergency stop (the machine stays off)\n"
+      "  on | off            turn the machine on or off\n"
+      "  home [JOINT...]     home all joints (or the given ones) and wait until homed\n"
+      "  run FILE [--from LINE]\n"
+      "                      open FILE, run it (from LINE) and follow it to the end\n"
+      "  open FILE           open FILE for run or step\n"
+      "  step [FILE]         run one more line of the open program (or of FILE) and wait\n"
+      "  pause | resume      feed hold and continue\n"
+      "  abort               stop the running program; returns once the machine is at rest\n"
+      "  mdi LINE            execute one block; returns when it has finished\n"
+      "  tools               list the tool table\n"
+      "  tools set T<n> [P<pocket>] [Z<offset> ...] [D<diameter>] [;comment]\n"
+      "                      change (or add) one tool\n"
+      "  offsets             list the coordinate systems G54..G59.3 and G92\n"
+      "  offsets set G55 [X<origin> ...] [R<rotation>]\n"
+      "                      set one coordinate system's origin (machine coordinates)\n"
+      "  errors              list recent errors and events\n"
       "\n"
+      "--json prints cncd's answer (or the final status) as JSON.\n"
       "The socket defaults to $CNCD_SOCKET, else /run/cncd/cncd.sock.\n"
-      "Exit status: 0 done, 1 failed, 2 refused, 64 usage, 69 cncd not reachable.\n",
+      "Exit status: 0 done, 1 failed (program error, fault), 2 refused (state, permission,\n"
+      "bad value), 64 usage, 69 cncd not reachable or connection lost.\n",
       out);
-}
-
-struct Refused {
-  std::string message;
-};
-
-json result_of(const json& response) {
-  if (response.contains("error")) {
-    const auto& error = response["error"];
-    throw Refused{error.value("message", std::string("error")) + " (code " +
-                  std::to_string(error.value("code", 0)) + ")"};
-  }
-  return response.value("result", json());
-}
-
-std::string axes_text(const json& axes) {
-  std::string out;
-  char buf[64];
-  for (const auto& [name, value] : axes.items()) {
-    std::snprintf(buf, sizeof buf, "%s%c %.4f", out.empty() ? "" : "  ", name[0] - 'a' + 'A',
-                  value.get<double>());
-    out += buf;
-  }
-  return out;
-}
-
-void print_status(const json& s) {
-  std::printf("state     %s\n", s.value("state", "").c_str());
-  std::printf("exec      %s (motion %s)\n", s.value("exec", "").c_str(),
-              s.value("motion", "").c_str());
-  std::string homed;
-  for (const auto& h : s["homed"])
-    homed += h.get<bool>() ? "H " : "- ";
-  std::printf("homed     %s\n", homed.c_str());
-  std::printf("commanded %s  (%s)\n", axes_text(s["position"]["commanded"]).c_str(),
-              s.value("units", "").c_str());
-  std::printf("actual    %s\n", axes_text(s["position"]["actual"]).c_str());
-  const auto& p = s["program"];
-  if (!p.value("path", "").empty()) {
-    const auto total = static_cast<unsigned long long>(p.value("total_lines", 0ULL));
-    if (s.value("exec", "") == "idle") {
-      std::printf("program   %s  (%llu lines)", p.value("path", "").c_str(), total);
-    } else {
-      std::printf("program   %s  line %d of %llu", p.value("path", "").c_str(), p.value("line", 0),
-                  total);
-    }
-    if (!p.value("result", "").empty())
-      std::printf("  last run: %s", p.value("result", "").c_str());
-    std::printf("\n");
-    if (!p.value("error", "").empty()) std::printf("error     %s\n", p.value("error", "").c_str());
-  }
-  if (!s.value("fault", "").empty()) std::printf("fault     %s\n", s.value("fault", "").c_str());
 }
 
 int wait_homed(cncd::daemon::Client& client, const std::vector<int>& joints) {
@@ -157,6 +111,40 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
   }
 }
 
+json open_program(cncd::daemon::Client& client, const std::string& file) {
+  std::error_code ec;
+  const auto path = std::filesystem::absolute(file, ec);
+  return result_of(client.call("program.open", json{{"path", path.string()}}));
+}
+
+// program.step has been sent: waits until the line has been carried out.
+int follow_step(cncd::daemon::Client& client, bool json_output) {
+  for (;;) {
+    const json s = result_of(client.call("status.get"));
+    const std::string exec = s.value("exec", "");
+    if (exec != "running") {
+      const auto& p = s["program"];
+      if (json_output) {
+        std::printf("%s\n", s.dump(2).c_str());
+      } else if (exec == "paused") {
+        std::printf("line %d/%llu  %s\n", p.value("line", 0),
+                    static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
+                    axes_text(s["work_position"]["commanded"]).c_str());
+      } else {
+        std::printf("%s; position %s\n", p.value("result", "").c_str(),
+                    axes_text(s["work_position"]["commanded"]).c_str());
+      }
+      if (exec == "idle" && p.value("result", "") != "done") {
+        std::fprintf(stderr, "cncctl: program %s: %s\n", p.value("result", "").c_str(),
+                     p.value("error", "").c_str());
+        return kFailed;
+      }
+      return kDone;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 int run_command(cncd::daemon::Client& client, const std::vector<std::string>& args,
                 bool json_output) {
   const std::string& command = args[0];
@@ -174,7 +162,10 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     return kDone;
   }
-  if (args.size() > 1 && command != "home" && command != "run" && command != "mdi") {
+  static const std::vector<std::string> kTakeArgs = {"home", "run",   "mdi",   "open",
+                                                     "step", "watch", "tools", "offsets"};
+  if (args.size() > 1 &&
+      std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
     return kUsage;
   }
@@ -232,20 +223,47 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     json params = json::object();
     if (!joints.empty()) params["joints"] = joints;
-    result_of(client.call("machine.home", params));
-    return wait_homed(client, joints);
+    const json result = result_of(client.call("machine.home", params));
+    const int status = wait_homed(client, joints);
+    if (json_output && status == kDone) std::printf("%s\n", result.dump().c_str());
+    return status;
   }
   if (command == "run") {
-    if (args.size() != 2) {
-      std::fprintf(stderr, "cncctl: run takes one program file\n");
-      return kUsage;
+    std::string file;
+    json params = json::object();
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      if (args[i] == "--from" && i + 1 < args.size()) {
+        const double line = number_arg(args[++i], "--from");
+        if (line < 1 || line != static_cast<double>(static_cast<long>(line))) {
+          throw UsageError{"--from needs a line number"};
+        }
+        params["from_line"] = static_cast<long>(line);
+      } else if (file.empty() && args[i].rfind("--", 0) != 0) {
+        file = args[i];
+      } else {
+        throw UsageError{"run takes one program file and --from LINE"};
+      }
     }
-    std::error_code ec;
-    const auto path = std::filesystem::absolute(args[1], ec);
-    result_of(client.call("program.open", json{{"path", path.string()}}));
-    result_of(client.call("program.run"));
+    if (file.empty()) throw UsageError{"run needs a program file"};
+    open_program(client, file);
+    result_of(client.call("program.run", params));
     return follow_program(client, json_output);
   }
+  if (command == "open") {
+    if (args.size() != 2) throw UsageError{"open takes one program file"};
+    const json result = open_program(client, args[1]);
+    if (json_output) std::printf("%s\n", result.dump().c_str());
+    return kDone;
+  }
+  if (command == "step") {
+    if (args.size() > 2) throw UsageError{"step takes at most one program file"};
+    if (args.size() == 2) open_program(client, args[1]);
+    result_of(client.call("program.step"));
+    return follow_step(client, json_output);
+  }
+  if (command == "watch") return watch(client, args, json_output);
+  if (command == "tools") return tools(client, args, json_output);
+  if (command == "offsets") return offsets(client, args, json_output);
   std::fprintf(stderr, "cncctl: unknown command '%s'\n", command.c_str());
   usage(stderr);
   return kUsage;
@@ -292,6 +310,9 @@ int main(int argc, char** argv) {
   } catch (const Refused& refused) {
     std::fprintf(stderr, "cncctl: %s: refused: %s\n", args[0].c_str(), refused.message.c_str());
     return kRefused;
+  } catch (const UsageError& error) {
+    std::fprintf(stderr, "cncctl: %s\n", error.message.c_str());
+    return kUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cncctl: %s\n", e.what());
     return kUnavailable;

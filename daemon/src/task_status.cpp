@@ -136,7 +136,10 @@ json Task::status() const {
       exec_ == ExecState::idle
           ? elapsed_s_
           : std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count();
-  const int line = exec_ == ExecState::idle ? 0 : s.line;
+  // Between steps nothing is read ahead: the interpreter's line is the one just carried out.
+  const int line = exec_ == ExecState::idle                  ? 0
+                   : stepping_ && exec_ == ExecState::paused ? interp_->current_line()
+                                                             : s.line;
   const std::uint64_t moves =
       exec_ == ExecState::idle ? moves_completed_ : s.segments_done - moves_done_base_;
   const double progress =

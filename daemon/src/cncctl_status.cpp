@@ -1,0 +1,125 @@
+// cncctl: helpers and the readable status view shared by `status` and `watch`.
+#include <cstdio>
+#include <cstdlib>
+
+#include "cncctl.hpp"
+
+namespace cncd::cncctl {
+
+using nlohmann::json;
+
+json result_of(const json& response) {
+  if (response.contains("error")) {
+    const auto& error = response["error"];
+    throw Refused{error.value("message", std::string("error")) + " (code " +
+                  std::to_string(error.value("code", 0)) + ")"};
+  }
+  return response.value("result", json());
+}
+
+std::string axes_text(const json& axes) {
+  std::string out;
+  char buf[64];
+  if (!axes.is_object()) return out;
+  for (const auto& [name, value] : axes.items()) {
+    if (!value.is_number()) continue;
+    std::snprintf(buf, sizeof buf, "%s%c %.4f", out.empty() ? "" : "  ", name[0] - 'a' + 'A',
+                  value.get<double>());
+    out += buf;
+  }
+  return out;
+}
+
+double number_arg(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) {
+    throw UsageError{"'" + text + "' is not a number (" + what + ")"};
+  }
+  return value;
+}
+
+namespace {
+std::string join(const json& list) {
+  std::string out;
+  if (!list.is_array()) return out;
+  for (const auto& item : list) {
+    if (!item.is_string()) continue;
+    out += (out.empty() ? "" : " ") + item.get<std::string>();
+  }
+  return out;
+}
+
+// nlohmann's value() insists on the stored type; status fields may be missing after a filter.
+template <typename T>
+T get(const json& object, const char* key, T fallback) {
+  if (!object.is_object()) return fallback;
+  const auto it = object.find(key);
+  if (it == object.end() || it->is_null()) return fallback;
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    return fallback;
+  }
+}
+}  // namespace
+
+void print_status(const json& s) {
+  std::printf("state     %s\n", get<std::string>(s, "state", "").c_str());
+  std::printf("exec      %s (motion %s, mode %s)\n", get<std::string>(s, "exec", "").c_str(),
+              get<std::string>(s, "motion", "").c_str(), get<std::string>(s, "mode", "").c_str());
+  std::string homed;
+  if (s.contains("homed")) {
+    for (const auto& h : s["homed"])
+      homed += h.get<bool>() ? "H " : "- ";
+  }
+  std::printf("homed     %s\n", homed.c_str());
+  const json position = s.value("position", json::object());
+  const json work = s.value("work_position", json::object());
+  std::printf("commanded %s  (%s)\n", axes_text(position.value("commanded", json())).c_str(),
+              get<std::string>(s, "units", "").c_str());
+  std::printf("actual    %s\n", axes_text(position.value("actual", json())).c_str());
+  const json offsets = s.value("offsets", json::object());
+  if (!work.empty()) {
+    std::printf("work      %s  (%s)\n", axes_text(work.value("commanded", json())).c_str(),
+                get<std::string>(offsets, "coord_system", "").c_str());
+  }
+  std::printf("velocity  %.3f\n", get<double>(s, "velocity", 0.0));
+  const json tool = s.value("tool", json::object());
+  const json spindle = s.value("spindle", json::object());
+  const json coolant = s.value("coolant", json::object());
+  const int direction = get<int>(spindle, "direction", 0);
+  std::printf(
+      "tool      T%d  length %s   spindle %s %.0f   coolant%s%s%s\n", get<int>(tool, "number", 0),
+      axes_text(tool.value("length_offset", json())).c_str(),
+      direction > 0   ? "cw"
+      : direction < 0 ? "ccw"
+                      : "off",
+      get<double>(spindle, "speed", 0.0), get<bool>(coolant, "mist", false) ? " mist" : "",
+      get<bool>(coolant, "flood", false) ? " flood" : "",
+      !get<bool>(coolant, "mist", false) && !get<bool>(coolant, "flood", false) ? " off" : "");
+  if (s.contains("gcodes")) {
+    std::printf("codes     %s %s\n", join(s["gcodes"]).c_str(), join(s["mcodes"]).c_str());
+  }
+  const json p = s.value("program", json::object());
+  const std::string path = get<std::string>(p, "path", "");
+  if (!path.empty()) {
+    const auto total = get<unsigned long long>(p, "total_lines", 0ULL);
+    if (get<std::string>(s, "exec", "idle") == "idle") {
+      std::printf("program   %s  (%llu lines)", path.c_str(), total);
+    } else {
+      std::printf("program   %s  line %d of %llu  %.0f%%  %.1f s", path.c_str(),
+                  get<int>(p, "line", 0), total, 100.0 * get<double>(p, "progress", 0.0),
+                  get<double>(p, "elapsed_s", 0.0));
+    }
+    const std::string result = get<std::string>(p, "result", "");
+    if (!result.empty()) std::printf("  last run: %s", result.c_str());
+    std::printf("\n");
+    const std::string error = get<std::string>(p, "error", "");
+    if (!error.empty()) std::printf("error     %s\n", error.c_str());
+  }
+  const std::string fault = get<std::string>(s, "fault", "");
+  if (!fault.empty()) std::printf("fault     %s\n", fault.c_str());
+}
+
+}  // namespace cncd::cncctl

@@ -1,0 +1,112 @@
+// cncctl against the real daemon: the setup, step, run-from-line and watch commands, --json and
+// the exit codes (0 done, 1 failed, 2 refused, 64 usage, 69 unreachable).
+#include <sstream>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+
+class CncctlTest : public MachineTest {
+ protected:
+  CommandResult cncctl(const std::vector<std::string>& args) {
+    std::vector<std::string> argv{CNCCTL_BINARY, "--socket", daemon_.socket()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv);
+  }
+  void ready() {
+    for (const char* command : {"reset", "on", "home"})
+      ASSERT_EQ(cncctl({command}).exit_status, 0) << command;
+  }
+};
+
+TEST_F(CncctlTest, ToolsListsAndSets) {
+  auto r = cncctl({"tools"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("3 mm drill"), std::string::npos) << r.out;
+  r = cncctl({"tools", "set", "T2", "Z12.5", "D3.2", ";3.2", "mm", "drill"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  r = cncctl({"--json", "tools"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const json list = json::parse(r.out);
+  EXPECT_EQ(list["tools"][1]["offset"]["z"], 12.5);
+  EXPECT_EQ(list["tools"][1]["diameter"], 3.2);
+  EXPECT_EQ(list["tools"][1]["comment"], "3.2 mm drill");
+  r = cncctl({"tools", "set", "T0", "Z1"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("\"number\" must be an integer from 1"), std::string::npos) << r.err;
+  EXPECT_EQ(cncctl({"tools", "set", "Z1"}).exit_status, 64);
+  EXPECT_EQ(cncctl({"tools", "set", "T1", "Zfoo"}).exit_status, 64);
+}
+
+TEST_F(CncctlTest, OffsetsListsAndSets) {
+  auto r = cncctl({"offsets", "set", "G55", "X5", "Z-2.5"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  r = cncctl({"offsets"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("G55     X 5.0000  Y 0.0000  Z -2.5000"), std::string::npos) << r.out;
+  r = cncctl({"--json", "offsets"});
+  EXPECT_EQ(json::parse(r.out)["systems"][1]["origin"]["x"], 5.0);
+  EXPECT_EQ(cncctl({"offsets", "set", "G60", "X1"}).exit_status, 2);
+  EXPECT_EQ(cncctl({"offsets", "set", "G55", "K1"}).exit_status, 64);
+}
+
+TEST_F(CncctlTest, StepAndRunFromLine) {
+  ready();
+  const auto program = dir_.write("p.ngc", "G21 G90\nG0 X1\nG0 X2\nM2\n");
+  auto r = cncctl({"step", program.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("line 1/4"), std::string::npos) << r.out;
+  r = cncctl({"step"});
+  EXPECT_NE(r.out.find("line 2/4  X 1.0000"), std::string::npos) << r.out;
+  r = cncctl({"--json", "step"});
+  EXPECT_EQ(json::parse(r.out)["position"]["commanded"]["x"], 2.0);
+  EXPECT_EQ(cncctl({"run", program.string()}).exit_status, 2);  // still stepping
+  EXPECT_EQ(cncctl({"abort"}).exit_status, 0);
+  r = cncctl({"run", program.string(), "--from", "3"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("done"), std::string::npos) << r.out;
+  EXPECT_EQ(cncctl({"run", program.string(), "--from", "9"}).exit_status, 2);
+  EXPECT_EQ(cncctl({"run", program.string(), "--from", "x"}).exit_status, 64);
+}
+
+TEST_F(CncctlTest, WatchPrintsUpdatesAndStopsOnInterrupt) {
+  auto r = cncctl({"--json", "watch", "--interval", "20", "--count", "2"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int count = 0;
+  while (std::getline(lines, line)) {
+    EXPECT_EQ(json::parse(line)["state"], "estop") << line;
+    ++count;
+  }
+  EXPECT_EQ(count, 2);
+  r = cncctl({"watch", "--count", "1"});
+  EXPECT_NE(r.out.find("state     estop"), std::string::npos) << r.out;
+  // Ctrl-C ends a watch cleanly (exit 0, not killed by the signal).
+  r = run_command({"/usr/bin/timeout", "--preserve-status", "-s", "INT", "0.5", CNCCTL_BINARY,
+                   "--socket", daemon_.socket(), "watch"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("state     estop"), std::string::npos) << r.out;
+  EXPECT_EQ(cncctl({"watch", "--count", "0"}).exit_status, 64);
+}
+
+TEST_F(CncctlTest, ExitCodesTellDoneRefusedFailedAndUnreachable) {
+  auto r = cncctl({"--json", "estop"});
+  EXPECT_EQ(r.exit_status, 0);
+  EXPECT_EQ(json::parse(r.out)["ok"], true);
+  EXPECT_EQ(cncctl({"on"}).exit_status, 2);  // in estop
+  ready();
+  const auto bad = dir_.write("bad.ngc", "G21 G90\nG1 X5\nM2\n");  // no feed rate
+  r = cncctl({"run", bad.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("bad.ngc:2"), std::string::npos) << r.err;
+  EXPECT_EQ(cncctl({"frobnicate"}).exit_status, 64);
+  r = run_command({CNCCTL_BINARY, "--socket", (dir_.path() / "none.sock").string(), "status"});
+  EXPECT_EQ(r.exit_status, 69);
+}
+
+}  // namespace
+}  // namespace cncd::test
