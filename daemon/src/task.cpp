@@ -54,7 +54,8 @@ Task::Task(const config::MachineConfig& config, EventLog& events, Completions& c
       completions_(completions),
       motion_(config),
       feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
-      interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))) {}
+      interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))),
+      saved_tools_(interp_->tools()) {}
 
 Task::~Task() {
   shutdown();
@@ -238,8 +239,10 @@ void Task::abort(std::uint64_t token) {
 }
 
 void Task::finish_program(const std::string& result, const std::string& error) {
-  // Offsets set by the program or MDI (G10, G92 ...) survive a crash or power loss.
+  // Offsets and tool data set by the program or MDI (G10, G92 ...) survive a crash or power
+  // loss.
   save_parameters();
+  save_tools_if_changed();
   if (mode_ == Mode::mdi) {
     exec_ = ExecState::idle;
     mode_ = Mode::manual;

@@ -90,6 +90,8 @@ class Task {
   void start_run(Mode mode, const motion::Status& status);
   void drain_servo_events();
   void save_parameters();
+  // Rewrites the tool table when G10 L1/L10/L11 changed it (task_setup.cpp).
+  void save_tools_if_changed();
   void finish_program(const std::string& result, const std::string& error);
   bool all_homed(const motion::Status& status) const;
   // Run from line: called after each block while lines before skip_to_line_ are read. Drops
@@ -104,6 +106,7 @@ class Task {
   motion::MotionController motion_;
   std::unique_ptr<ProgramFeeder> feeder_;
   std::unique_ptr<interp::Interpreter> interp_;
+  std::vector<interp::ToolEntry> saved_tools_;  // the tool table as its file holds it
   ExecState exec_ = ExecState::idle;
   Mode mode_ = Mode::manual;
   std::uint64_t mdi_token_ = 0;

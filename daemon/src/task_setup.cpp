@@ -64,7 +64,20 @@ void Task::set_tool(const interp::ToolEntry& entry) {
   const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
   if (!error.empty()) throw RpcError(kFileError, error);
   interp_->set_tool(entry);
+  saved_tools_ = std::move(tools);
   events_.add("info", "tools", "tool " + std::to_string(entry.number) + " changed");
+}
+
+void Task::save_tools_if_changed() {
+  if (config_.tool_table.empty()) return;
+  auto tools = interp_->tools();
+  if (tools == saved_tools_) return;
+  const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
+  if (!error.empty()) {
+    events_.add("error", "tools", error);
+    return;
+  }
+  saved_tools_ = std::move(tools);
 }
 
 json Task::offsets() const {

@@ -117,6 +117,16 @@ TEST_F(PermissionTest, ReaderMayReadButNotCommand) {
   EXPECT_EQ(command["error"]["code"], 1005) << command.dump();
 }
 
+TEST_F(PermissionTest, ReaderMayListToolsAndOffsetsButNotChangeThem) {
+  const gid_t users = group_id("users");
+  EXPECT_EQ(json::parse(call_as({users}, "tool.list"))["result"]["tools"].size(), 3u);
+  EXPECT_EQ(json::parse(call_as({users}, "offsets.get"))["result"]["active"], "G54");
+  for (const char* method : {"tool.set", "offsets.set", "program.step"}) {
+    const json reply = json::parse(call_as({users}, method));
+    EXPECT_EQ(reply["error"]["code"], 1005) << method << ": " << reply.dump();
+  }
+}
+
 TEST_F(PermissionTest, ControlGroupMayCommand) {
   const json command = json::parse(call_as({group_id("dialout")}, "machine.reset"));
   EXPECT_TRUE(command.contains("result")) << command.dump();

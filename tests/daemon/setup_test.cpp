@@ -56,6 +56,15 @@ TEST_F(MachineTest, ToolSetRewritesTheTableAndTheInterpreterUsesIt) {
   EXPECT_EQ(again[1]["comment"], "3.2 mm drill");
 }
 
+TEST_F(MachineTest, ToolDataSetByG10L1IsWrittenToTheTable) {
+  ready_machine();
+  mdi("G10 L1 P3 Z30 R4");
+  const auto table = slurp(dir_.path() / "sim_mm.tbl");
+  EXPECT_NE(table.find("T3 P3 Z+30.000000 D8.000000 ;10 mm face mill\n"), std::string::npos)
+      << table;
+  EXPECT_EQ(result_of(call("tool.list"))["tools"][2]["offset"]["z"], 30.0);
+}
+
 TEST_F(MachineTest, ToolSetRejectsBadValuesClearly) {
   const auto before = slurp(dir_.path() / "sim_mm.tbl");
   const std::vector<std::pair<json, std::string>> cases = {

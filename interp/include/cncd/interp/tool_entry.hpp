@@ -17,6 +17,8 @@ struct ToolEntry {
   double back_angle = 0;
   int orientation = 0;
   std::string comment;  // the text after ';', without leading blanks
+
+  bool operator==(const ToolEntry&) const = default;
 };
 
 }  // namespace cncd::interp
