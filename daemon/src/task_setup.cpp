@@ -39,10 +39,7 @@ json Task::tool_list() const {
 }
 
 std::optional<interp::ToolEntry> Task::find_tool(int number) const {
-  for (const auto& tool : interp_->tools()) {
-    if (tool.number == number) return tool;
-  }
-  return std::nullopt;
+  return interp_->tool(number);
 }
 
 void Task::set_tool(const interp::ToolEntry& entry) {

@@ -149,11 +149,8 @@ json Task::status() const {
                                : 0.0;
   const interp::InterpState st = interp_->state();
   json tool_entry = nullptr;
-  for (const auto& entry : interp_->tools()) {
-    if (entry.number == st.tool_in_spindle && st.tool_in_spindle != 0) {
-      tool_entry = {{"diameter", entry.diameter}, {"comment", entry.comment}};
-    }
-  }
+  if (const auto entry = st.tool_in_spindle != 0 ? interp_->tool(st.tool_in_spindle) : std::nullopt)
+    tool_entry = {{"diameter", entry->diameter}, {"comment", entry->comment}};
   return json{
       {"state", machine_state_name(s.machine)},
       {"exec", exec_state_name(exec_)},

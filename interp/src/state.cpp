@@ -124,6 +124,12 @@ std::vector<ToolEntry> Interpreter::tools() const {
   return out;
 }
 
+std::optional<ToolEntry> Interpreter::tool(int number) const {
+  const ToolEntry* entry = impl_->tools_.find(number);
+  if (entry == nullptr) return std::nullopt;
+  return *entry;
+}
+
 void Interpreter::set_tool(const ToolEntry& entry) {
   impl_->tools_.set(entry);
 }

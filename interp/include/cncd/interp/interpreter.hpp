@@ -107,6 +107,7 @@ class Interpreter {
 
   // The tool table as the interpreter holds it (offsets in the table's units), by number.
   std::vector<ToolEntry> tools() const;
+  std::optional<ToolEntry> tool(int number) const;
   // Adds or replaces one entry, as G10 L1 does: the tool in the spindle takes a new length at
   // its next G43. Call between programs only.
   void set_tool(const ToolEntry& entry);
