@@ -84,8 +84,11 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
     const std::string exec = s.value("exec", "");
     const int line = p.value("line", 0);
     if (exec != "idle" && !json_output && (tty || line != last_line)) {
-      std::printf("%sline %d/%llu  %s  %.1f s%s", tty ? "\r\033[K" : "", line,
-                  static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
+      const double progress = p.value("progress", 0.0);
+      const int filled = static_cast<int>(progress * 20.0 + 0.5);
+      std::printf("%s[%.*s%.*s] %3.0f%%  line %d/%llu  %s  %.1f s%s", tty ? "\r\033[K" : "", filled,
+                  "####################", 20 - filled, "                    ", 100.0 * progress,
+                  line, static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
                   axes_text(s["position"]["commanded"]).c_str(), p.value("elapsed_s", 0.0),
                   tty ? "" : "\n");
       std::fflush(stdout);

@@ -55,19 +55,20 @@ TEST_F(CncctlTest, OffsetsListsAndSets) {
 
 TEST_F(CncctlTest, StepAndRunFromLine) {
   ready();
-  const auto program = dir_.write("p.ngc", "G21 G90\nG0 X1\nG0 X2\nM2\n");
+  const auto program = dir_.write("p.ngc", "G21 G90\nG0 X1\nG1 F600 X5\nM2\n");
   auto r = cncctl({"step", program.string()});
   EXPECT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("line 1/4"), std::string::npos) << r.out;
   r = cncctl({"step"});
   EXPECT_NE(r.out.find("line 2/4  X 1.0000"), std::string::npos) << r.out;
   r = cncctl({"--json", "step"});
-  EXPECT_EQ(json::parse(r.out)["position"]["commanded"]["x"], 2.0);
+  EXPECT_EQ(json::parse(r.out)["position"]["commanded"]["x"], 5.0);
   EXPECT_EQ(cncctl({"run", program.string()}).exit_status, 2);  // still stepping
   EXPECT_EQ(cncctl({"abort"}).exit_status, 0);
   r = cncctl({"run", program.string(), "--from", "3"});
   EXPECT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("done"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[###############     ]  75%  line 3/4"), std::string::npos) << r.out;
   EXPECT_EQ(cncctl({"run", program.string(), "--from", "9"}).exit_status, 2);
   EXPECT_EQ(cncctl({"run", program.string(), "--from", "x"}).exit_status, 64);
 }
