@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "program_check.hpp"
 #include "rpc.hpp"
 
 namespace cncd::daemon {
@@ -31,18 +32,6 @@ std::uint64_t count_lines(const std::string& path) {
     last_newline = buffer[n - 1] == '\n';
   }
   return last_newline ? lines : lines + 1;
-}
-}  // namespace
-
-namespace {
-interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
-  interp::InterpOptions options;
-  options.machine_units = machine_units(config);
-  options.parameter_file = config.parameter_file;
-  options.tool_table = config.tool_table;
-  options.subroutine_path = config.subroutine_path;
-  options.startup_code = config.startup_code;
-  return options;
 }
 }  // namespace
 
@@ -140,11 +129,32 @@ void Task::open_program(const std::string& path) {
   }
   std::ifstream probe(path);
   if (!probe) throw RpcError(kProgramError, "cannot open program '" + path + "': not readable");
+  check_limits(path);
   program_path_ = path;
   program_lines_ = count_lines(path);
   last_result_.clear();
   last_error_.clear();
   spdlog::info("program opened: {} ({} lines)", path, program_lines_);
+}
+
+// Refuses a program whose moves leave the soft limits, from where the machine is now and with
+// the offsets and tools saved in the parameter file and tool table.
+void Task::check_limits(const std::string& path) {
+  CheckOptions options;
+  options.interp = interpreter_options(config_);
+  options.machine = &config_;
+  options.max_problems = 1;
+  const auto status = motion_.status();
+  interp::Pose start{};
+  std::copy(status.commanded.begin(), status.commanded.end(), start.begin());
+  options.start_machine = start;
+  const CheckReport report = check_program(path, options);
+  if (report.limit_violations == 0) return;
+  std::string message = report.problems.front().to_string();
+  if (report.limit_violations > 1) {
+    message += " (and " + std::to_string(report.limit_violations - 1) + " more)";
+  }
+  throw RpcError(kProgramError, message);
 }
 
 bool Task::all_homed(const motion::Status& status) const {

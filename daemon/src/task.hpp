@@ -48,6 +48,7 @@ class Task {
   void machine_on();
   void machine_off();
   void home(std::uint32_t joint_mask);
+  // Refuses (RpcError) a program that cannot be read or whose moves leave the soft limits.
   void open_program(const std::string& path);
   // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
   // `step` runs its first line only, as program.step does.
@@ -93,6 +94,7 @@ class Task {
   // Rewrites the tool table when G10 L1/L10/L11 changed it (task_setup.cpp).
   void save_tools_if_changed();
   void finish_program(const std::string& result, const std::string& error);
+  void check_limits(const std::string& path);
   bool all_homed(const motion::Status& status) const;
   // Run from line: called after each block while lines before skip_to_line_ are read. Drops
   // their motion (modal state, offsets and tool stay as they left them) and, at the first

@@ -1,0 +1,75 @@
+// Checks a whole G-code program against a machine without moving it: runs it through the
+// interpreter into a sink that converts every move to machine coordinates (MachineTracker) and
+// tests it against the axis soft limits ([AXIS_<L>] MIN_LIMIT/MAX_LIMIT), arcs over their whole
+// sweep. Used by cncd-check and by the daemon's program.open. Any thread; no shared state.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/interp/interpreter.hpp"
+
+namespace cncd::daemon {
+
+// The interpreter options a machine's INI gives: units, tool table, parameter file, subroutine
+// path, start-up code.
+interp::InterpOptions interpreter_options(const config::MachineConfig& config);
+
+struct CheckProblem {
+  std::string file;
+  int line = 0;
+  std::string message;
+  // "FILE:LINE: message"
+  std::string to_string() const;
+};
+
+struct CheckOptions {
+  interp::InterpOptions interp;
+  // The machine whose soft limits apply; null = no limit check.
+  const config::MachineConfig* machine = nullptr;
+  // Where the machine is when the program starts (machine coordinates and units); unset = the
+  // interpreter's default (program zero).
+  std::optional<interp::Pose> start_machine;
+  // Limit problems kept in `problems`; further ones are only counted.
+  std::size_t max_problems = 100;
+  // Also receives every canonical command as the interpreter emits it (cncd-check --canon).
+  interp::CanonSink* trace = nullptr;
+};
+
+struct CheckReport {
+  bool limits_checked = false;
+  std::size_t traverses = 0;  // G0 moves, canned-cycle rapids included
+  std::size_t feeds = 0;      // straight feed moves
+  std::size_t arcs = 0;
+  std::size_t dwells = 0;
+  std::size_t blocks = 0;  // blocks interpreted
+  // Extents of the commanded path per axis, machine coordinates and units; an axis no move
+  // reached keeps moved[axis] false.
+  std::array<bool, interp::kAxes> moved{};
+  interp::Pose min{};
+  interp::Pose max{};
+  std::set<int> tools;        // tools put in the spindle (M6, M61)
+  double feed_length = 0;     // length of the feed moves (XYZ, machine units)
+  bool inch_machine = false;  // machine units are inches (else mm)
+  // The interpreter's error, when it stopped the program.
+  std::optional<interp::InterpError> error;
+  // Moves beyond a soft limit, in program order.
+  std::vector<CheckProblem> problems;
+  std::size_t limit_violations = 0;  // all of them, including those not kept
+
+  bool ok() const { return !error && limit_violations == 0; }
+};
+
+// Runs `program` from start to end. Never writes the parameter file.
+CheckReport check_program(const std::filesystem::path& program, const CheckOptions& options);
+
+// The human summary cncd-check prints: moves by kind, extents per axis, tools, feed length.
+std::string describe(const CheckReport& report);
+
+}  // namespace cncd::daemon

@@ -1,0 +1,181 @@
+// cncd-check and the program check behind it: summaries, soft limits in machine coordinates
+// (arcs over their whole sweep), exit statuses, and the parameter file left alone.
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "daemon_process.hpp"
+#include "program_check.hpp"
+
+namespace cncd::test {
+namespace {
+
+std::string read_all(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class CncdCheckTest : public ::testing::Test {
+ protected:
+  void SetUp() override { ini_ = copy_example_machine(dir_.path()); }
+
+  CommandResult check(const std::string& program, std::vector<std::string> args = {}) {
+    const auto path = dir_.write("prog.ngc", program);
+    std::vector<std::string> argv{CNCD_CHECK_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.push_back(path.string());
+    return run_command(argv);
+  }
+  CommandResult check_ini(const std::string& program) {
+    return check(program, {"--ini", ini_.string()});
+  }
+
+  TempDir dir_;
+  std::filesystem::path ini_;
+};
+
+TEST_F(CncdCheckTest, GoodProgramPrintsASummaryAndExitsZero) {
+  const auto r = check_ini(
+      "G21 G90 T2 M6\nG0 X1 Y2 Z3\nG1 X11 F100\nG2 X21 Y2 I5 J0\nG4 P1\n"
+      "G99 G81 X4 Y5 Z1.5 R2.8 F100\nG80\nM2\n");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(r.out.find("moves: 7 (4 rapid, 2 feed, 1 arc), 1 dwell,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  X 1.0000 .. 21.0000\n"), std::string::npos) << r.out;
+  // Clockwise from X11 to X21 around X16 Y2 the arc goes over the top, to Y7.
+  EXPECT_NE(r.out.find("  Y 2.0000 .. 7.0000\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  Z 1.5000 .. 3.0000\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tools: T2\n"), std::string::npos) << r.out;
+  // 10 straight + a half circle of radius 5 + the drill's 1.3 feed down.
+  EXPECT_NE(r.out.find("feed path: 27.0080 mm\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("soft limits: every move within them"), std::string::npos) << r.out;
+}
+
+TEST_F(CncdCheckTest, WithoutAnIniTheLimitsAreNotCheckedAndTheSummarySaysSo) {
+  const auto r = check("G0 X5000\nM2\n");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("soft limits: not checked (no --ini"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  X 5000.0000 .. 5000.0000\n"), std::string::npos) << r.out;
+}
+
+TEST_F(CncdCheckTest, MovesBeyondTheSoftLimitsNameTheLineTheAxisAndTheLimit) {
+  const auto r = check_ini("G21 G90\nG0 X10 Y10\nG0 X350\nG1 Z-120 F50\nM2\n");
+  EXPECT_EQ(r.exit_status, 1);
+  const std::string file = (dir_.path() / "prog.ngc").string();
+  EXPECT_NE(r.err.find(file + ":3: rapid move: X 350.0000 is above [AXIS_X] MAX_LIMIT 300.0000"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(file + ":4: feed move: Z -120.0000 is below [AXIS_Z] MIN_LIMIT -100.0000"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("soft limits: 3 violations"), std::string::npos) << r.out;
+}
+
+TEST_F(CncdCheckTest, LimitsApplyInMachineCoordinatesAndUnits) {
+  // G54 X250 puts program X60 at machine X310; 12 inches are 304.8 mm.
+  auto r = check_ini("G10 L2 P1 X250\nG0 X40\nG0 X60\nM2\n");
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find(":3: rapid move: X 310.0000 is above"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(":2:"), std::string::npos) << r.err;
+  r = check_ini("G20 G0 X11.8\nG0 X12\nM2\n");
+  EXPECT_NE(r.err.find(":2: rapid move: X 304.8000 is above"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(":1:"), std::string::npos) << r.err;
+}
+
+TEST_F(CncdCheckTest, TheParameterFileIsReadButNeverWritten) {
+  const auto var = dir_.path() / "sim_mm.var";
+  const std::string before = read_all(var);
+  const auto r = check_ini("G10 L2 P1 X5 Y6\nG92 X1\nG0 X0\nM2\n");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(read_all(var), before);
+}
+
+TEST_F(CncdCheckTest, AnInvalidIniListsEveryProblemAndExits78) {
+  std::string text = read_all(ini_);
+  const auto replace = [&text](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("MAX_LIMIT = 300", "MAX_LIMIT = far");
+  replace("LINEAR_UNITS = mm", "LINEAR_UNITS = furlong");
+  const auto bad = dir_.write("bad.ini", text);
+  const auto r = check("G0 X1\nM2\n", {"--ini", bad.string()});
+  EXPECT_EQ(r.exit_status, 78);
+  EXPECT_NE(r.err.find("[AXIS_X] MAX_LIMIT"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[TRAJ] LINEAR_UNITS"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("problems in " + bad.string()), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
+TEST_F(CncdCheckTest, MissingProgramBadUsageAndInterpreterErrors) {
+  auto r = run_command({CNCD_CHECK_BINARY, "--ini", ini_.string(), "/nonexistent/part.ngc"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("/nonexistent/part.ngc"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(run_command({CNCD_CHECK_BINARY}).exit_status, 2);
+  EXPECT_EQ(run_command({CNCD_CHECK_BINARY, "--bogus", "x.ngc"}).exit_status, 2);
+  EXPECT_EQ(run_command({CNCD_CHECK_BINARY, "--ini"}).exit_status, 2);
+  r = check_ini("G0 X1\nG82 X2 Y2 Z-1 R1 F10\nM2\n");
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("prog.ngc:2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Dwell time p word missing with g82"), std::string::npos) << r.err;
+}
+
+daemon::CheckReport check_text(const TempDir& dir, const config::MachineConfig& machine,
+                               const std::string& program) {
+  daemon::CheckOptions options;
+  options.interp = daemon::interpreter_options(machine);
+  options.machine = &machine;
+  return daemon::check_program(dir.write("arc.ngc", program), options);
+}
+
+TEST_F(CncdCheckTest, ArcsAreCheckedOverTheirWholeSweep) {
+  const auto loaded = config::load_machine_config(ini_);
+  ASSERT_TRUE(loaded.ok());
+  const auto& machine = *loaded.config;
+  // Both ends at Y160, within Y 200; clockwise over the top it reaches Y210.
+  auto report = check_text(dir_, machine, "G0 X100 Y160\nG2 X200 Y160 I50 J0 F100\nM2\n");
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_EQ(report.problems[0].line, 2);
+  EXPECT_NE(report.problems[0].message.find("arc: Y 210.0000 is above [AXIS_Y] MAX_LIMIT"),
+            std::string::npos)
+      << report.problems[0].message;
+  // Counterclockwise it passes underneath, at Y110.
+  report = check_text(dir_, machine, "G0 X100 Y160\nG3 X200 Y160 I50 J0 F100\nM2\n");
+  EXPECT_TRUE(report.ok()) << report.problems.size();
+  EXPECT_DOUBLE_EQ(report.min[1], 110.0);
+  // XZ plane: seen from +Y, Z points right and X up; clockwise from below the centre goes
+  // towards -Z and reaches Z-105 past MIN_LIMIT -100.
+  report = check_text(dir_, machine, "G18 G0 X100 Z-90\nG2 X130 Z-90 I15 K0 F100\nM2\n");
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_NE(report.problems[0].message.find("Z -105.0000 is below [AXIS_Z] MIN_LIMIT"),
+            std::string::npos)
+      << report.problems[0].message;
+  report = check_text(dir_, machine, "G18 G0 X100 Z-90\nG3 X130 Z-90 I15 K0 F100\nM2\n");
+  EXPECT_TRUE(report.ok());
+  EXPECT_DOUBLE_EQ(report.max[2], -75.0);
+  // A full circle with extra turns (P3) reaches every side once, reported once per side.
+  report = check_text(dir_, machine, "G0 X5 Y100\nG2 X5 Y100 I10 J0 P3 F100\nM2\n");
+  EXPECT_EQ(report.limit_violations, 0u);
+  EXPECT_DOUBLE_EQ(report.min[0], 5.0);
+  EXPECT_DOUBLE_EQ(report.max[0], 25.0);
+  report = check_text(dir_, machine, "G0 X-5 Y100\nG2 X-5 Y100 I10 J0 P3 F100\nM2\n");
+  EXPECT_EQ(report.limit_violations, 0u);
+  report = check_text(dir_, machine, "G0 X-5 Y195\nG2 X-5 Y195 I10 J0 P3 F100\nM2\n");
+  ASSERT_EQ(report.limit_violations, 1u);
+  EXPECT_NE(report.problems[0].message.find("Y 205.0000 is above"), std::string::npos);
+  // A rotated coordinate system (G10 L2 R90) turns the arc's bulge from +Y to -X.
+  report =
+      check_text(dir_, machine, "G10 L2 P1 X0 Y100 R90\nG0 X0 Y0\nG2 X0 Y-20 I0 J-10 F100\nM2\n");
+  ASSERT_EQ(report.limit_violations, 0u);
+  EXPECT_NEAR(report.min[0], -0.0, 1e-9);
+  EXPECT_NEAR(report.max[0], 20.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace cncd::test
