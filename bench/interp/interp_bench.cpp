@@ -1,0 +1,193 @@
+// Interpreter throughput and memory, side by side with LinuxCNC's rs274 when it is installed.
+// Generates into a temporary directory a G1 3D surfacing program (1,000,000 lines), a program
+// of 100,000 G81 blocks and, for memory, a 10,000,000-line surfacing program; interprets each
+// into a null sink in a child process of its own and prints lines/s and the child's peak
+// resident memory. rs274 runs on the same files (output to /dev/null, its own HOME).
+//
+//   cncd_interp_bench [--scale F] [--no-rs274] [--no-memory]
+//
+// --scale multiplies every program's length (0.1 for a quick look). A benchmark, never a test.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/interp/rs274_printer.hpp"  // NullSink
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kRs274 = "/usr/bin/rs274";
+
+// A raster over a 100 x 100 mm sine-shaped surface: each line one G1 with X, Y and Z.
+void write_surfacing(const fs::path& path, long lines) {
+  std::ofstream out(path);
+  out << "G21 G90 G17 G94 F1500\nG0 X0 Y0 Z5\n";
+  const long per_row = 1000;
+  char text[96];
+  for (long i = 0; i < lines; ++i) {
+    const long row = i / per_row;
+    const long col = row % 2 == 0 ? i % per_row : per_row - 1 - i % per_row;
+    const double x = col * 0.1;
+    const double y = static_cast<double>(row % 1000) * 0.1;
+    const double z = -1.0 + 0.5 * std::sin(x * 0.2) * std::cos(y * 0.3);
+    std::snprintf(text, sizeof text, "G1 X%.3f Y%.3f Z%.4f\n", x, y, z);
+    out << text;
+  }
+  out << "G0 Z5\nM2\n";
+}
+
+// Drilling a 100 x 100 mm grid, one G81 block a hole, alternating R retracts (G98/G99).
+void write_drilling(const fs::path& path, long blocks) {
+  std::ofstream out(path);
+  out << "G21 G90 G17 G94 F300\nG0 X0 Y0 Z10\n";
+  char text[96];
+  for (long i = 0; i < blocks; ++i) {
+    std::snprintf(text, sizeof text, "%s G81 X%.3f Y%.3f Z-2.5 R1.0\n", i % 2 ? "G99" : "G98",
+                  static_cast<double>(i % 500) * 0.2, static_cast<double>(i / 500 % 500) * 0.2);
+    out << text;
+  }
+  out << "G80\nG0 Z10\nM2\n";
+}
+
+long count_lines(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  long lines = 0;
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    for (std::streamsize i = 0; i < in.gcount(); ++i)
+      lines += buffer[i] == '\n';
+  }
+  return lines;
+}
+
+struct Run {
+  bool ok = false;
+  double seconds = 0;
+  long peak_rss_kb = 0;  // the child's ru_maxrss
+};
+
+// Runs `child` in a forked process; its exit status 0 means success. Times the whole child.
+template <typename Child>
+Run in_child(Child child) {
+  std::fflush(nullptr);
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) return {};
+  if (pid == 0) _exit(child());
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) return {};
+  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+  Run run;
+  run.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  run.seconds = elapsed.count();
+  run.peak_rss_kb = usage.ru_maxrss;
+  return run;
+}
+
+Run run_ours(const fs::path& program) {
+  return in_child([&program] {
+    cncd::interp::Interpreter interp;
+    cncd::interp::NullSink sink;
+    auto error = interp.open(program);
+    if (!error) error = cncd::interp::run_program(interp, sink);
+    if (error) std::fprintf(stderr, "%s\n", error->to_string().c_str());
+    return error ? 1 : 0;
+  });
+}
+
+Run run_rs274(const fs::path& program, const fs::path& home) {
+  return in_child([&program, &home] {
+    // The same invocation as the differential test: -g, its own HOME (rs274 keeps its tool
+    // data in a file there), canonical output thrown away.
+    if (!freopen("/dev/null", "r", stdin) || !freopen("/dev/null", "w", stdout) ||
+        !freopen("/dev/null", "w", stderr) || setenv("HOME", home.c_str(), 1) != 0 ||
+        chdir(home.c_str()) != 0) {
+      return 1;
+    }
+    execl(kRs274, kRs274, "-g", program.c_str(), static_cast<char*>(nullptr));
+    return 127;
+  });
+}
+
+void report(const char* name, const fs::path& program, bool with_rs274, const fs::path& home) {
+  const long lines = count_lines(program);
+  const Run ours = run_ours(program);
+  if (!ours.ok) {
+    std::printf("%-22s %10ld lines: cncd interpreter FAILED\n", name, lines);
+    return;
+  }
+  const double our_rate = static_cast<double>(lines) / ours.seconds;
+  std::printf("%-22s %10ld lines  cncd %9.0f lines/s (%.2f s, peak RSS %ld KiB)\n", name, lines,
+              our_rate, ours.seconds, ours.peak_rss_kb);
+  if (!with_rs274) return;
+  const Run theirs = run_rs274(program, home);
+  if (!theirs.ok) {
+    std::printf("%-22s rs274 failed on this file\n", "");
+    return;
+  }
+  const double their_rate = static_cast<double>(lines) / theirs.seconds;
+  std::printf("%-22s %10s        rs274 %8.0f lines/s (%.2f s, peak RSS %ld KiB)  ratio %.1fx\n", "",
+              "", their_rate, theirs.seconds, theirs.peak_rss_kb, our_rate / their_rate);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double scale = 1.0;
+  bool rs274 = fs::exists(kRs274);
+  bool memory = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--scale" && i + 1 < argc) {
+      scale = std::atof(argv[++i]);
+    } else if (arg == "--no-rs274") {
+      rs274 = false;
+    } else if (arg == "--no-memory") {
+      memory = false;
+    } else {
+      std::fprintf(stderr, "usage: cncd_interp_bench [--scale F] [--no-rs274] [--no-memory]\n");
+      return 2;
+    }
+  }
+  if (!(scale > 0)) {
+    std::fprintf(stderr, "cncd_interp_bench: --scale must be positive\n");
+    return 2;
+  }
+  char pattern[] = "/tmp/cncd-interp-bench-XXXXXX";
+  if (!mkdtemp(pattern)) {
+    std::perror("mkdtemp");
+    return 1;
+  }
+  const fs::path dir = pattern;
+  const fs::path home = dir / "home";
+  fs::create_directories(home);
+  if (!rs274)
+    std::printf("rs274 not run (%s)\n", fs::exists(kRs274) ? "--no-rs274" : "not installed");
+
+  const auto scaled = [scale](long n) { return std::max(1L, std::lround(n * scale)); };
+  write_surfacing(dir / "surface_1m.ngc", scaled(1'000'000));
+  report("G1 surfacing", dir / "surface_1m.ngc", rs274, home);
+  write_drilling(dir / "drill_g81.ngc", scaled(100'000));
+  report("G81 drilling", dir / "drill_g81.ngc", rs274, home);
+  if (memory) {
+    fs::remove(dir / "surface_1m.ngc");
+    write_surfacing(dir / "surface_10m.ngc", scaled(10'000'000));
+    report("G1 surfacing (memory)", dir / "surface_10m.ngc", false, home);
+    write_surfacing(dir / "surface_10.ngc", 10);
+    const Run tiny = run_ours(dir / "surface_10.ngc");
+    std::printf("%-22s %10ld lines  peak RSS %ld KiB (for comparison)\n", "G1 surfacing (short)",
+                count_lines(dir / "surface_10.ngc"), tiny.peak_rss_kb);
+  }
+  fs::remove_all(dir);
+  return 0;
+}
