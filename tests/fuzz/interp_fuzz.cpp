@@ -1,0 +1,67 @@
+// libFuzzer target over the interpreter's lexer, parser, expression evaluator and executor:
+// arbitrary bytes run as a program through the real Interpreter (or, when the first byte is
+// odd, as MDI blocks one line at a time), every command converted to machine coordinates.
+// Any input must end in a clean error or a clean end: never a crash, hang or leak.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/interp/to_machine.hpp"
+
+namespace {
+
+using namespace cncd::interp;
+
+// Blocks executed per input: an O-word loop that never moves may run forever by design (as in
+// LinuxCNC), so the harness bounds it; the interpreter's own limits are tested beyond it.
+constexpr int kMaxBlocks = 20000;
+
+class MachineSink final : public CanonSink {
+ public:
+  void emit(const CanonCommand& command) override {
+    const CanonCommand out = tracker_.to_machine(command);
+    checksum_ += out.pos[0] + static_cast<double>(out.text.size());
+  }
+  double checksum() const { return checksum_; }
+
+ private:
+  MachineTracker tracker_;
+  double checksum_ = 0;
+};
+
+void run(Interpreter& interp, MachineSink& sink) {
+  for (int blocks = 0; blocks < kMaxBlocks; ++blocks) {
+    const auto step = interp.step(sink);
+    if (step != Interpreter::Step::block) {
+      if (step == Interpreter::Step::error && !interp.error()) __builtin_trap();
+      return;
+    }
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  const bool mdi = (data[0] & 1) != 0;
+  const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
+  InterpOptions options;
+  options.machine_units = (data[0] & 2) != 0 ? Units::inches : Units::mm;
+  Interpreter interp(options);
+  MachineSink sink;
+  if (!mdi) {
+    if (!interp.open_string(text, "fuzz.ngc")) run(interp, sink);
+    return 0;
+  }
+  std::string_view rest = text;
+  while (!rest.empty()) {
+    const auto end = rest.find('\n');
+    const std::string line(rest.substr(0, end));
+    rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
+    if (!interp.open_mdi(line)) run(interp, sink);
+  }
+  (void)interp.state();
+  return 0;
+}
