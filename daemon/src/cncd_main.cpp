@@ -118,6 +118,10 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   EventLog events;
   Completions completions;
   Task task(config, events, completions);
+  if (const auto error = task.load_files(); !error.empty()) {
+    spdlog::critical("{}", error);
+    return cncd::config::kExitConfig;
+  }
   if (const auto error = task.start(); !error.empty()) {
     spdlog::critical("cannot start motion: {}", error);
     return kExitUnavailable;

@@ -52,6 +52,7 @@ Task::~Task() {
 
 std::string Task::start() {
   std::string error = motion_.start();
+  started_ = error.empty();
   for (const auto& warning : motion_.start_warnings())
     events_.add("warning", "servo", warning);
   return error;
@@ -80,10 +81,14 @@ void Task::shutdown() {
   }
   motion_.machine_off();
   motion_.stop();
+  if (files_corrupt_) return;
   save_parameters();
+  save_positions();
+  started_ = false;
 }
 
 void Task::save_parameters() {
+  if (files_corrupt_) return;
   if (const auto error = interp_->save_parameters()) {
     events_.add("error", "parameters", error->to_string());
   }

@@ -37,9 +37,14 @@ class Task {
   Task(const Task&) = delete;
   Task& operator=(const Task&) = delete;
 
+  // Checks the files read at start: the parameter file and tool table (when they exist) and
+  // [TRAJ] POSITION_FILE, whose joint positions the next start() begins at. Returns "" or
+  // "FILE:LINE: what is wrong"; after an error shutdown() leaves those files alone.
+  std::string load_files();
   // Starts the servo thread. Returns "" or an error.
   std::string start();
-  // Stops motion under control and the servo thread.
+  // Stops motion under control and the servo thread, then saves the parameter file and the
+  // joint positions to [TRAJ] POSITION_FILE.
   void shutdown();
 
   // Each command throws RpcError when refused in the current state.
@@ -91,6 +96,7 @@ class Task {
   void start_run(Mode mode, const motion::Status& status);
   void drain_servo_events();
   void save_parameters();
+  void save_positions();
   // Rewrites the tool table when G10 L1/L10/L11 changed it (task_setup.cpp).
   void save_tools_if_changed();
   void finish_program(const std::string& result, const std::string& error);
@@ -128,6 +134,8 @@ class Task {
   int step_budget_ = 0;    // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
+  bool files_corrupt_ = false;  // load_files() failed: keep them as they are for the user
+  bool started_ = false;        // motion started: its joint positions are worth saving
 };
 
 }  // namespace cncd::daemon

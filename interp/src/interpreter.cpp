@@ -266,6 +266,10 @@ const std::optional<InterpError>& Interpreter::error() const {
   return impl_->error_;
 }
 
+const std::optional<InterpError>& Interpreter::load_error() const {
+  return impl_->config_error_;
+}
+
 int Interpreter::current_line() const {
   return impl_->current_line_;
 }

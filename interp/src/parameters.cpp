@@ -1,5 +1,8 @@
 #include "parameters.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -79,13 +82,20 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
       if (!is_persistent_parameter(number)) continue;
       std::fprintf(out, "%d\t%f\n", number, numbered_[static_cast<std::size_t>(number)]);
     }
-    const bool ok = std::fflush(out) == 0;
+    // On disk before the rename, so that a crash leaves the old file or the new one.
+    const bool ok = std::fflush(out) == 0 && ::fsync(::fileno(out)) == 0;
     std::fclose(out);
     if (!ok) return "Unable to write parameter file: " + temp.string();
   }
   std::error_code error;
   std::filesystem::rename(temp, path, error);
   if (error) return "Unable to replace parameter file: " + error.message();
+  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
   return std::nullopt;
 }
 

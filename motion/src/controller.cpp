@@ -6,6 +6,7 @@
 #include <sys/prctl.h>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -59,6 +60,7 @@ struct MotionController::Impl {
   std::string enqueue_error;
   AxisPose plan_end{};
   std::uint64_t enqueued = 0;
+  std::vector<double> start_positions;  // empty = where the drives stand
 
   // Hands a command to the servo thread and waits until a cycle has applied it (a period or
   // two), so that the caller's next status read already reflects it.
@@ -184,6 +186,13 @@ std::string MotionController::start() {
     impl_->drivers.push_back(std::move(driver));
   }
   impl_->loop = std::make_unique<ServoLoop>(config, std::move(bindings));
+  if (!impl_->start_positions.empty()) {
+    JointArray joints{};
+    const std::size_t n = std::min(impl_->start_positions.size(), joints.size());
+    std::copy_n(impl_->start_positions.begin(), n, joints.begin());
+    impl_->loop->set_start_positions(joints);
+    impl_->start_positions.clear();
+  }
   for (auto& driver : impl_->drivers)
     driver->enable();
 
@@ -204,6 +213,10 @@ std::string MotionController::start() {
   impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });
   impl_->collect_rt_warnings();
   return "";
+}
+
+void MotionController::set_start_positions(const std::vector<double>& joints) {
+  impl_->start_positions = joints;
 }
 
 void MotionController::stop() {

@@ -45,6 +45,23 @@ void ServoLoop::set_rt_flags(bool realtime, bool memory_locked) noexcept {
   status_.rt.memory_locked = memory_locked;
 }
 
+void ServoLoop::set_start_positions(const JointArray& joints) noexcept {
+  start_positions_ = joints;
+  has_start_positions_ = true;
+}
+
+void ServoLoop::adopt_start_positions() noexcept {
+  has_start_positions_ = false;
+  for (int j = 0; j < joint_count_; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    joints_.motor_offset[k] = feedback_[k].position - start_positions_[k];
+    joints_.feedback[k] = start_positions_[k];
+    joints_.command[k] = start_positions_[k];
+    last_motor_cmd_[k] = feedback_[k].position;
+  }
+  sync_axes_from_joints();
+}
+
 namespace {
 // Copies `text` into a fixed buffer, cut to fit. RT-safe.
 void copy_text(char* out, std::size_t size, const char* text) noexcept {
@@ -292,6 +309,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
   Command command;
   // Feedback first: a command (homing) may redefine joint positions from it.
   read_drivers();
+  if (has_start_positions_) adopt_start_positions();
   while (commands_.pop(command))
     apply(command);
   check_joints();

@@ -137,6 +137,19 @@ int DaemonProcess::stop() {
   return decode_status(status);
 }
 
+void DaemonProcess::signal(int signal) {
+  if (pid_ > 0) kill(pid_, signal);
+}
+
+int DaemonProcess::kill_hard() {
+  if (pid_ <= 0) return -1;
+  kill(pid_, SIGKILL);
+  int status = 0;
+  waitpid(pid_, &status, 0);
+  pid_ = -1;
+  return decode_status(status);
+}
+
 std::string DaemonProcess::log() const {
   return slurp(log_);
 }

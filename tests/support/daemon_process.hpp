@@ -49,6 +49,10 @@ class DaemonProcess {
   std::string start(const std::filesystem::path& dir, const std::vector<std::string>& args);
   // SIGTERM and wait; returns the exit status.
   int stop();
+  // Sends `signal` without waiting (SIGTERM: the daemon starts shutting down).
+  void signal(int signal);
+  // SIGKILL and wait: the daemon dies wherever it is. Returns the exit status.
+  int kill_hard();
   const std::string& socket() const { return socket_; }
   std::string log() const;
 

@@ -92,6 +92,8 @@ class Interpreter {
   // M2/M30/% or end of file, `error` when the block is rejected (see error()).
   Step step(CanonSink& sink);
   const std::optional<InterpError>& error() const;
+  // Why the parameter file or the tool table could not be loaded at construction, if so.
+  const std::optional<InterpError>& load_error() const;
   // Line number of the block last executed.
   int current_line() const;
 

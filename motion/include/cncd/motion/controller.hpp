@@ -30,6 +30,9 @@ class MotionController {
   // it: start_warnings() then says what, once, for the caller to log. Calling start() again
   // after stop() starts afresh (estop, unhomed).
   std::string start();
+  // Joint positions (machine units, joint order) the next start() begins at instead of where
+  // the drives stand, unhomed: LinuxCNC's [TRAJ] POSITION_FILE. Call before start().
+  void set_start_positions(const std::vector<double>& joints);
   // Stops the servo thread (joins it) and disables the drives. Idempotent.
   void stop();
 

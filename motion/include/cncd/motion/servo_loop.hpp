@@ -61,6 +61,10 @@ class ServoLoop {
   Status status() const noexcept { return published_.load(); }
   // Before the first cycle, or on the servo thread.
   void set_rt_flags(bool realtime, bool memory_locked) noexcept;
+  // Before the first cycle: the joints start at these positions (still unhomed) wherever the
+  // drives report them, as with LinuxCNC's [TRAJ] POSITION_FILE; the motor offsets take up
+  // the difference on the first cycle.
+  void set_start_positions(const JointArray& joints) noexcept;
 
  private:
   void apply(const Command& command) noexcept;
@@ -78,6 +82,7 @@ class ServoLoop {
   void latch_fault(const char* reason) noexcept;
   void post(Event::Level level, const char* text) noexcept;
   void sync_axes_from_joints() noexcept;
+  void adopt_start_positions() noexcept;
   void publish() noexcept;
 
   const config::MachineConfig& config_;
@@ -108,6 +113,8 @@ class ServoLoop {
   std::array<drivers::JointCommand, kJoints> commands_out_{};
   std::array<drivers::JointFeedback, kJoints> feedback_{};  // motor coordinates
   RtHistogram histogram_;
+  JointArray start_positions_{};
+  bool has_start_positions_ = false;
 };
 
 }  // namespace cncd::motion
