@@ -72,7 +72,7 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
     const double p = block_.get('p');
     if (p != std::floor(p)) fail("P value not an integer with M19 G2 or G3", block_.col('p'));
     if (p < 1.0) fail("P value should be 1 or greater with G2 or G3", block_.col('p'));
-    turns = static_cast<int>(p);
+    turns = to_int(p);
   }
 
   double center1 = 0;

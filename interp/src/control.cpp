@@ -252,7 +252,7 @@ void Interpreter::Impl::handle_o_word() {
       if (top_is_this && control_.back().kind == OKind::do_) {
         // The end of a do loop.
         if (block_.o_value != 0.0) {
-          source().seek(control_.back().offset, control_.back().line_before);
+          loop_back(control_.back().offset, control_.back().line_before);
         } else {
           control_.pop_back();
         }
@@ -271,10 +271,10 @@ void Interpreter::Impl::handle_o_word() {
       if (!top_is_this || control_.back().kind != OKind::while_) {
         fail(label_error("undefined O-word label"));
       }
-      source().seek(control_.back().offset, control_.back().line_before);
+      loop_back(control_.back().offset, control_.back().line_before);
       return;
     case OKind::repeat: {
-      const int count = static_cast<int>(std::nearbyint(block_.o_value));
+      const int count = to_int(std::nearbyint(block_.o_value));
       if (count <= 0) {
         skip_block(name, {OKind::endrepeat});
         return;
@@ -288,7 +288,7 @@ void Interpreter::Impl::handle_o_word() {
         fail(label_error("undefined O-word label"));
       }
       if (--control_.back().remaining > 0) {
-        source().seek(control_.back().offset, control_.back().line_before);
+        loop_back(control_.back().offset, control_.back().line_before);
       } else {
         control_.pop_back();
       }
@@ -306,7 +306,7 @@ void Interpreter::Impl::handle_o_word() {
         skip_loop_end(ended);
       } else if (loop.kind == OKind::repeat) {
         if (--loop.remaining > 0) {
-          source().seek(loop.offset, loop.line_before);
+          loop_back(loop.offset, loop.line_before);
         } else {
           const ControlFrame ended = loop;
           control_.pop_back();
@@ -317,13 +317,21 @@ void Interpreter::Impl::handle_o_word() {
         parser_.parse(line_, block_);
         handle_o_word();
       } else {
-        source().seek(loop.offset, loop.line_before);
+        loop_back(loop.offset, loop.line_before);
       }
       return;
     }
     case OKind::none:
       return;
   }
+}
+
+void Interpreter::Impl::loop_back(std::int64_t offset, int line_before) {
+  if (++loops_without_motion_ > options_.max_loops_without_motion) {
+    fail("Endless loop: " + std::to_string(options_.max_loops_without_motion) +
+         " loop iterations without a move or dwell");
+  }
+  source().seek(offset, line_before);
 }
 
 }  // namespace cncd::interp

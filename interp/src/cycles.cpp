@@ -51,7 +51,7 @@ void Interpreter::Impl::do_canned_cycle(int code) {
 
   int repeats = 1;
   if (block_.has('l')) {
-    repeats = static_cast<int>(block_.get('l'));
+    repeats = to_int(block_.get('l'));
     if (repeats == 0) fail("Cannot do zero repeats of cycle", block_.col('l'));
   }
   if (block_.has('r')) {

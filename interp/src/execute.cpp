@@ -144,7 +144,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
     emit_simple(CanonKind::set_spindle_speed, 0, modal_.speed);
   }
   if (block_.has('t')) {
-    const int tool = static_cast<int>(block_.get('t'));
+    const int tool = to_int(block_.get('t'));
     if (tool != 0 && tools_.find(tool) == nullptr && !options_.tool_table.empty()) {
       fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
            block_.col('t'));
@@ -164,7 +164,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
     if (!block_.has('q') || block_.get('q') < 0) {
       fail("Need non-negative Q-word to specify tool number with M61", block_.m_column[6]);
     }
-    const int tool = static_cast<int>(block_.get('q'));
+    const int tool = to_int(block_.get('q'));
     tool_in_spindle_ = tool;
     emit_simple(CanonKind::change_tool_number, tool);
   }

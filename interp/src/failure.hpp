@@ -12,6 +12,16 @@ struct Failure {
   int column = 0;  // 1-based column in the source line, 0 = whole line
 };
 
+// A program or file value used as an integer (L, P, T, H, Q words, loop counts, tool table
+// fields): truncated toward zero and clamped to +-2e9, so that a huge value fails the range
+// check that follows instead of overflowing the conversion; NaN gives 0.
+inline int to_int(double value) {
+  if (value != value) return 0;
+  if (value > 2e9) return 2'000'000'000;
+  if (value < -2e9) return -2'000'000'000;
+  return static_cast<int>(value);
+}
+
 [[noreturn]] inline void fail(std::string message, int column = 0) {
   throw Failure{std::move(message), column};
 }

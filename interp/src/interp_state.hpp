@@ -191,7 +191,13 @@ struct Interpreter::Impl {
 
   // emit helpers
   CanonCommand& make(CanonKind kind);
-  void emit(const CanonCommand& command) { sink_->emit(command); }
+  void emit(const CanonCommand& command) {
+    if (command.kind <= CanonKind::dwell) loops_without_motion_ = 0;  // a move or a dwell
+    sink_->emit(command);
+  }
+  // Jumps back to the start of a loop; fails once loops have run max_loops_without_motion
+  // times in a row without a move or dwell (an endless loop that would never end).
+  void loop_back(std::int64_t offset, int line_before);
   void emit_comment(const std::string& text);
   void emit_simple(CanonKind kind, int ivalue = 0, double value = 0);
 
@@ -211,6 +217,7 @@ struct Interpreter::Impl {
   std::optional<InterpError> error_;
   std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
   int current_line_ = 0;
+  std::uint64_t loops_without_motion_ = 0;
   bool preamble_done_ = false;
   bool ended_ = false;
   bool mdi_ = false;  // executing MDI: the end of the text ends it, no M2 or % needed

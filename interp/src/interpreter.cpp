@@ -35,7 +35,7 @@ void Interpreter::Impl::reset_modal_state() {
   modal_ = ModalState{};
   modal_.units = options_.machine_units;
   cycle_ = CycleState{};
-  const int system = static_cast<int>(parameters_.get(5220));
+  const int system = to_int(parameters_.get(5220));
   modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
   parameters_.set(5220, modal_.coord_system);
   load_coord_system(modal_.coord_system);
@@ -46,6 +46,7 @@ void Interpreter::Impl::reset_modal_state() {
   subs_.clear();
   preamble_done_ = false;
   ended_ = false;
+  loops_without_motion_ = 0;
   seen_percent_ = false;
 }
 
@@ -240,6 +241,7 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   // Modal state carries over from the previous MDI line or program, as in LinuxCNC.
   impl_->mdi_ = true;
   impl_->ended_ = false;
+  impl_->loops_without_motion_ = 0;
   impl_->control_.clear();
   impl_->calls_.clear();
   return std::nullopt;

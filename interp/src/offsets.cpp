@@ -112,7 +112,7 @@ void Interpreter::Impl::change_units(Units units) {
 void Interpreter::Impl::apply_tool_length(int code) {
   Pose offset{};
   if (code == 430) {
-    const int tool = block_.has('h') ? static_cast<int>(block_.get('h')) : tool_in_spindle_;
+    const int tool = block_.has('h') ? to_int(block_.get('h')) : tool_in_spindle_;
     if (tool != 0) {
       const ToolEntry* entry = tools_.find(tool);
       if (entry == nullptr && !options_.tool_table.empty()) {

@@ -61,6 +61,7 @@ void BlockParser::parse(std::string_view line, Block& block) {
   block.clear();
   normalize(line);
   pos_ = 0;
+  depth_ = 0;
   if (peek() == '/') {
     block.block_delete = true;
     ++pos_;
@@ -305,7 +306,18 @@ int BlockParser::read_integer_value() {
   return static_cast<int>(rounded);
 }
 
+// Every value, however nested, passes here: the nesting depth and the result are checked once.
 double BlockParser::read_real_value() {
+  if (++depth_ > kMaxNesting) {
+    error("Expression nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
+  }
+  const double value = read_nested_value();
+  --depth_;
+  if (!std::isfinite(value)) error("Result is not a finite number (overflow)");
+  return value;
+}
+
+double BlockParser::read_nested_value() {
   const char c = peek();
   if (c == '[') return read_expression();
   if (c == '#') return read_parameter_value();
@@ -349,14 +361,17 @@ double BlockParser::read_number() {
   const char* last = text_.data() + pos_;
   if (*first == '.') {
     // from_chars needs a digit before the point: ".5" is parsed as the fraction alone.
-    const auto result = std::from_chars(first, last, value);
-    if (result.ec != std::errc()) {
-      std::string padded = "0";
-      padded.append(first, last);
-      std::from_chars(padded.data(), padded.data() + padded.size(), value);
+    std::string padded = "0";
+    padded.append(first, last);
+    if (std::from_chars(padded.data(), padded.data() + padded.size(), value).ec != std::errc()) {
+      value = HUGE_VAL;
     }
-  } else {
-    std::from_chars(first, last, value);
+  } else if (std::from_chars(first, last, value).ec != std::errc()) {
+    value = HUGE_VAL;  // out of range
+  }
+  if (!(std::fabs(value) <= kMaxNumber)) {
+    pos_ = start;
+    error("Number too large (more than 1e300)");
   }
   return negative ? -value : value;
 }

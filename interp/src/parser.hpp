@@ -12,6 +12,11 @@
 
 namespace cncd::interp {
 
+// Limits on what one value may be: brackets, unary functions and signs nest at most
+// kMaxNesting deep, and a number written in the program is at most kMaxNumber in magnitude.
+inline constexpr int kMaxNesting = 100;
+inline constexpr double kMaxNumber = 1e300;
+
 class BlockParser {
  public:
   explicit BlockParser(const Parameters& parameters) : parameters_(parameters) {}
@@ -29,6 +34,7 @@ class BlockParser {
   void read_assignment(Block& block);
 
   double read_real_value();
+  double read_nested_value();
   double read_number();
   double read_expression();
   double read_unary(int column);
@@ -51,6 +57,7 @@ class BlockParser {
   std::string comment_raw_;
   std::string name_;
   std::size_t pos_ = 0;
+  int depth_ = 0;  // nesting of the value being read
 };
 
 }  // namespace cncd::interp

@@ -14,11 +14,11 @@ constexpr int kG30Base = 5181;
 }  // namespace
 
 void Interpreter::Impl::do_g10() {
-  const int l = block_.has('l') ? static_cast<int>(block_.get('l')) : -1;
+  const int l = block_.has('l') ? to_int(block_.get('l')) : -1;
   if (l != 1 && l != 2 && l != 10 && l != 11 && l != 20) {
     fail("Line with G10 does not have L0, L1, L10, L11, L2, or L20", block_.g_column[0]);
   }
-  const int p = block_.has('p') ? static_cast<int>(std::nearbyint(block_.get('p'))) : -1;
+  const int p = block_.has('p') ? to_int(std::nearbyint(block_.get('p'))) : -1;
   if (l == 2 || l == 20) {
     if (p < 0 || p > 9) fail("P value out of range (0-9) with G10 L" + std::to_string(l));
     if (block_.has('i') || block_.has('j')) fail("I J words not allowed with G10 L2");
@@ -112,7 +112,7 @@ void Interpreter::Impl::set_tool_data(int l, int tool) {
   if (block_.has('r')) entry.diameter = 2.0 * block_.get('r') * to_table;
   if (block_.has('i')) entry.front_angle = block_.get('i');
   if (block_.has('j')) entry.back_angle = block_.get('j');
-  if (block_.has('q')) entry.orientation = static_cast<int>(block_.get('q'));
+  if (block_.has('q')) entry.orientation = to_int(block_.get('q'));
   tools_.set(entry);
   auto report = [&](int pocket) {
     CanonCommand& command = make(CanonKind::set_tool_table_entry);

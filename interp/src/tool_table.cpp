@@ -4,6 +4,8 @@
 #include <charconv>
 #include <fstream>
 
+#include "failure.hpp"
+
 namespace cncd::interp {
 
 std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
@@ -47,11 +49,11 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
       }
       switch (letter) {
         case 'T':
-          entry.number = static_cast<int>(value);
+          entry.number = to_int(value);
           has_tool = true;
           break;
         case 'P':
-          entry.pocket = static_cast<int>(value);
+          entry.pocket = to_int(value);
           break;
         case 'D':
           entry.diameter = value;
@@ -63,7 +65,7 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
           entry.back_angle = value;
           break;
         case 'Q':
-          entry.orientation = static_cast<int>(value);
+          entry.orientation = to_int(value);
           break;
         default:
           break;

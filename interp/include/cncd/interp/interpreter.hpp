@@ -36,6 +36,9 @@ struct InterpOptions {
   std::vector<std::filesystem::path> subroutine_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'
+  // O-word loop iterations in a row without a move or dwell before the program is rejected as
+  // an endless loop (LinuxCNC would spin forever).
+  std::uint64_t max_loops_without_motion = 1'000'000;
 };
 
 // What the interpreter holds between blocks, for status displays. Lengths in machine units,
