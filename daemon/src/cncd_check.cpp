@@ -4,10 +4,11 @@
 // LinuxCNC's rs274 does instead. Problems go to stderr as FILE:LINE: message.
 //
 //   cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch] [-t TOOL.tbl]
-//              [-v PARAMS.var] PROGRAM
+//              [-v PARAMS.var] [--max-seconds S] PROGRAM
 //
 // Exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI.
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <string>
 
@@ -24,13 +25,14 @@ int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "cncd-check: " << why << '\n';
   std::cerr
       << "usage: cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch]\n"
-         "                  [-t TOOL.tbl] [-v PARAMS.var] PROGRAM.ngc\n"
+         "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
          "               start-up code and the axis soft limits from the machine's INI\n"
          "  --canon      print the canonical commands as LinuxCNC's rs274 does\n"
          "  --inch       machine units are inches (without --ini)\n"
          "  --tool-units units the tool table is written in (default: the machine's)\n"
          "  -t, -v       tool table and parameter file (without --ini, or to override it)\n"
+         "  --max-seconds S  stop checking after S seconds (default 600, 0 = never)\n"
          "exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI\n";
   return kExitUsage;
 }
@@ -44,6 +46,7 @@ int main(int argc, char** argv) {
   bool canon = false;
   std::string ini;
   std::string program;
+  double max_seconds = 600;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
@@ -51,11 +54,16 @@ int main(int argc, char** argv) {
       canon = true;
     } else if (arg == "--inch") {
       inch = true;
-    } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v") {
+    } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
+               arg == "--max-seconds") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
         ini = value;
+      } else if (arg == "--max-seconds") {
+        char* end = nullptr;
+        max_seconds = std::strtod(value.c_str(), &end);
+        if (*end != '\0' || !(max_seconds >= 0)) return usage("--max-seconds needs a number");
       } else if (arg == "--tool-units") {
         if (value != "mm" && value != "inch") return usage("--tool-units must be mm or inch");
         overrides.tool_table_units = value == "mm" ? interp::Units::mm : interp::Units::inches;
@@ -75,6 +83,7 @@ int main(int argc, char** argv) {
   if (program.empty()) return usage("no program given");
 
   daemon::CheckOptions options;
+  options.max_seconds = max_seconds;
   std::optional<config::LoadResult> loaded;
   if (!ini.empty()) {
     loaded = config::load_machine_config(ini);
@@ -108,5 +117,6 @@ int main(int argc, char** argv) {
               << " more limit violations not shown\n";
   }
   if (report.error) std::cerr << report.error->to_string() << '\n';
+  if (report.stopped) std::cerr << report.stopped->to_string() << '\n';
   return report.ok() ? 0 : kExitProblems;
 }

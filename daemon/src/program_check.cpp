@@ -1,6 +1,7 @@
 #include "program_check.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -243,19 +244,16 @@ class CheckSink final : public interp::CanonSink {
       if (frame.u[axis] == 0 && frame.v[axis] == 0) continue;
       const double base = std::atan2(frame.v[axis], frame.u[axis]);
       for (double extreme : {base, base + std::numbers::pi}) {
-        // Every crossing of this direction inside the sweep (several with extra turns).
-        double t = extreme - start_angle;
-        if (sweep > 0) {
-          t = std::fmod(t, kTwoPi);
-          if (t < 0) t += kTwoPi;
-          for (; t < sweep; t += kTwoPi)
-            reach_axis(axis, point_at(t)[axis], command.line);
-        } else {
-          t = std::fmod(t, kTwoPi);
-          if (t > 0) t -= kTwoPi;
-          for (; t > sweep; t -= kTwoPi)
-            reach_axis(axis, point_at(t)[axis], command.line);
-        }
+        // The crossings of this direction inside the sweep, one a turn. The radius changes
+        // linearly along the sweep, so the first and the last crossing are the farthest.
+        double t = std::fmod(extreme - start_angle, kTwoPi);
+        if (sweep > 0 && t < 0) t += kTwoPi;
+        if (sweep < 0 && t > 0) t -= kTwoPi;
+        if (std::abs(t) >= std::abs(sweep)) continue;
+        const double last =
+            t + std::copysign(kTwoPi, sweep) * std::floor((std::abs(sweep) - std::abs(t)) / kTwoPi);
+        reach_axis(axis, point_at(t)[axis], command.line);
+        reach_axis(axis, point_at(last)[axis], command.line);
       }
     }
     reach(machine_end, command.line, "arc");
@@ -316,7 +314,17 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     interp.set_machine_position(*options.start_machine);
     sink.start_at(*options.start_machine);
   }
+  const auto start = std::chrono::steady_clock::now();
   for (;;) {
+    if (options.max_seconds > 0 && report.blocks % 4096 == 4095 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+            options.max_seconds) {
+      report.stopped = CheckProblem{program.string(), interp.current_line(),
+                                    "check stopped after " + number(options.max_seconds) + " s (" +
+                                        std::to_string(report.blocks) +
+                                        " blocks): the program runs too long to check"};
+      break;
+    }
     const auto step = interp.step(sink);
     if (step == interp::Interpreter::Step::error) {
       report.error = interp.error();

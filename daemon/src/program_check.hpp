@@ -38,6 +38,9 @@ struct CheckOptions {
   std::optional<interp::Pose> start_machine;
   // Limit problems kept in `problems`; further ones are only counted.
   std::size_t max_problems = 100;
+  // The check stops after this long (0 = never) and says so in `stopped`: a program looping
+  // forever with moves never ends.
+  double max_seconds = 0;
   // Also receives every canonical command as the interpreter emits it (cncd-check --canon).
   interp::CanonSink* trace = nullptr;
 };
@@ -59,11 +62,13 @@ struct CheckReport {
   bool inch_machine = false;  // machine units are inches (else mm)
   // The interpreter's error, when it stopped the program.
   std::optional<interp::InterpError> error;
+  // Set when the check stopped before the end of the program (CheckOptions::max_seconds).
+  std::optional<CheckProblem> stopped;
   // Moves beyond a soft limit, in program order.
   std::vector<CheckProblem> problems;
   std::size_t limit_violations = 0;  // all of them, including those not kept
 
-  bool ok() const { return !error && limit_violations == 0; }
+  bool ok() const { return !error && !stopped && limit_violations == 0; }
 };
 
 // Runs `program` from start to end. Never writes the parameter file.

@@ -153,7 +153,11 @@ void Task::check_limits(const std::string& path) {
   interp::Pose start{};
   std::copy(status.commanded.begin(), status.commanded.end(), start.begin());
   options.start_machine = start;
+  // The daemon's loop waits meanwhile: a program too long to check in time is checked by the
+  // planner as it runs.
+  options.max_seconds = 5;
   const CheckReport report = check_program(path, options);
+  if (report.stopped) events_.add("warning", "program", report.stopped->to_string());
   if (report.limit_violations == 0) return;
   std::string message = report.problems.front().to_string();
   if (report.limit_violations > 1) {

@@ -126,6 +126,18 @@ TEST_F(CncdCheckTest, MissingProgramBadUsageAndInterpreterErrors) {
   EXPECT_NE(r.err.find("Dwell time p word missing with g82"), std::string::npos) << r.err;
 }
 
+TEST_F(CncdCheckTest, AProgramThatNeverEndsIsStoppedWithAClearMessage) {
+  const auto r = check("o1 while [1]\nG0 X1\nG0 X2\no1 endwhile\nM2\n", {"--max-seconds", "0.2"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("check stopped after 0.2000 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the program runs too long to check"), std::string::npos) << r.err;
+  // Without moves the interpreter itself calls it an endless loop.
+  const auto idle = check("o1 while [1]\no1 endwhile\nM2\n");
+  EXPECT_EQ(idle.exit_status, 1);
+  EXPECT_NE(idle.err.find("prog.ngc:2: Endless loop: 1000000 loop iterations"), std::string::npos)
+      << idle.err;
+}
+
 daemon::CheckReport check_text(const TempDir& dir, const config::MachineConfig& machine,
                                const std::string& program) {
   daemon::CheckOptions options;
