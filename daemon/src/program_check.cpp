@@ -124,7 +124,8 @@ class CheckSink final : public interp::CanonSink {
         left_start_[axis] = true;
       }
       extend(axis, point[axis]);
-      check(axis, point[axis], line, what);
+      // An axis the move leaves where it was has been checked already.
+      if (point[axis] != position_[axis]) check(axis, point[axis], line, what);
     }
   }
 
