@@ -114,7 +114,8 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
   dirs.push_back(std::filesystem::path(program_name_).parent_path());
   for (const auto& dir : dirs) {
     const auto file = dir / (name + ".ngc");
-    if (!std::filesystem::exists(file)) continue;
+    std::error_code error;  // a name too long for a file name is simply not found
+    if (!std::filesystem::exists(file, error)) continue;
     LineSource sub_file;
     if (!sub_file.open_file(file)) continue;
     while (sub_file.read_line(line_)) {

@@ -73,5 +73,12 @@ TEST(InterpLimits, HugeIntegerWordsFailTheirRangeChecks) {
   EXPECT_NE(error_of("G81 X1 Z-1 R1 F10 L" + huge + "\nM2\n"), "");
 }
 
+TEST(InterpLimits, ASubroutineNameTooLongForAFileIsNotFound) {
+  // Found by the fuzzer: the file lookup threw "File name too long" out of the interpreter.
+  const std::string error = error_of("o<" + std::string(5000, 'a') + "> call\nM2\n");
+  EXPECT_EQ(error.rfind("1:0: ", 0), 0u) << error;
+  EXPECT_NE(error.find("o<aaaa"), std::string::npos) << error.substr(0, 80);
+}
+
 }  // namespace
 }  // namespace cncd::interp
