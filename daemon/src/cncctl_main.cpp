@@ -39,6 +39,11 @@ void usage(std::FILE* out) {
       "  pause | resume      feed hold and continue\n"
       "  abort               stop the running program; returns once the machine is at rest\n"
       "  mdi LINE            execute one block; returns when it has finished\n"
+      "  jog AXIS +/-VELOCITY\n"
+      "                      jog AXIS (e.g. X) at VELOCITY units/s until 'jog AXIS stop'\n"
+      "  jog AXIS --increment DIST [--velocity V]\n"
+      "                      move AXIS by DIST and wait until it is there\n"
+      "  jog AXIS stop       stop a jog under control and wait until at rest\n"
       "  tools               list the tool table\n"
       "  tools set T<n> [P<pocket>] [Z<offset> ...] [D<diameter>] [;comment]\n"
       "                      change (or add) one tool\n"
@@ -165,8 +170,8 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     return kDone;
   }
-  static const std::vector<std::string> kTakeArgs = {"home", "run",   "mdi",   "open",
-                                                     "step", "watch", "tools", "offsets"};
+  static const std::vector<std::string> kTakeArgs = {"home",  "run",   "mdi",     "open", "step",
+                                                     "watch", "tools", "offsets", "jog"};
   if (args.size() > 1 &&
       std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
@@ -265,6 +270,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     return follow_step(client, json_output);
   }
   if (command == "watch") return watch(client, args, json_output);
+  if (command == "jog") return jog(client, args, json_output);
   if (command == "tools") return tools(client, args, json_output);
   if (command == "offsets") return offsets(client, args, json_output);
   std::fprintf(stderr, "cncctl: unknown command '%s'\n", command.c_str());

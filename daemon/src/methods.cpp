@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "jog_methods.hpp"
 #include "server.hpp"
 #include "setup_methods.hpp"
 #include "version.hpp"
@@ -206,6 +207,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     return json();
   });
   register_setup_methods(dispatcher, task, config);
+  register_jog_methods(dispatcher, task, config);
 }
 
 }  // namespace cncd::daemon

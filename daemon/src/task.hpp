@@ -64,6 +64,11 @@ class Task {
   void resume();
   // Stops under control; the answer under `token` (if not 0) is posted once at rest.
   void abort(std::uint64_t token = 0);
+  // Jogs of one axis (config::axis_index), velocities in machine units per second (see
+  // MotionController::jog_start); refused while a program or MDI block runs (jog_methods.cpp).
+  void jog_start(int axis, double velocity);
+  void jog_increment(int axis, double distance, double velocity);
+  void jog_stop(int axis);
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 

@@ -38,6 +38,8 @@ const char* motion_state_name(motion::MotionState state) {
       return "stopping";
     case motion::MotionState::homing:
       return "homing";
+    case motion::MotionState::jogging:
+      return "jogging";
   }
   return "idle";
 }

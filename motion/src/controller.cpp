@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <thread>
@@ -65,11 +66,17 @@ struct MotionController::Impl {
   // Hands a command to the servo thread and waits until a cycle has applied it (a period or
   // two), so that the caller's next status read already reflects it.
   void send(Command::Kind kind, std::uint32_t mask = 0) {
+    Command command;
+    command.kind = kind;
+    command.joint_mask = mask;
+    send(command);
+  }
+  void send(const Command& command) {
     if (!loop) return;
     const std::uint64_t before = loop->status().sequence;
     // The command ring is drained every period; it is full only when the servo thread is not
     // running, and then there is nobody to act on the command anyway.
-    if (!loop->commands().push(Command{kind, mask}) || !running.load()) return;
+    if (!loop->commands().push(command) || !running.load()) return;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     while (loop->status().sequence < before + 2 && std::chrono::steady_clock::now() < deadline) {
       std::this_thread::sleep_for(std::chrono::microseconds(100));
@@ -242,10 +249,12 @@ MotionController::EnqueueResult MotionController::enqueue(const Move& move) {
   }
   // Homing moves the joints and an abort flushes whatever is queued: a move planned now would
   // start from the wrong place or vanish.
-  if (status.motion == MotionState::homing || status.motion == MotionState::stopping) {
-    impl_->enqueue_error = status.motion == MotionState::homing
-                               ? "the machine is homing"
-                               : "the machine is stopping after an abort";
+  if (status.motion == MotionState::homing || status.motion == MotionState::stopping ||
+      status.motion == MotionState::jogging) {
+    impl_->enqueue_error = status.motion == MotionState::homing    ? "the machine is homing"
+                           : status.motion == MotionState::jogging ? "the machine is jogging"
+                                                                   : "the machine is stopping "
+                                                                     "after an abort";
     return EnqueueResult::refused;
   }
   // With every queued segment done, the commanded position is where the next move starts
@@ -294,6 +303,68 @@ void MotionController::pause() {
 }
 void MotionController::resume() {
   impl_->send(Command::Kind::resume);
+}
+
+namespace {
+// Why a jog cannot start now (checked before the servo thread sees it), or "".
+std::string jog_problem(const config::MachineConfig& config, const Status& status, int axis,
+                        double direction) {
+  if (status.machine != MachineState::on) return "machine is not on";
+  if (status.motion != MotionState::idle && status.motion != MotionState::jogging)
+    return "the machine is moving";
+  if (status.queued != 0) return "the machine is moving";
+  bool homed = false;
+  for (int j = 0; j < status.joint_count; ++j) {
+    if (config::axis_index(config.joints[static_cast<std::size_t>(j)].axis) != axis) continue;
+    homed = status.homed[static_cast<std::size_t>(j)];
+    if (!homed) break;
+  }
+  const double position =
+      axis >= 0 && axis < kAxes ? status.commanded[static_cast<std::size_t>(axis)] : 0.0;
+  const char* refusal = jog_refusal(config, axis, position, direction, homed);
+  return refusal != nullptr ? refusal : "";
+}
+}  // namespace
+
+std::string MotionController::jog_start(int axis, double velocity_per_s) {
+  if (!impl_->loop) return "motion is not started";
+  if (!std::isfinite(velocity_per_s) || velocity_per_s == 0)
+    return "the jog velocity must not be 0";
+  if (auto problem =
+          jog_problem(impl_->config, impl_->loop->status(), axis, velocity_per_s > 0 ? 1.0 : -1.0);
+      !problem.empty())
+    return problem;
+  Command command;
+  command.kind = Command::Kind::jog_start;
+  command.axis = axis;
+  command.velocity = velocity_per_s;
+  impl_->send(command);
+  return "";
+}
+
+std::string MotionController::jog_increment(int axis, double distance, double speed_per_s) {
+  if (!impl_->loop) return "motion is not started";
+  if (!std::isfinite(distance) || distance == 0) return "the jog distance must not be 0";
+  if (!std::isfinite(speed_per_s) || speed_per_s <= 0) return "the jog speed must be above 0";
+  const Status status = impl_->loop->status();
+  if (auto problem = jog_problem(impl_->config, status, axis, distance > 0 ? 1.0 : -1.0);
+      !problem.empty())
+    return problem;
+  if (status.motion == MotionState::jogging) return "the machine is jogging";
+  Command command;
+  command.kind = Command::Kind::jog_increment;
+  command.axis = axis;
+  command.distance = distance;
+  command.velocity = speed_per_s;
+  impl_->send(command);
+  return "";
+}
+
+void MotionController::jog_stop(int axis) {
+  Command command;
+  command.kind = Command::Kind::jog_stop;
+  command.axis = axis;
+  impl_->send(command);
 }
 
 Status MotionController::status() const {

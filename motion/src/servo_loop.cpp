@@ -25,7 +25,8 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       drivers_(std::move(drivers)),
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
       joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
-      homing_(config, period_s_, home_switch_joints(drivers_)) {
+      homing_(config, period_s_, home_switch_joints(drivers_)),
+      jog_(config) {
   joint_axis_.fill(-1);
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
@@ -102,6 +103,7 @@ void ServoLoop::flush_queue() noexcept {
 void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
   flush_queue();
   homing_.stop_now();
+  jog_.halt();
   // VOLATILE_HOME joints lose their home whenever the drives turn off.
   for (int j = 0; j < joint_count_; ++j) {
     if (config_.joints[static_cast<std::size_t>(j)].volatile_home)
@@ -142,6 +144,7 @@ void ServoLoop::apply(const Command& command) noexcept {
     case Command::Kind::abort:
       if (has_active_ || segments_.size() > 0) abort_requested_ = true;
       homing_.abort();
+      jog_.stop_all();
       break;
     case Command::Kind::pause:
       pause_requested_ = true;
@@ -149,13 +152,18 @@ void ServoLoop::apply(const Command& command) noexcept {
     case Command::Kind::resume:
       pause_requested_ = false;
       break;
+    case Command::Kind::jog_start:
+    case Command::Kind::jog_increment:
+    case Command::Kind::jog_stop:
+      apply_jog(command);
+      break;
   }
 }
 
 void ServoLoop::start_homing(std::uint32_t mask) noexcept {
   if (status_.machine != MachineState::on) {
     post(Event::Level::warning, "home ignored: the machine is not on");
-  } else if (has_active_ || segments_.size() > 0 || homing_.active()) {
+  } else if (has_active_ || segments_.size() > 0 || homing_.active() || jog_.active()) {
     post(Event::Level::warning, "home ignored: the machine is moving");
   } else if (!homing_.start(mask, joints_)) {
     latch_fault(homing_.error());
@@ -317,6 +325,8 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
   if (status_.machine == MachineState::on) {
     if (homing_.active()) {
       advance_homing();
+    } else if (jog_.active()) {
+      advance_jog();
     } else {
       // Joints follow the path only while it moves: at rest they keep what homing left
       // (a gantry joint homed apart is caught, not jumped, when the next move starts).

@@ -10,6 +10,7 @@
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
 #include "cncd/motion/homing.hpp"
+#include "cncd/motion/jog.hpp"
 #include "cncd/motion/rt_stats.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/seqlock.hpp"
@@ -19,9 +20,24 @@
 namespace cncd::motion {
 
 struct Command {
-  enum class Kind : std::uint8_t { estop, reset_estop, on, off, home, abort, pause, resume };
+  enum class Kind : std::uint8_t {
+    estop,
+    reset_estop,
+    on,
+    off,
+    home,
+    abort,
+    pause,
+    resume,
+    jog_start,
+    jog_increment,
+    jog_stop
+  };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
+  int axis = 0;         // jogs: axis index
+  double velocity = 0;  // jog_start: units/s, signed; jog_increment: speed
+  double distance = 0;  // jog_increment: units, signed
 };
 
 // Something the servo thread tells the non-RT side (which logs it).
@@ -75,6 +91,9 @@ class ServoLoop {
   bool starts_here(const Segment& segment) noexcept;  // false: fault latched
   bool joints_on_their_axes() noexcept;               // false: fault latched
   void advance_homing() noexcept;
+  void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
+  void advance_jog() noexcept;
+  bool axis_homed(int axis) const noexcept;
   void read_drivers() noexcept;
   void check_joints() noexcept;
   void write_drivers() noexcept;
@@ -109,6 +128,7 @@ class ServoLoop {
   AxisPose axis_pose_{};
   JointIo joints_{};
   Homing homing_;
+  Jog jog_;
   JointArray last_motor_cmd_{};  // what the drivers were told last period (motor coordinates)
   std::array<drivers::JointCommand, kJoints> commands_out_{};
   std::array<drivers::JointFeedback, kJoints> feedback_{};  // motor coordinates

@@ -9,7 +9,7 @@
 namespace cncd::motion {
 
 enum class MachineState : std::uint8_t { estop, off, on };
-enum class MotionState : std::uint8_t { idle, moving, pausing, paused, stopping, homing };
+enum class MotionState : std::uint8_t { idle, moving, pausing, paused, stopping, homing, jogging };
 
 struct RtStats {
   std::uint64_t cycles = 0;

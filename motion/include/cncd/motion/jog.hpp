@@ -1,0 +1,64 @@
+// Jogging: continuous and incremental moves of single axes, each a trapezoid within the axis's
+// MAX_VELOCITY and MAX_ACCELERATION that ends at the soft limit on a homed axis.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/motion/types.hpp"
+
+namespace cncd::motion {
+
+// Why a jog of `axis` from `position` in `direction` (+1 or -1) cannot start, or nullptr.
+// A homed axis may not jog at or beyond its soft limit in that direction. Any thread.
+const char* jog_refusal(const config::MachineConfig& config, int axis, double position,
+                        double direction, bool homed) noexcept;
+
+class Jog {
+ public:
+  explicit Jog(const config::MachineConfig& config);
+
+  // RT (servo thread, as every method). Continuous jog of `axis` from `position` at `velocity`
+  // units/s (its sign is the direction, its size capped at MAX_VELOCITY), on a homed axis up
+  // to the soft limit. An axis jogging the same way takes the new speed; one jogging the other
+  // way comes to rest first. Returns nullptr or why it is refused.
+  const char* start(int axis, double position, double velocity, bool homed) noexcept;
+  // RT. Moves `axis` by `distance` (on a homed axis no further than the soft limit) at up to
+  // `speed` units/s. Refused while the axis jogs.
+  const char* increment(int axis, double position, double distance, double speed,
+                        bool homed) noexcept;
+  // RT. Controlled stop at the axis's MAX_ACCELERATION.
+  void stop(int axis) noexcept;
+  void stop_all() noexcept;
+  // RT. Forgets every jog at once (estop, drives off): the caller holds the positions.
+  void halt() noexcept;
+  bool active() const noexcept { return active_mask() != 0; }
+  // Bit i set: axis i is jogging.
+  std::uint32_t active_mask() const noexcept;
+  // RT. Advances every jogging axis by `dt` seconds and writes its position into `pose`.
+  void update(AxisPose& pose, double dt) noexcept;
+  // Speed along the combined direction of the jogging axes, units/s.
+  double speed() const noexcept;
+
+ private:
+  struct AxisJog {
+    bool active = false;
+    double origin = 0;     // where this leg started
+    double direction = 1;  // +1 / -1
+    double length = 0;     // distance from origin to the target
+    double target = 0;     // where it comes to rest (absent a stop)
+    double s = 0;          // distance covered
+    double v = 0;          // speed, >= 0
+    double v_max = 0;
+    bool pending = false;  // a reversal waits for the axis to come to rest
+    double pending_velocity = 0;
+    bool pending_homed = false;
+  };
+  void begin(int axis, double position, double target, double speed) noexcept;
+
+  const config::MachineConfig& config_;
+  std::array<AxisJog, kAxes> axes_{};
+};
+
+}  // namespace cncd::motion

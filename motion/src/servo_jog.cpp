@@ -1,0 +1,61 @@
+// The jog part of the servo loop: jog commands in, jogging axes advanced, their joints moved.
+#include <cstdio>
+
+#include "cncd/motion/servo_loop.hpp"
+
+namespace cncd::motion {
+
+bool ServoLoop::axis_homed(int axis) const noexcept {
+  bool any = false;
+  for (int j = 0; j < joint_count_; ++j) {
+    if (joint_axis_[static_cast<std::size_t>(j)] != axis) continue;
+    if (!joints_.homed[static_cast<std::size_t>(j)]) return false;
+    any = true;
+  }
+  return any;
+}
+
+void ServoLoop::apply_jog(const Command& command) noexcept {
+  if (command.kind == Command::Kind::jog_stop) {
+    jog_.stop(command.axis);
+    return;
+  }
+  const char* refusal = nullptr;
+  if (status_.machine != MachineState::on) {
+    refusal = "the machine is not on";
+  } else if (has_active_ || segments_.size() > 0 || homing_.active()) {
+    refusal = "the machine is moving";
+  } else if (command.axis < 0 || command.axis >= kAxes) {
+    refusal = "the machine has no such axis";
+  } else {
+    sync_axes_from_joints();  // a jog starts from where the axis's joints stand
+    const bool homed = axis_homed(command.axis);
+    const double position = axis_pose_[static_cast<std::size_t>(command.axis)];
+    refusal =
+        command.kind == Command::Kind::jog_start
+            ? jog_.start(command.axis, position, command.velocity, homed)
+            : jog_.increment(command.axis, position, command.distance, command.velocity, homed);
+  }
+  if (refusal != nullptr) {
+    char text[120];
+    std::snprintf(text, sizeof text, "jog ignored: %s", refusal);
+    post(Event::Level::warning, text);
+    return;
+  }
+  status_.motion = MotionState::jogging;
+}
+
+void ServoLoop::advance_jog() noexcept {
+  // The axes that move this period (including the one that comes to rest in it).
+  const std::uint32_t moving = jog_.active_mask();
+  jog_.update(axis_pose_, period_s_);
+  for (int j = 0; j < joint_count_; ++j) {
+    const int axis = joint_axis_[static_cast<std::size_t>(j)];
+    if (axis >= 0 && (moving & (1u << axis)) != 0)
+      joints_.command[static_cast<std::size_t>(j)] = axis_pose_[static_cast<std::size_t>(axis)];
+  }
+  status_.velocity = jog_.speed();
+  status_.motion = jog_.active() ? MotionState::jogging : MotionState::idle;
+}
+
+}  // namespace cncd::motion

@@ -1,0 +1,72 @@
+// jog.start, jog.stop and jog.increment through the real daemon and cncctl.
+#include <thread>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+
+class JogTest : public MachineTest {
+ protected:
+  CommandResult cncctl(const std::vector<std::string>& args) {
+    std::vector<std::string> argv{CNCCTL_BINARY, "--socket", daemon_.socket()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv);
+  }
+  double x() { return status()["position"]["commanded"]["x"].get<double>(); }
+};
+
+TEST_F(JogTest, ContinuousJogRunsUntilStoppedAndStopsUnderControl) {
+  ready_machine();
+  result_of(call("jog.start", {{"axis", "X"}, {"velocity", 20}}));
+  EXPECT_EQ(status()["motion"], "jogging");
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const double moving = x();
+  EXPECT_GT(moving, 1);
+  // No program while jogging; no second jog on the same axis by increment.
+  EXPECT_EQ(error_code(call("mdi.execute", {{"line", "G0 Y10"}})), 1004);
+  EXPECT_EQ(error_code(call("jog.increment", {{"axis", "X"}, {"distance", 1}})), 1004);
+  result_of(call("jog.stop", {{"axis", "X"}}));
+  const auto s = wait_until([](const json& st) { return st["motion"] == "idle"; });
+  EXPECT_GT(s["position"]["commanded"]["x"].get<double>(), moving);
+  EXPECT_EQ(s["fault"], "");
+  EXPECT_EQ(s["position"]["commanded"]["y"].get<double>(), 0);
+}
+
+TEST_F(JogTest, IncrementsAndSoftLimitsThroughCncctl) {
+  ready_machine();
+  auto r = cncctl({"jog", "Y", "--increment", "12.5", "--velocity", "50"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("Y 12.5000"), std::string::npos) << r.out;
+  // Z's maximum soft limit is 50: a long jog ends there exactly, and no further.
+  r = cncctl({"jog", "Z", "+100"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  const auto s = wait_until([](const json& st) { return st["motion"] == "idle"; });
+  EXPECT_EQ(s["position"]["commanded"]["z"].get<double>(), 50.0);
+  r = cncctl({"jog", "Z", "+1"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("maximum soft limit"), std::string::npos) << r.err;
+  r = cncctl({"jog", "Z", "-5"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  r = cncctl({"jog", "Z", "stop"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_LT(status()["position"]["commanded"]["z"].get<double>(), 50.0);
+  EXPECT_EQ(cncctl({"jog", "Q", "+1"}).exit_status, 2);
+  EXPECT_EQ(cncctl({"jog", "X"}).exit_status, 64);
+}
+
+TEST_F(JogTest, RefusedWhenOffAndStoppedByEstop) {
+  EXPECT_EQ(error_code(call("jog.start", {{"axis", "X"}, {"velocity", 10}})), 1001);
+  EXPECT_EQ(error_code(call("jog.start", {{"axis", "X"}})), -32602);
+  ready_machine();
+  result_of(call("jog.start", {{"axis", "X"}, {"velocity", -5}}));
+  result_of(call("machine.estop"));
+  const auto s = status();
+  EXPECT_EQ(s["motion"], "idle");
+  EXPECT_EQ(s["state"], "estop");
+}
+
+}  // namespace
+}  // namespace cncd::test
