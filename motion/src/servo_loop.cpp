@@ -49,6 +49,11 @@ void ServoLoop::set_rt_flags(bool realtime, bool memory_locked) noexcept {
 void ServoLoop::set_start_positions(const JointArray& joints) noexcept {
   start_positions_ = joints;
   has_start_positions_ = true;
+  // Status shows them from the start, before the first cycle has read the drives.
+  joints_.command = joints;
+  joints_.feedback = joints;
+  sync_axes_from_joints();
+  publish();
 }
 
 void ServoLoop::adopt_start_positions() noexcept {

@@ -15,6 +15,7 @@ TEST(StartPositions, JointsStartThereUnhomedAndTheMotorsStayPut) {
   saved[1] = -7.25;
   saved[2] = 3;
   m.loop().set_start_positions(saved);
+  EXPECT_DOUBLE_EQ(m.status().commanded[0], 12.5);  // before the first cycle too
   m.cycles(1);
   auto status = m.status();
   for (int j = 0; j < 3; ++j) {
