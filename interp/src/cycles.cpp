@@ -26,6 +26,10 @@ std::string g_name(int code) {
 }
 
 constexpr double kDegree = std::numbers::pi / 180.0;
+// One cycle block may not expand without bound: L repeats and G73/G83 pecks are limited (a Q
+// too small for the depth would otherwise never reach the bottom in floating point).
+constexpr int kMaxCycleRepeats = 100'000;
+constexpr int kMaxPecks = 100'000;
 
 // LinuxCNC's chip-break and peck clearance: 0.010 inch.
 double peck_clearance(Units units) {
@@ -53,6 +57,10 @@ void Interpreter::Impl::do_canned_cycle(int code) {
   if (block_.has('l')) {
     repeats = to_int(block_.get('l'));
     if (repeats == 0) fail("Cannot do zero repeats of cycle", block_.col('l'));
+    if (repeats > kMaxCycleRepeats) {
+      fail("Too many repeats of cycle (L more than " + std::to_string(kMaxCycleRepeats) + ")",
+           block_.col('l'));
+    }
   }
   if (block_.has('r')) {
     cycle_.r = block_.get('r');
@@ -211,7 +219,12 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
     case 730:
     case 830: {
       const double clearance = peck_clearance(modal_.units);
+      int pecks = 0;
       for (double depth = g.r - cycle_.q; depth > g.bottom; depth -= cycle_.q) {
+        if (++pecks > kMaxPecks) {
+          fail("Too many pecks in " + g_name(code) + ": Q too small for the depth (more than " +
+               std::to_string(kMaxPecks) + " pecks)");
+        }
         feed(depth);
         if (code == 830) traverse(g.r);
         traverse(depth + clearance);

@@ -73,6 +73,19 @@ TEST(InterpLimits, HugeIntegerWordsFailTheirRangeChecks) {
   EXPECT_NE(error_of("G81 X1 Z-1 R1 F10 L" + huge + "\nM2\n"), "");
 }
 
+TEST(InterpLimits, ACycleBlockExpandsIntoABoundedNumberOfMoves) {
+  // Found by the fuzzer: a G83 whose Q is too small to change the depth in floating point
+  // pecked forever inside one block.
+  EXPECT_EQ(error_of("G0 Z100000000000000000\n"
+                     "G83 X1 Z99999999999990000 R100000000000000000 Q0.2 F10\nM2\n"),
+            "2:0: Too many pecks in g83: Q too small for the depth (more than 100000 pecks)");
+  EXPECT_EQ(error_of("G0 Z1\nG73 X1 Z-10 R0 Q0.00001 F10\nM2\n"),
+            "2:0: Too many pecks in g73: Q too small for the depth (more than 100000 pecks)");
+  EXPECT_EQ(error_of("G0 Z1\nG83 X1 Z-10 R0 Q0.001 F10\nM2\n"), "");  // 10,000 pecks
+  EXPECT_EQ(error_of("G91 G0 Z1\nG81 X1 Z-1 R0 F10 L100001\nM2\n"),
+            "2:19: Too many repeats of cycle (L more than 100000)");
+}
+
 TEST(InterpLimits, ASubroutineNameTooLongForAFileIsNotFound) {
   // Found by the fuzzer: the file lookup threw "File name too long" out of the interpreter.
   const std::string error = error_of("o<" + std::string(5000, 'a') + "> call\nM2\n");
