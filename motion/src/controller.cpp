@@ -304,6 +304,18 @@ void MotionController::pause() {
 void MotionController::resume() {
   impl_->send(Command::Kind::resume);
 }
+void MotionController::set_feed_override(double ratio) {
+  Command command;
+  command.kind = Command::Kind::feed_override;
+  command.velocity = ratio;
+  impl_->send(command);
+}
+void MotionController::set_rapid_override(double ratio) {
+  Command command;
+  command.kind = Command::Kind::rapid_override;
+  command.velocity = ratio;
+  impl_->send(command);
+}
 
 namespace {
 // Why a jog cannot start now (checked before the servo thread sees it), or "".

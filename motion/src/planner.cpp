@@ -180,11 +180,12 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   if (check_limits && !within_limits(seg, error)) return std::nullopt;
   if (seg.length == 0) {
     seg.max_velocity = 1;
+    seg.axis_velocity = 1;
     seg.max_acceleration = 1;
     return seg;
   }
 
-  double v = move.kind == Move::Kind::traverse ? 1e300 : move.feed;
+  double v = 1e300;
   double a = 1e300;
   for (int i = 0; i < kAxes; ++i) {
     if (direction[i] <= kTiny) continue;
@@ -204,7 +205,9 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
     a = std::min(a, 0.5 * plane_a);
     v = std::min(v, std::sqrt(0.5 * plane_a * centripetal_radius));
   }
-  seg.max_velocity = v;
+  seg.axis_velocity = v;
+  seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;
+  seg.max_velocity = seg.feed > 0 ? std::min(v, seg.feed) : v;
   seg.max_acceleration = a;
   return seg;
 }

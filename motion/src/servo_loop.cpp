@@ -117,6 +117,7 @@ void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
   status_.machine = next;
   status_.motion = MotionState::idle;
   status_.velocity = 0;
+  status_.distance_to_go = 0;
   if (reason != nullptr) post(Event::Level::warning, reason);
 }
 
@@ -156,6 +157,15 @@ void ServoLoop::apply(const Command& command) noexcept {
       break;
     case Command::Kind::resume:
       pause_requested_ = false;
+      break;
+    case Command::Kind::feed_override:
+      // The controller clamps; a NaN would stall every later move.
+      if (std::isfinite(command.velocity))
+        status_.feed_override = std::clamp(command.velocity, 0.0, config_.max_feed_override);
+      break;
+    case Command::Kind::rapid_override:
+      if (std::isfinite(command.velocity))
+        status_.rapid_override = std::clamp(command.velocity, 0.0, 1.0);
       break;
     case Command::Kind::jog_start:
     case Command::Kind::jog_increment:

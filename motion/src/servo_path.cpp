@@ -40,6 +40,15 @@ bool ServoLoop::joints_on_their_axes() noexcept {
   return true;
 }
 
+double ServoLoop::speed_limit(const Segment& segment) const noexcept {
+  // Overrides only ever lower the speed below what the axes allow (a feed override above 1
+  // raises the feed, never the axis limit); the profile decelerates within the segment's
+  // acceleration when the limit drops under the current speed.
+  if (segment.feed > 0)
+    return std::min(segment.axis_velocity, segment.feed * status_.feed_override);
+  return segment.axis_velocity * status_.rapid_override;
+}
+
 bool ServoLoop::advance_path(double dt) noexcept {
   const bool holding = pause_requested_ || abort_requested_;
   // Joints and axes agree at the start of a period (not between two moves inside one).
@@ -73,7 +82,7 @@ bool ServoLoop::advance_path(double dt) noexcept {
         dt = done ? std::max(0.0, dt - left) : 0;
       }
     } else {
-      done = advance_profile(path_s_, path_v_, active_.length, holding ? 0.0 : active_.max_velocity,
+      done = advance_profile(path_s_, path_v_, active_.length, holding ? 0.0 : speed_limit(active_),
                              active_.max_acceleration, dt);
       axis_pose_ = done ? active_.end : active_.point_at(path_s_);
     }
@@ -83,6 +92,8 @@ bool ServoLoop::advance_path(double dt) noexcept {
     ++status_.segments_done;
   }
   status_.velocity = path_v_;
+  status_.distance_to_go =
+      has_active_ && active_.kind != Segment::Kind::dwell ? active_.length - path_s_ : 0.0;
   if (abort_requested_ && path_v_ == 0) {
     flush_queue();
     status_.motion = MotionState::idle;

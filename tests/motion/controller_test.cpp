@@ -51,6 +51,11 @@ TEST(MotionController, RunsAMoveOnItsServoThread) {
   EXPECT_EQ(s.commanded[2], -1);
   EXPECT_EQ(s.actual[0], 5);
   EXPECT_GT(s.rt.cycles, 10u);
+  // Overrides are applied by the servo thread before the calls return, clamped.
+  motion.set_feed_override(0.5);
+  motion.set_rapid_override(7);
+  EXPECT_DOUBLE_EQ(motion.status().feed_override, 0.5);
+  EXPECT_DOUBLE_EQ(motion.status().rapid_override, 1.0);
   motion.stop();
   motion.stop();  // idempotent
 }

@@ -55,6 +55,14 @@ class MotionController {
   void abort();                         // controlled stop, flush queued motion, abort homing
   void pause();                         // feed hold: controlled stop on the path
   void resume();
+  // Overrides, applied by the servo thread from its next period on, also to the move under
+  // way: feed moves run at min(programmed feed x feed override, what the axes allow),
+  // traverses at their axis-limited speed x rapid override. The ratio is clamped to
+  // [0, [DISPLAY] MAX_FEED_OVERRIDE] (feed) or [0, 1] (rapid); 0 stops on the path, within the
+  // acceleration limits, until the override is raised again. A non-finite ratio is ignored.
+  // Status::feed_override and Status::rapid_override show the ratios in force.
+  void set_feed_override(double ratio);
+  void set_rapid_override(double ratio);
 
   // Jogs of one axis (config::axis_index), run by the servo thread within the axis's
   // MAX_VELOCITY (speeds above it are capped) and MAX_ACCELERATION; on a homed axis up to its

@@ -16,6 +16,8 @@ struct Segment {
   AxisPose end{};
   double length = 0;            // path length (units); 0 for dwell
   double max_velocity = 0;      // path speed limit, units/s (feed, axis and arc limits)
+  double axis_velocity = 0;     // path speed limit of the axes and the arc alone, units/s
+  double feed = 0;              // programmed feed, units/s; 0 = traverse (rapid override)
   double max_acceleration = 0;  // path acceleration limit, units/s^2
   double dwell_s = 0;
   // Arc: centre in the plane, radius, start angle and signed sweep (rad), plane axes.

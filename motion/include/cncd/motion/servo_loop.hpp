@@ -31,7 +31,9 @@ struct Command {
     resume,
     jog_start,
     jog_increment,
-    jog_stop
+    jog_stop,
+    feed_override,  // velocity = the new ratio
+    rapid_override  // velocity = the new ratio
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
@@ -87,9 +89,10 @@ class ServoLoop {
   void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
   void flush_queue() noexcept;
-  bool advance_path(double dt) noexcept;              // true: a move ran this period
-  bool starts_here(const Segment& segment) noexcept;  // false: fault latched
-  bool joints_on_their_axes() noexcept;               // false: fault latched
+  bool advance_path(double dt) noexcept;                      // true: a move ran this period
+  bool starts_here(const Segment& segment) noexcept;          // false: fault latched
+  bool joints_on_their_axes() noexcept;                       // false: fault latched
+  double speed_limit(const Segment& segment) const noexcept;  // with the overrides applied
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;

@@ -34,6 +34,9 @@ struct Status {
   JointArray joint_commanded{};
   JointArray joint_actual{};
   double velocity = 0;              // units/s along the path
+  double distance_to_go = 0;        // path distance left in the segment being executed
+  double feed_override = 1.0;       // applied to feed moves, 0 .. [DISPLAY] MAX_FEED_OVERRIDE
+  double rapid_override = 1.0;      // applied to traverses, 0 .. 1
   std::int32_t line = 0;            // source line of the segment being executed
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
   std::uint64_t segments_done = 0;  // segments completed since start
