@@ -1,10 +1,12 @@
 #include "modbus_bus.hpp"
 
 #include <modbus/modbus.h>
+#include <sys/socket.h>
 #include <time.h>
 
 #include <cerrno>
 #include <cstdio>
+#include <cstring>
 
 #include "monotonic_clock.hpp"
 
@@ -32,6 +34,19 @@ std::int64_t decode(const std::uint16_t* regs, const DriveSettings& d) {
   const std::uint32_t high = d.high_first ? regs[0] : regs[1];
   const std::uint32_t low = d.high_first ? regs[1] : regs[0];
   return static_cast<std::int32_t>((high << 16) | low);
+}
+
+// A TCP socket whose two ends are the same address and port.
+bool connected_to_itself(int fd) {
+  sockaddr_storage local{};
+  sockaddr_storage peer{};
+  socklen_t local_size = sizeof local;
+  socklen_t peer_size = sizeof peer;
+  if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_size) != 0 ||
+      getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &peer_size) != 0) {
+    return false;
+  }
+  return local_size == peer_size && std::memcmp(&local, &peer, local_size) == 0;
 }
 
 // An exception reply: the drive answered, the request was wrong; the link itself is fine.
@@ -71,6 +86,14 @@ bool ModbusBus::connect() {
   modbus_set_response_timeout(ctx, timeout_us / 1'000'000u, timeout_us % 1'000'000u);
   if (modbus_connect(ctx) != 0) {
     modbus_free(ctx);
+    return false;
+  }
+  if (!bus_.rtu && connected_to_itself(modbus_get_socket(ctx))) {
+    // With nobody listening on a loopback port in the ephemeral range, the kernel may hand
+    // the connection that very port as its source and connect it to itself. That is no drive.
+    modbus_close(ctx);
+    modbus_free(ctx);
+    errno = ECONNREFUSED;
     return false;
   }
   ctx_ = ctx;

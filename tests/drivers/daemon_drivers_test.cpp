@@ -54,7 +54,10 @@ class DriveSimProcess {
       line += c;
     close(out[0]);
     std::smatch m;
-    if (!std::regex_search(line, m, std::regex(":([0-9]+)$"))) return "no port in: " + line;
+    if (!std::regex_search(line, m, std::regex(":([0-9]+)$"))) {
+      stop(SIGTERM);
+      return "no port in: " + line;
+    }
     port_ = std::stoi(m[1]);
     return "";
   }
@@ -125,13 +128,25 @@ std::string adapt(const TempDir& dir, const std::string& name,
                   const std::vector<std::pair<std::string, std::string>>& replace) {
   std::string text = slurp(kExamples + name);
   for (const auto& [from, to] : replace) {
-    const auto at = text.find(from);
+    auto at = text.find(from);
     EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
+    for (; at != std::string::npos; at = text.find(from, at + to.size()))
+      text.replace(at, from.size(), to);
   }
   dir.write("sim_mm.tbl", slurp(kExamples + "sim_mm.tbl"));
   dir.write("sim_mm.var", slurp(kExamples + "sim_mm.var"));
   return dir.write(name, text).string();
+}
+
+// The Modbus example pointed at the drive simulator on `port`. The simulator is an ordinary
+// process on a machine shared with other tests: starved of the CPU, its replies can come tens
+// of milliseconds late, which the example's following-error limits (meant for drives that
+// answer in time) would take for a drive that cannot follow. These tests are about the
+// program's end and the fault handling, so the limits are widened.
+std::vector<std::pair<std::string, std::string>> modbus_changes(int port) {
+  return {{"PORT = 1502", "PORT = " + std::to_string(port)},
+          {"FERROR = 2\n", "FERROR = 20\n"},
+          {"MIN_FERROR = 0.5\n", "MIN_FERROR = 5\n"}};
 }
 
 void expect_end(const json& s, const char* driver) {
@@ -153,7 +168,12 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
     const std::string vcd = (dir.path() / "steps.vcd").string();
     const json s = run_example(
         dir,
-        adapt(dir, "gpio_vcd_mill.ini", {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd}}));
+        adapt(dir, "gpio_vcd_mill.ini",
+              {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
+               // As for the Modbus drives below: a base thread stalled by a busy shared machine
+               // catches up afterwards, which the example's tight limits would call a fault.
+               {"FERROR = 1\n", "FERROR = 10\n"},
+               {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
     expect_end(s, "gpio");
     // cncd has stopped and flushed the recording: the pulses add up to the end position.
     const auto changes = read_vcd(vcd);
@@ -166,9 +186,7 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
     DriveSimProcess sim;
     ASSERT_EQ(sim.start(), "");
     TempDir dir;
-    const json s = run_example(
-        dir,
-        adapt(dir, "modbus_sim.ini", {{"PORT = 1502", "PORT = " + std::to_string(sim.port())}}));
+    const json s = run_example(dir, adapt(dir, "modbus_sim.ini", modbus_changes(sim.port())));
     expect_end(s, "modbus");
   }
 }
@@ -178,8 +196,7 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   ASSERT_EQ(sim.start(), "");
   const int port = sim.port();
   TempDir dir;
-  const std::string ini =
-      adapt(dir, "modbus_sim.ini", {{"PORT = 1502", "PORT = " + std::to_string(port)}});
+  const std::string ini = adapt(dir, "modbus_sim.ini", modbus_changes(port));
   DaemonProcess daemon;
   ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
   daemon::Client client;
@@ -226,8 +243,15 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   EXPECT_EQ(later["position"]["commanded"]["x"].get<double>(), x);
   EXPECT_LT(x, 200.0);
 
-  // The drives come back: after an explicit reset the machine runs again.
-  ASSERT_EQ(sim.start(port), "");
+  // The drives come back: after an explicit reset the machine runs again. The port may stay
+  // taken for a moment by the daemon's own reconnection attempts (a loopback connection to a
+  // port nobody listens on can land on itself until the daemon drops it), so try for a while.
+  std::string restarted = sim.start(port);
+  for (int attempt = 0; !restarted.empty() && attempt < 50; ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    restarted = sim.start(port);
+  }
+  ASSERT_EQ(restarted, "");
   const json refused = client.call("program.run");
   EXPECT_TRUE(refused.contains("error")) << refused.dump();
   if (later["state"] == "estop") result(client.call("machine.reset"));
