@@ -52,6 +52,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       move.kind = motion::Move::Kind::dwell;
       move.dwell_s = m.value;
       break;
+    case interp::CanonKind::set_motion_control_mode:
+      // G61 and G64 go on at speed through tangent junctions; G61.1 stops after every move.
+      continuous_ = m.ivalue != static_cast<int>(interp::MotionMode::exact_stop);
+      return;
     case interp::CanonKind::program_stop:
     case interp::CanonKind::optional_program_stop:
     case interp::CanonKind::pallet_shuttle:
@@ -91,6 +95,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     default:
       return;
   }
+  move.continuous = continuous_;
   pending.push_back(move);
 }
 

@@ -32,6 +32,9 @@ class ProgramFeeder final : public interp::CanonSink {
  private:
   interp::MachineTracker tracker_;
   EventLog& events_;
+  // Path control mode as the interpreter last set it (it starts in G64 and keeps its modes
+  // from one program to the next, as this feeder does).
+  bool continuous_ = true;
 };
 
 }  // namespace cncd::daemon

@@ -22,6 +22,34 @@ double path_length(const AxisPose& delta) {
   return norm(3);
 }
 
+// The unit tangents at both ends, over every axis.
+void set_directions(Segment& seg) {
+  AxisPose start{}, end{};
+  for (int i = 0; i < kAxes; ++i)
+    start[i] = end[i] = seg.end[i] - seg.start[i];
+  if (seg.kind == Segment::Kind::arc) {
+    const double k = seg.radius * seg.sweep;  // d(in-plane position)/d(fraction of the sweep)
+    const double a0 = seg.start_angle;
+    const double a1 = seg.start_angle + seg.sweep;
+    start[seg.first_axis] = -k * std::sin(a0);
+    start[seg.second_axis] = k * std::cos(a0);
+    end[seg.first_axis] = -k * std::sin(a1);
+    end[seg.second_axis] = k * std::cos(a1);
+  }
+  auto normalize = [](AxisPose& d) {
+    double sum = 0;
+    for (double x : d)
+      sum += x * x;
+    const double n = std::sqrt(sum);
+    for (double& x : d)
+      x = n > kTiny ? x / n : 0.0;
+  };
+  normalize(start);
+  normalize(end);
+  seg.start_direction = start;
+  seg.end_direction = end;
+}
+
 }  // namespace
 
 AxisPose Segment::point_at(double s) const noexcept {
@@ -205,6 +233,8 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
     a = std::min(a, 0.5 * plane_a);
     v = std::min(v, std::sqrt(0.5 * plane_a * centripetal_radius));
   }
+  seg.continuous = move.continuous;
+  set_directions(seg);
   seg.axis_velocity = v;
   seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;
   seg.max_velocity = seg.feed > 0 ? std::min(v, seg.feed) : v;

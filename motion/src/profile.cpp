@@ -5,28 +5,28 @@
 
 namespace cncd::motion {
 
-bool advance_profile(double& s, double& v, double length, double v_max, double a,
+bool advance_profile(double& s, double& v, double length, double v_max, double a, double v_end,
                      double& dt) noexcept {
   for (int phase = 0; phase < 8 && dt > 0; ++phase) {
     const double d = length - s;
     if (d <= 1e-12) {
       s = length;
-      v = 0;
+      v = std::min(v, std::max(v_end, 0.0));
       return true;
     }
-    const double stop_sq = 2.0 * a * d;
-    if (v * v >= stop_sq - 1e-9 * (1.0 + v * v)) {
-      // On the braking curve: brake to rest exactly at the end.
-      if (v <= 0) {
+    const double end_sq = v_end * v_end;
+    const double stop_sq = end_sq + 2.0 * a * d;
+    if (v * v >= stop_sq - 1e-9 * (1.0 + v * v) && v > v_end) {
+      // On the braking curve: slow to v_end exactly at the end, or at `a` when that is not
+      // enough (the limit dropped under the speed).
+      const double needed = (v * v - end_sq) / (2.0 * d);
+      const double brake = needed > a * (1 + 1e-6) ? a : needed;
+      const double arrival = brake == needed ? v_end : std::sqrt(std::max(0.0, v * v - 2 * a * d));
+      const double t_end = (v - arrival) / brake;
+      if (t_end <= dt) {
         s = length;
-        return true;
-      }
-      const double brake = v * v / (2.0 * d);
-      const double t_stop = v / brake;
-      if (t_stop <= dt) {
-        s = length;
-        v = 0;
-        dt -= t_stop;
+        v = arrival;
+        dt -= t_end;
         return true;
       }
       s += v * dt - 0.5 * brake * dt * dt;
@@ -41,15 +41,16 @@ bool advance_profile(double& s, double& v, double length, double v_max, double a
       duration = (v - v_max) / a;
     } else {
       const double peak = std::sqrt(0.5 * (stop_sq + v * v));
-      const double target = std::min(v_max, peak);
+      // Below a fast v_end the end may come before the peak: accelerate up to it.
+      const double target = std::min({v_max, peak, std::sqrt(v * v + 2.0 * a * d)});
       if (target > v + 1e-12) {
         accel = a;
         duration = (target - v) / a;
       } else if (v <= 0) {
         return false;  // holding at rest
       } else {
-        accel = 0;  // cruise until the braking curve
-        duration = (d - v * v / (2.0 * a)) / v;
+        accel = 0;  // cruise until the braking curve (or the end, below v_end)
+        duration = (d - std::max(0.0, v * v - end_sq) / (2.0 * a)) / v;
       }
     }
     const double step = std::min(std::max(duration, 0.0), dt);

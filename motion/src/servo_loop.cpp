@@ -97,6 +97,8 @@ void ServoLoop::flush_queue() noexcept {
   Segment dropped;
   if (has_active_) ++status_.segments_done;
   has_active_ = false;
+  status_.segments_done += static_cast<std::uint64_t>(ahead_count_);
+  ahead_count_ = 0;
   while (segments_.pop(dropped))
     ++status_.segments_done;
   path_s_ = 0;
@@ -148,7 +150,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       start_homing(command.joint_mask);
       break;
     case Command::Kind::abort:
-      if (has_active_ || segments_.size() > 0) abort_requested_ = true;
+      if (path_pending()) abort_requested_ = true;
       homing_.abort();
       jog_.stop_all();
       break;
@@ -178,7 +180,7 @@ void ServoLoop::apply(const Command& command) noexcept {
 void ServoLoop::start_homing(std::uint32_t mask) noexcept {
   if (status_.machine != MachineState::on) {
     post(Event::Level::warning, "home ignored: the machine is not on");
-  } else if (has_active_ || segments_.size() > 0 || homing_.active() || jog_.active()) {
+  } else if (path_pending() || homing_.active() || jog_.active()) {
     post(Event::Level::warning, "home ignored: the machine is moving");
   } else if (!homing_.start(mask, joints_)) {
     latch_fault(homing_.error());
@@ -366,7 +368,8 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
 void ServoLoop::publish() noexcept {
   status_.sequence = status_.rt.cycles;
   status_.commanded = axis_pose_;
-  status_.queued = static_cast<std::uint32_t>(segments_.size() + (has_active_ ? 1 : 0));
+  status_.queued = static_cast<std::uint32_t>(
+      segments_.size() + static_cast<std::size_t>(ahead_count_) + (has_active_ ? 1 : 0));
   status_.homed = joints_.homed;
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {

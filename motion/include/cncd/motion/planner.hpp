@@ -1,7 +1,8 @@
 // Turns programmed moves into segments whose every axis stays within its MAX_VELOCITY and
 // MAX_ACCELERATION: the path limits are the tightest the axes allow along the move's direction
-// (and, on arcs, with the centripetal acceleration included). Moves run with exact stop
-// between them. Non-RT: called on the task thread.
+// (and, on arcs, with the centripetal acceleration included). Each segment carries its end
+// tangents: under G61/G64 the servo loop crosses a tangent junction at speed, any other
+// junction at rest. Non-RT: called on the task thread.
 #pragma once
 
 #include <optional>

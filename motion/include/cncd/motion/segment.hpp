@@ -27,6 +27,12 @@ struct Segment {
   double start_angle = 0;
   double sweep = 0;
   std::int32_t line = 0;
+  // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
+  // moves. With `continuous`, a next segment whose start tangent matches the end tangent is
+  // entered at speed.
+  AxisPose start_direction{};
+  AxisPose end_direction{};
+  bool continuous = false;
 
   // Point at path distance s in [0, length]. RT-safe.
   AxisPose point_at(double s) const noexcept;

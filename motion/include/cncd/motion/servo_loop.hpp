@@ -92,7 +92,15 @@ class ServoLoop {
   bool advance_path(double dt) noexcept;                      // true: a move ran this period
   bool starts_here(const Segment& segment) noexcept;          // false: fault latched
   bool joints_on_their_axes() noexcept;                       // false: fault latched
-  double speed_limit(const Segment& segment) const noexcept;  // with the overrides applied
+  double speed_limit(const Segment& segment) const noexcept;  // with overrides and holds
+  // Path motion under way or waiting, in the look-ahead window or in the ring.
+  bool path_pending() const noexcept {
+    return has_active_ || ahead_count_ > 0 || segments_.size() > 0;
+  }
+  void refill_lookahead() noexcept;
+  // Fastest speeds the active segment may end at and still stop on the path within the
+  // window: with the overrides (`soft`) and with the axis limits alone (`hard`).
+  void exit_speeds(double& soft, double& hard) const noexcept;
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
@@ -123,6 +131,12 @@ class ServoLoop {
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
   Segment active_{};
   bool has_active_ = false;
+  // The segments after the active one, taken from the ring so that the path can go on at
+  // speed through tangent junctions: a ring buffer of ahead_count_ from ahead_head_.
+  static constexpr int kLookAhead = 256;
+  std::array<Segment, kLookAhead> ahead_{};
+  int ahead_head_ = 0;
+  int ahead_count_ = 0;
   double path_s_ = 0;
   double path_v_ = 0;
   double dwell_elapsed_s_ = 0;

@@ -28,7 +28,10 @@ struct Move {
   double center_first = 0;
   double center_second = 0;
   int turns = 0;
-  double dwell_s = 0;     // dwell
+  double dwell_s = 0;  // dwell
+  // G61 / G64: the path goes on at speed through the end of this move when the next move
+  // starts in the same direction (a tangent junction); false (G61.1): stop at the end.
+  bool continuous = false;
   std::int32_t line = 0;  // source line of the program, 0 = none
 };
 
