@@ -1,19 +1,31 @@
 // cncd-check: runs a G-code program through the interpreter without a machine. By default it
 // checks the program against the machine in the INI (interpreter errors, every move within the
 // axis soft limits) and prints a summary; --canon prints the canonical commands the way
-// LinuxCNC's rs274 does instead. Problems go to stderr as FILE:LINE: message.
+// LinuxCNC's rs274 does instead; --plan runs the program through the planner and the servo
+// loop in virtual time and prints the cycle time and what the motion would be like (plan_sim).
+// Problems go to stderr as FILE:LINE: message.
 //
 //   cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch] [-t TOOL.tbl]
 //              [-v PARAMS.var] [--max-seconds S] PROGRAM
+//   cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM
 //
 // Exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI.
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/rs274_printer.hpp"
+#include "plan_sim.hpp"
 #include "program_check.hpp"
 
 namespace {
@@ -26,6 +38,7 @@ int usage(const std::string& why) {
   std::cerr
       << "usage: cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch]\n"
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
+         "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
          "               start-up code and the axis soft limits from the machine's INI\n"
          "  --canon      print the canonical commands as LinuxCNC's rs274 does\n"
@@ -33,8 +46,87 @@ int usage(const std::string& why) {
          "  --tool-units units the tool table is written in (default: the machine's)\n"
          "  -t, -v       tool table and parameter file (without --ini, or to override it)\n"
          "  --max-seconds S  stop checking after S seconds (default 600, 0 = never)\n"
+         "  --plan       run the planner and servo loop in virtual time: cycle time, its\n"
+         "               feed-limited and exact-stop bounds, peak axis velocity and\n"
+         "               acceleration, largest deviation from the programmed path\n"
+         "  --json       with --plan: print one JSON object instead\n"
+         "  --trajectory FILE.csv  with --plan: write t and every axis per servo period\n"
          "exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI\n";
   return kExitUsage;
+}
+
+// Writes the commanded trajectory to `path` through a temporary file renamed into place at
+// the end, so that a reader never sees half of it.
+class TrajectoryFile {
+ public:
+  TrajectoryFile(const std::string& path, const cncd::config::MachineConfig& machine)
+      : path_(path), temp_(path + ".tmp." + std::to_string(::getpid())), out_(temp_) {
+    out_ << 't';
+    for (std::size_t i = 0; i < cncd::config::kAxisLetters.size(); ++i) {
+      if (!machine.axes[i].present) continue;
+      axes_.push_back(i);
+      out_ << ',' << static_cast<char>(cncd::config::kAxisLetters[i] - 'A' + 'a');
+    }
+    out_ << '\n';
+  }
+  bool opened() const { return static_cast<bool>(out_); }
+  void add(double t, const cncd::motion::AxisPose& pose) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.6f", t);
+    out_ << text;
+    for (const std::size_t i : axes_) {
+      std::snprintf(text, sizeof text, ",%.6f", pose[i]);
+      out_ << text;
+    }
+    out_ << '\n';
+  }
+  // "" or what went wrong; the temporary file is removed on failure.
+  std::string finish() {
+    out_.flush();
+    const bool written = static_cast<bool>(out_);
+    out_.close();
+    std::error_code ec;
+    if (written) std::filesystem::rename(temp_, path_, ec);
+    if (!written || ec) {
+      std::filesystem::remove(temp_, ec);
+      return "cannot write " + path_ + (written ? ": " + ec.message() : "");
+    }
+    return "";
+  }
+
+ private:
+  std::string path_;
+  std::string temp_;
+  std::ofstream out_;
+  std::vector<std::size_t> axes_;
+};
+
+int check_plan(const cncd::config::MachineConfig& machine, const std::string& program,
+               cncd::daemon::PlanSimOptions options, bool json, const std::string& trajectory) {
+  std::unique_ptr<TrajectoryFile> csv;
+  if (!trajectory.empty()) {
+    csv = std::make_unique<TrajectoryFile>(trajectory, machine);
+    if (!csv->opened()) {
+      std::cerr << "cncd-check: cannot write " << trajectory << ": " << std::strerror(errno)
+                << '\n';
+      return kExitProblems;
+    }
+    options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose) { csv->add(t, pose); };
+  }
+  const auto result = cncd::daemon::simulate_plan(machine, program, options);
+  std::cout << (json ? cncd::daemon::plan_json(machine, result) + "\n"
+                     : cncd::daemon::describe_plan(machine, result));
+  std::cout.flush();
+  bool ok = result.complete();
+  if (result.error) std::cerr << result.error->to_string() << '\n';
+  if (result.stopped) std::cerr << result.stopped->to_string() << '\n';
+  if (csv) {
+    if (const auto problem = csv->finish(); !problem.empty()) {
+      std::cerr << "cncd-check: " << problem << '\n';
+      ok = false;
+    }
+  }
+  return ok ? 0 : kExitProblems;
 }
 
 }  // namespace
@@ -44,6 +136,9 @@ int main(int argc, char** argv) {
   interp::InterpOptions overrides;
   bool inch = false;
   bool canon = false;
+  bool plan = false;
+  bool json = false;
+  std::string trajectory;
   std::string ini;
   std::string program;
   double max_seconds = 600;
@@ -52,14 +147,20 @@ int main(int argc, char** argv) {
     const bool has_value = i + 1 < argc;
     if (arg == "--canon") {
       canon = true;
+    } else if (arg == "--plan") {
+      plan = true;
+    } else if (arg == "--json") {
+      json = true;
     } else if (arg == "--inch") {
       inch = true;
     } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
-               arg == "--max-seconds") {
+               arg == "--max-seconds" || arg == "--trajectory") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
         ini = value;
+      } else if (arg == "--trajectory") {
+        trajectory = value;
       } else if (arg == "--max-seconds") {
         char* end = nullptr;
         max_seconds = std::strtod(value.c_str(), &end);
@@ -81,6 +182,10 @@ int main(int argc, char** argv) {
     }
   }
   if (program.empty()) return usage("no program given");
+  if (plan && ini.empty()) return usage("--plan needs --ini: the machine's limits");
+  if (plan && canon) return usage("--plan and --canon exclude each other");
+  if (!plan && (json || !trajectory.empty()))
+    return usage("--json and --trajectory go with --plan");
 
   daemon::CheckOptions options;
   options.max_seconds = max_seconds;
@@ -104,6 +209,12 @@ int main(int argc, char** argv) {
   if (overrides.tool_table_units) options.interp.tool_table_units = overrides.tool_table_units;
 
   std::ios::sync_with_stdio(false);
+  if (plan) {
+    daemon::PlanSimOptions plan_options;
+    plan_options.interp = options.interp;
+    plan_options.max_wall_s = max_seconds;
+    return check_plan(*loaded->config, program, plan_options, json, trajectory);
+  }
   interp::Rs274Printer printer(std::cout);
   if (canon) options.trace = &printer;
   const daemon::CheckReport report = daemon::check_program(program, options);

@@ -1,0 +1,82 @@
+#include "plan_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cncd::daemon {
+namespace {
+
+double xyz_distance(const motion::AxisPose& a, const motion::AxisPose& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+}  // namespace
+
+MoveLimits move_limits(const config::MachineConfig& machine, const motion::Segment& segment) {
+  MoveLimits limits;
+  if (segment.kind == motion::Segment::Kind::dwell || segment.length <= 0) return limits;
+  double v = 1e300;
+  double a = 1e300;
+  bool linear = false;
+  for (int i = 0; i < motion::kAxes; ++i) {
+    const auto& axis = machine.axes[static_cast<std::size_t>(i)];
+    if (!axis.present) continue;
+    const double share = std::abs(segment.end[i] - segment.start[i]) / segment.length;
+    if (share <= 1e-12) continue;
+    linear = linear || i < 3;
+    v = std::min(v, axis.max_velocity / share);
+    a = std::min(a, axis.max_acceleration / share);
+  }
+  if (linear && machine.max_linear_velocity > 0) v = std::min(v, machine.max_linear_velocity);
+  if (segment.feed > 0) v = std::min(v, segment.feed);
+  // A full circle moves no axis from end to end: the feed alone bounds it.
+  limits.velocity = v < 1e300 ? v : (segment.feed > 0 ? segment.feed : 1e300);
+  limits.acceleration = a;
+  return limits;
+}
+
+double rest_to_rest_s(double length, double velocity, double acceleration) {
+  if (length <= 0) return 0;
+  if (!(velocity < 1e300)) return 0;
+  if (!(acceleration < 1e300)) return length / velocity;
+  // Reaches `velocity` when the length allows the ramps up and down, else a triangle.
+  if (length >= velocity * velocity / acceleration)
+    return length / velocity + velocity / acceleration;
+  return 2.0 * std::sqrt(length / acceleration);
+}
+
+double distance_to_path(const motion::Segment& segment, const motion::AxisPose& point) {
+  using Kind = motion::Segment::Kind;
+  if (segment.kind == Kind::dwell || segment.length <= 0) return xyz_distance(segment.end, point);
+  if (segment.kind == Kind::line) {
+    double along = 0;
+    double squared = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = segment.end[i] - segment.start[i];
+      along += (point[i] - segment.start[i]) * d;
+      squared += d * d;
+    }
+    if (squared <= 1e-24) return xyz_distance(segment.start, point);
+    const double f = std::clamp(along / squared, 0.0, 1.0);
+    motion::AxisPose nearest{};
+    for (int i = 0; i < 3; ++i)
+      nearest[i] = segment.start[i] + f * (segment.end[i] - segment.start[i]);
+    return xyz_distance(nearest, point);
+  }
+  // Arc: the candidates are the ends and, on every turn the sweep covers, the point at the
+  // sample's angle about the centre.
+  double best = std::min(xyz_distance(segment.start, point), xyz_distance(segment.end, point));
+  const double angle = std::atan2(point[segment.second_axis] - segment.center_second,
+                                  point[segment.first_axis] - segment.center_first);
+  const double two_pi = 2 * std::numbers::pi;
+  const double sweep = std::abs(segment.sweep);
+  double offset = segment.sweep >= 0 ? angle - segment.start_angle : segment.start_angle - angle;
+  offset = std::fmod(offset, two_pi);
+  if (offset < 0) offset += two_pi;
+  for (int turn = 0; offset <= sweep && turn < 64; ++turn, offset += two_pi)
+    best = std::min(best, xyz_distance(segment.point_at(segment.length * offset / sweep), point));
+  return best;
+}
+
+}  // namespace cncd::daemon

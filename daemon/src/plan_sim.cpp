@@ -1,0 +1,283 @@
+#include "plan_sim.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <memory>
+
+#include "cncd/drivers/sim_driver.hpp"
+#include "cncd/motion/planner.hpp"
+#include "cncd/motion/servo_loop.hpp"
+#include "feeder.hpp"
+#include "plan_geometry.hpp"
+
+namespace cncd::daemon {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+
+// Passes the program's canonical commands to the feeder, except operator messages: the
+// simulation must not log them as if the program ran.
+class QuietSink final : public interp::CanonSink {
+ public:
+  explicit QuietSink(ProgramFeeder& feeder) : feeder_(feeder) {}
+  void emit(const interp::CanonCommand& command) override {
+    if (command.kind == interp::CanonKind::message ||
+        command.kind == interp::CanonKind::debug_message)
+      return;
+    feeder_.emit(command);
+  }
+
+ private:
+  ProgramFeeder& feeder_;
+};
+
+interp::Units machine_units(const config::MachineConfig& config) {
+  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
+                                                          : interp::Units::mm;
+}
+
+// One simulation run: the interpreter feeding the planner and the servo loop as the daemon's
+// Task::feed() does, the loop stepped in virtual time.
+class Simulation {
+ public:
+  Simulation(const config::MachineConfig& machine, std::string program,
+             const PlanSimOptions& options, PlanSimResult& result)
+      : machine_(machine),
+        program_(std::move(program)),
+        options_(options),
+        result_(result),
+        interp_(options.interp),
+        feeder_(machine_units(machine), unused_events_),
+        sink_(feeder_),
+        planner_(machine) {}
+
+  void run() {
+    if (auto error = interp_.open(program_)) {
+      result_.error = CheckProblem{error->file, error->line, error->message};
+      return;
+    }
+    if (!start_machine()) return;
+    feeder_.start_program();
+    std::uint64_t& cycle = cycle_;
+    for (;;) {
+      if (!feed()) return;
+      const motion::Status before = loop_->status();
+      const std::uint64_t done_before = before.segments_done - base_;
+      if (interp_done_ && feeder_.pending.empty() && done_before >= pushed_ &&
+          before.motion == motion::MotionState::idle)
+        break;
+      if ((cycle & 1023) == 0 && over_budget(before.line)) break;
+      const double begin_s = static_cast<double>(cycle) * result_.period_s;
+      const double cpu_start = options_.measure ? thread_cpu_s() : 0.0;
+      loop_->cycle(0);
+      if (options_.measure) result_.servo_cpu_s += thread_cpu_s() - cpu_start;
+      ++cycle;
+      const motion::Status s = loop_->status();
+      if (s.fault_reason[0] != '\0') {
+        result_.error = CheckProblem{program_, s.line, s.fault_reason};
+        break;
+      }
+      const std::uint64_t done = s.segments_done - base_;
+      for (std::uint64_t i = done_before + 1; i <= done && i < pushed_; ++i)
+        result_.move_start_s[i] = begin_s;
+      const double t = static_cast<double>(cycle) * result_.period_s;
+      if (options_.on_sample) options_.on_sample(t, s.commanded);
+      if (options_.measure) measure(s, done);
+    }
+    result_.cycles = cycle;
+    result_.cycle_time_s = static_cast<double>(cycle) * result_.period_s;
+  }
+
+ private:
+  // Machine on at the start position, all joints as if homed there: the planner checks the
+  // soft limits as it does for a homed machine.
+  bool start_machine() {
+    interp::Pose start{};
+    if (options_.start_machine) {
+      start = *options_.start_machine;
+    } else {
+      const interp::InterpState state = interp_.state();
+      for (std::size_t i = 0; i < start.size(); ++i)
+        start[i] = state.g5x_offset[i] + state.g92_offset[i] + state.tool_offset[i];
+    }
+    interp_.set_machine_position(start);
+    std::vector<int> joints;
+    motion::JointArray joint_start{};
+    for (std::size_t j = 0; j < machine_.joints.size() && j < joint_start.size(); ++j) {
+      joints.push_back(static_cast<int>(j));
+      const int axis = config::axis_index(machine_.joints[j].axis);
+      if (axis >= 0) joint_start[j] = start[static_cast<std::size_t>(axis)];
+    }
+    if (auto problem = sim_.configure(machine_, joints); !problem.empty()) {
+      result_.error = CheckProblem{program_, 0, "simulated drives: " + problem};
+      return false;
+    }
+    loop_ = std::make_unique<motion::ServoLoop>(
+        machine_, std::vector<motion::DriverBinding>{{&sim_, joints}});
+    loop_->set_start_positions(joint_start);
+    loop_->commands().push(motion::Command{motion::Command::Kind::reset_estop});
+    loop_->commands().push(motion::Command{motion::Command::Kind::on});
+    loop_->cycle(0);
+    loop_->cycle(0);
+    const motion::Status status = loop_->status();
+    if (status.machine != motion::MachineState::on) {
+      result_.error = CheckProblem{
+          program_, 0,
+          std::string("the simulated machine does not turn on: ") + status.fault_reason};
+      return false;
+    }
+    base_ = status.segments_done;
+    plan_end_ = status.commanded;
+    previous_ = status.commanded;
+    return true;
+  }
+
+  // Fills the segment queue as far as it goes, reading the program as needed. False on error.
+  bool feed() {
+    auto& ring = loop_->segments();
+    for (int blocks = 0;; ++blocks) {
+      while (!feeder_.pending.empty()) {
+        if (ring.size() >= ring.capacity()) return true;
+        const motion::Move& move = feeder_.pending.front();
+        std::string error;
+        const double cpu_start = thread_cpu_s();
+        const auto segment = planner_.plan(move, plan_end_, true, error);
+        result_.planner_cpu_s += thread_cpu_s() - cpu_start;
+        if (!segment) {
+          result_.error = CheckProblem{program_, move.line, error};
+          return false;
+        }
+        if (!ring.push(*segment)) return true;
+        account(*segment);
+        plan_end_ = segment->end;
+        feeder_.pending.pop_front();
+      }
+      if (interp_done_) return true;
+      // A program reading thousands of blocks without a move still answers the budget.
+      if ((blocks & 4095) == 4095 && over_budget(interp_.current_line())) return false;
+      const auto step = interp_.step(sink_);
+      if (step == interp::Interpreter::Step::error) {
+        const auto& error = interp_.error();
+        result_.error = error ? CheckProblem{error->file, error->line, error->message}
+                              : CheckProblem{program_, interp_.current_line(), "interpreter error"};
+        return false;
+      }
+      // M0/M1/M60 wait for the operator: the estimate leaves that time out.
+      feeder_.stop_seen = false;
+      if (step == interp::Interpreter::Step::end) interp_done_ = true;
+    }
+  }
+
+  void account(const motion::Segment& segment) {
+    ++pushed_;
+    ++result_.moves;
+    result_.move_line.push_back(segment.line);
+    result_.move_start_s.push_back(pushed_ == 1 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
+    if (segment.kind == motion::Segment::Kind::dwell) {
+      result_.feed_bound_s += segment.dwell_s;
+      result_.exact_stop_bound_s += segment.dwell_s;
+    } else {
+      const MoveLimits limits = move_limits(machine_, segment);
+      if (segment.length > 0 && limits.velocity < 1e300)
+        result_.feed_bound_s += segment.length / limits.velocity;
+      result_.exact_stop_bound_s +=
+          rest_to_rest_s(segment.length, limits.velocity, limits.acceleration);
+    }
+    if (options_.measure) window_.push_back(segment);
+  }
+
+  // Sets `stopped` and returns true when a budget is used up or the caller cancelled.
+  bool over_budget(int line) {
+    std::string why;
+    const double machine_s = static_cast<double>(cycle_) * result_.period_s;
+    if (options_.cancel && options_.cancel->load(std::memory_order_relaxed)) {
+      why = "simulation cancelled";
+    } else if (options_.max_machine_s > 0 && machine_s > options_.max_machine_s) {
+      why = "the program runs longer than " + std::to_string(options_.max_machine_s) +
+            " s of machine time";
+    } else if (options_.max_moves > 0 && pushed_ > options_.max_moves) {
+      why = "the program has more than " + std::to_string(options_.max_moves) + " moves";
+    } else if (options_.max_wall_s > 0 &&
+               std::chrono::duration<double>(Clock::now() - wall_start_).count() >
+                   options_.max_wall_s) {
+      why = "simulation stopped after " + std::to_string(options_.max_wall_s) + " s";
+    }
+    if (why.empty()) return false;
+    result_.stopped = CheckProblem{program_, line, why};
+    return true;
+  }
+
+  void measure(const motion::Status& s, std::uint64_t done) {
+    const double period = result_.period_s;
+    for (int i = 0; i < motion::kAxes; ++i) {
+      if (!machine_.axes[static_cast<std::size_t>(i)].present) continue;
+      const double v = (s.commanded[i] - previous_[i]) / period;
+      const double a = (v - velocity_[i]) / period;
+      result_.peak_velocity[i] = std::max(result_.peak_velocity[i], std::abs(v));
+      result_.peak_acceleration[i] = std::max(result_.peak_acceleration[i], std::abs(a));
+      velocity_[i] = v;
+    }
+    previous_ = s.commanded;
+    // The sample lies on the move under way or, where the path blends, on a neighbour.
+    while (!window_.empty() && window_first_ + 3 <= done) {
+      window_.pop_front();
+      ++window_first_;
+    }
+    double nearest = std::numeric_limits<double>::infinity();
+    const std::uint64_t last = std::min<std::uint64_t>(done + 2, window_first_ + window_.size());
+    for (std::uint64_t i = window_first_; i < last; ++i)
+      nearest = std::min(nearest, distance_to_path(window_[i - window_first_], s.commanded));
+    if (std::isfinite(nearest) && nearest > result_.max_deviation) {
+      result_.max_deviation = nearest;
+      result_.max_deviation_line = s.line;
+    }
+  }
+
+  const config::MachineConfig& machine_;
+  std::string program_;
+  const PlanSimOptions& options_;
+  PlanSimResult& result_;
+  interp::Interpreter interp_;
+  EventLog unused_events_;  // the feeder's, never written: messages are dropped before it
+  ProgramFeeder feeder_;
+  QuietSink sink_;
+  motion::Planner planner_;
+  drivers::SimDriver sim_;
+  std::unique_ptr<motion::ServoLoop> loop_;
+  const Clock::time_point wall_start_ = Clock::now();
+  std::uint64_t cycle_ = 0;   // servo periods since the program started
+  std::uint64_t base_ = 0;    // segments done before the program
+  std::uint64_t pushed_ = 0;  // segments queued by the program
+  bool interp_done_ = false;
+  motion::AxisPose plan_end_{};
+  motion::AxisPose previous_{};
+  motion::AxisPose velocity_{};
+  std::deque<motion::Segment> window_;  // queued segments from index window_first_ on
+  std::uint64_t window_first_ = 0;
+};
+
+}  // namespace
+
+PlanSimResult simulate_plan(const config::MachineConfig& machine,
+                            const std::filesystem::path& program, const PlanSimOptions& options) {
+  const auto wall_start = Clock::now();
+  PlanSimResult result;
+  result.period_s = static_cast<double>(machine.servo_period_ns) * 1e-9;
+  auto simulation = std::make_unique<Simulation>(machine, program.string(), options, result);
+  simulation->run();
+  result.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,85 @@
+// Offline plan simulation: runs a program through the interpreter, the daemon's ProgramFeeder,
+// the real Planner and a ServoLoop on simulated drives, cycle by cycle in virtual time (no
+// thread, no sleeping), and measures what the machine would do: the cycle time, its lower
+// bounds, peak axis velocity and acceleration, the deviation from the programmed path and when
+// each move starts. Used by `cncd-check --plan`, the daemon's remaining-time estimate and the
+// planner benchmark. Any thread; no shared state.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/motion/types.hpp"
+#include "program_check.hpp"
+
+namespace cncd::daemon {
+
+struct PlanSimOptions {
+  interp::InterpOptions interp;
+  // Where the machine stands when the program starts (machine coordinates and units); unset =
+  // program zero in the coordinate system the program starts in.
+  std::optional<interp::Pose> start_machine;
+  // The simulation stops (PlanSimResult::stopped) after this much wall-clock time, after this
+  // much simulated machine time, or past this many moves; 0 = no limit.
+  double max_wall_s = 0;
+  double max_machine_s = 0;
+  std::size_t max_moves = 0;
+  // Measure peaks and path deviation (a little slower); the daemon's estimate does without.
+  bool measure = true;
+  // Called once per servo period with the time (s, from the program's start) and the
+  // commanded axis positions (machine coordinates) at the end of that period.
+  std::function<void(double, const motion::AxisPose&)> on_sample;
+  // Set from another thread to stop the simulation early (PlanSimResult::stopped says so).
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+struct PlanSimResult {
+  // The interpreter's error, a move the planner refused, or why the simulation stopped early;
+  // the figures below then cover the part simulated.
+  std::optional<CheckProblem> error;
+  std::optional<CheckProblem> stopped;
+  bool complete() const { return !error && !stopped; }
+
+  double period_s = 0;
+  std::uint64_t cycles = 0;  // servo periods from the program's start until motion ended
+  double cycle_time_s = 0;   // cycles * period
+  // Sum over the moves of length / programmed feed (capped by the axis limits along the move),
+  // traverses at the fastest speed the axes allow along them, dwells included.
+  double feed_bound_s = 0;
+  // Every move a rest-to-rest trapezoid at that speed within the axes' accelerations, dwells
+  // included: what a planner stopping after every move needs at least.
+  double exact_stop_bound_s = 0;
+  std::size_t moves = 0;  // moves planned (dwells included)
+  // Per axis (config::axis_index), from finite differences of the commanded positions per
+  // servo period: the largest |velocity| (units/s) and |acceleration| (units/s^2).
+  motion::AxisPose peak_velocity{};
+  motion::AxisPose peak_acceleration{};
+  // Largest XYZ distance from a commanded position to the programmed path near the move under
+  // way (units), and the program line where it happened.
+  double max_deviation = 0;
+  int max_deviation_line = 0;
+  // For each planned move in order: its source line and when it starts (s, virtual time).
+  std::vector<std::int32_t> move_line;
+  std::vector<double> move_start_s;
+  double planner_cpu_s = 0;  // thread CPU time spent in Planner::plan
+  double servo_cpu_s = 0;    // thread CPU time spent in ServoLoop::cycle (with `measure`)
+  double wall_s = 0;         // wall-clock time of the whole simulation
+};
+
+// Simulates `program` on `machine`. Never writes the parameter file or the tool table.
+PlanSimResult simulate_plan(const config::MachineConfig& machine,
+                            const std::filesystem::path& program, const PlanSimOptions& options);
+
+// The human report cncd-check --plan prints, and the same as one JSON object (one line).
+std::string describe_plan(const config::MachineConfig& machine, const PlanSimResult& result);
+std::string plan_json(const config::MachineConfig& machine, const PlanSimResult& result);
+
+}  // namespace cncd::daemon

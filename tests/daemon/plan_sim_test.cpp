@@ -1,0 +1,177 @@
+// The offline plan simulation (plan_sim) and cncd-check --plan: cycle time against the bounds
+// worked out by hand, peaks within the limits, path deviation, per-move start times, errors
+// naming file and line, budgets, the trajectory CSV.
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "daemon_process.hpp"
+#include "plan_sim.hpp"
+
+namespace cncd::test {
+namespace {
+
+class PlanSimTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ini_ = copy_example_machine(dir_.path());
+    loaded_ = config::load_machine_config(ini_);
+    ASSERT_TRUE(loaded_.ok());
+    options_.interp = daemon::interpreter_options(*loaded_.config);
+  }
+  const config::MachineConfig& machine() const { return *loaded_.config; }
+  daemon::PlanSimResult simulate(const std::string& program) {
+    return daemon::simulate_plan(machine(), dir_.write("prog.ngc", program), options_);
+  }
+
+  TempDir dir_;
+  std::filesystem::path ini_;
+  config::LoadResult loaded_;
+  daemon::PlanSimOptions options_;
+};
+
+TEST_F(PlanSimTest, AStraightFeedTakesItsTrapezoidAndStaysWithinTheLimits) {
+  // 10 mm at 10 mm/s, X accelerating at 2000 mm/s^2: 1 s plus 5 ms of ramps.
+  const auto r = simulate("G21 G90\nG1 X10 F600\nM2\n");
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+  EXPECT_EQ(r.moves, 1u);
+  EXPECT_NEAR(r.feed_bound_s, 1.0, 1e-12);
+  EXPECT_NEAR(r.exact_stop_bound_s, 1.005, 1e-12);
+  EXPECT_GE(r.cycle_time_s, 1.005 - 1e-9);
+  EXPECT_LE(r.cycle_time_s, 1.005 + 2 * r.period_s);
+  EXPECT_EQ(r.cycles, static_cast<std::uint64_t>(std::llround(r.cycle_time_s / r.period_s)));
+  EXPECT_NEAR(r.peak_velocity[0], 10.0, 1e-6);
+  EXPECT_LE(r.peak_acceleration[0], 2000.0 * 1.001);
+  EXPECT_GE(r.peak_acceleration[0], 1900.0);
+  EXPECT_EQ(r.peak_velocity[1], 0.0);
+  EXPECT_LT(r.max_deviation, 1e-9);
+  ASSERT_EQ(r.move_start_s.size(), 1u);
+  EXPECT_EQ(r.move_start_s[0], 0.0);
+  EXPECT_EQ(r.move_line[0], 2);
+}
+
+TEST_F(PlanSimTest, RapidsRunAtTheFastestSpeedTheAxesAllowAlongThem) {
+  // Diagonal: each axis would allow 200 * sqrt(2) mm/s, [TRAJ] MAX_LINEAR_VELOCITY caps at 250.
+  const auto r = simulate("G21 G90\nG0 X100 Y100\nM2\n");
+  ASSERT_TRUE(r.complete());
+  const double length = std::sqrt(2.0) * 100;
+  EXPECT_NEAR(r.feed_bound_s, length / 250, 1e-12);
+  EXPECT_NEAR(r.exact_stop_bound_s, length / 250 + 250 / (2000 * std::sqrt(2.0)), 1e-12);
+  EXPECT_GE(r.cycle_time_s, r.exact_stop_bound_s - 1e-9);
+  EXPECT_LE(r.peak_velocity[0], 200 * 1.001);
+  EXPECT_LE(r.peak_acceleration[1], 2000 * 1.001);
+}
+
+TEST_F(PlanSimTest, ArcsAndDwellsAreFollowedAndEachMoveGetsItsStartTime) {
+  std::vector<double> times;
+  options_.on_sample = [&times](double t, const motion::AxisPose&) { times.push_back(t); };
+  const auto r = simulate("G21 G90\nG0 X20 Y0\nG2 X20 Y0 I-10 J0 F1200\nG4 P0.25\nG1 X30\nM2\n");
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : "");
+  ASSERT_EQ(r.moves, 4u);
+  EXPECT_EQ(r.move_line, (std::vector<std::int32_t>{2, 3, 4, 5}));
+  for (std::size_t i = 1; i < r.move_start_s.size(); ++i)
+    EXPECT_GT(r.move_start_s[i], r.move_start_s[i - 1]) << i;
+  // The dwell starts when the circle ends and lasts its 0.25 s.
+  EXPECT_NEAR(r.move_start_s[3] - r.move_start_s[2], 0.25, 2 * r.period_s);
+  // The full circle: 2 pi 10 mm at 20 mm/s is in the feed bound, and so is the dwell.
+  const double rapid = 20.0 / 200;
+  EXPECT_NEAR(r.feed_bound_s, rapid + 2 * M_PI * 10 / 20 + 0.25 + 10.0 / 20, 1e-9);
+  EXPECT_LT(r.max_deviation, 1e-6);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(r.peak_velocity[axis], machine().axes[axis].max_velocity * 1.001);
+    EXPECT_LE(r.peak_acceleration[axis], machine().axes[axis].max_acceleration * 1.001);
+  }
+  ASSERT_EQ(times.size(), r.cycles);
+  EXPECT_NEAR(times.back(), r.cycle_time_s, 1e-9);
+  EXPECT_NEAR(times.front(), r.period_s, 1e-12);
+}
+
+TEST_F(PlanSimTest, StartsWhereTheMachineStands) {
+  options_.start_machine = interp::Pose{50, 60, 0};
+  const auto r = simulate("G21 G91\nG1 X10 F600\nM2\n");
+  ASSERT_TRUE(r.complete());
+  EXPECT_NEAR(r.feed_bound_s, 1.0, 1e-12);
+  EXPECT_LT(r.max_deviation, 1e-9);
+}
+
+TEST_F(PlanSimTest, ErrorsNameTheFileAndTheLine) {
+  auto r = simulate("G21 G90\nG0 X5\nG1 X10\nM2\n");
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 3);
+  EXPECT_NE(r.error->file.find("prog.ngc"), std::string::npos);
+  r = simulate("G21 G90\nG0 X5\nG1 X320 F600\nM2\n");
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 3);
+  EXPECT_NE(r.error->message.find("X soft limits"), std::string::npos) << r.error->message;
+}
+
+TEST_F(PlanSimTest, BudgetsAndCancellingStopTheSimulationAndSaySo) {
+  options_.max_machine_s = 0.5;
+  auto r = simulate("G21 G90\nG1 X20 F600\nM2\n");
+  ASSERT_TRUE(r.stopped);
+  EXPECT_FALSE(r.complete());
+  EXPECT_NE(r.stopped->message.find("longer than"), std::string::npos) << r.stopped->message;
+  EXPECT_LE(r.cycle_time_s, 0.5 + 1.1);
+  options_.max_machine_s = 0;
+  std::atomic<bool> cancel{true};
+  options_.cancel = &cancel;
+  r = simulate("G21 G90\nG1 X20 F600\nM2\n");
+  ASSERT_TRUE(r.stopped);
+  EXPECT_NE(r.stopped->message.find("cancelled"), std::string::npos);
+}
+
+std::vector<std::string> lines_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);)
+    lines.push_back(line);
+  return lines;
+}
+
+TEST_F(PlanSimTest, CncdCheckPlanPrintsFiguresJsonAndTheTrajectory) {
+  const auto program = dir_.write("part.ngc", "G21 G90\nG0 X5 Y5\nG1 X15 F600\nM2\n");
+  auto r = run_command({CNCD_CHECK_BINARY, "--plan", "--ini", ini_.string(), program.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("cycle time: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("feed-limited bound: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("max path deviation: "), std::string::npos) << r.out;
+
+  const auto csv = dir_.path() / "out.csv";
+  r = run_command({CNCD_CHECK_BINARY, "--plan", "--json", "--trajectory", csv.string(), "--ini",
+                   ini_.string(), program.string()});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["complete"], true);
+  EXPECT_EQ(report["moves"], 2);
+  EXPECT_GT(report["cycle_time_s"].get<double>(), report["feed_bound_s"].get<double>());
+  EXPECT_LE(report["axes"]["x"]["acceleration_ratio"].get<double>(), 1.001);
+  const auto rows = lines_of(csv);
+  ASSERT_EQ(rows.size(), report["cycles"].get<std::size_t>() + 1);
+  EXPECT_EQ(rows.front(), "t,x,y,z");
+  char last[80];
+  std::snprintf(last, sizeof last, "%.6f,15.000000,5.000000,0.000000",
+                report["cycle_time_s"].get<double>());
+  EXPECT_EQ(rows.back(), last);
+  EXPECT_FALSE(std::filesystem::exists(csv.string() + ".tmp"));
+}
+
+TEST_F(PlanSimTest, CncdCheckPlanRefusesBadUseAndReportsProgramErrors) {
+  const auto program = dir_.write("bad.ngc", "G21 G90\nG1 X10\nM2\n");
+  EXPECT_EQ(run_command({CNCD_CHECK_BINARY, "--plan", program.string()}).exit_status, 2);
+  EXPECT_EQ(run_command({CNCD_CHECK_BINARY, "--json", program.string()}).exit_status, 2);
+  auto r = run_command({CNCD_CHECK_BINARY, "--plan", "--ini", ini_.string(), program.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find(program.string() + ":2:"), std::string::npos) << r.err;
+  const auto good = dir_.write("good.ngc", "G0 X1\nM2\n");
+  r = run_command({CNCD_CHECK_BINARY, "--plan", "--trajectory", "/nonexistent/dir/t.csv", "--ini",
+                   ini_.string(), good.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("cannot write /nonexistent/dir/t.csv"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace cncd::test
