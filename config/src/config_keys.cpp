@@ -163,6 +163,9 @@ constexpr std::array kKeys{
           "gpio: line of the maximum limit switch input; empty: none"},
   KeySpec{"JOINT_n", "MAX_LIMIT_ACTIVE_LOW", boolean, "0", 0, 0, false, "", "",
           "gpio: the maximum limit switch reads low when tripped"},
+  KeySpec{"JOINT_n", "SIM_LAG", real, "0", 0, 10, false, "s", "",
+          "sim: the simulated motor follows its command through a first-order lag of this time "
+          "constant (to try the following-error limits); 0 = it is exactly where commanded"},
   KeySpec{"JOINT_n", "STEPLEN", integer, "1", 0, 100'000'000, false, "ns", "",
           "gpio: shortest time the step line is high (rounded up to base periods)"},
   KeySpec{"JOINT_n", "STEPSPACE", integer, "1", 0, 100'000'000, false, "ns", "",

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ini_lookup.hpp"
+
 namespace cncd::drivers {
 
 std::string SimDriver::configure(const config::MachineConfig& machine,
@@ -10,11 +12,14 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   if (joints.size() > static_cast<std::size_t>(kMaxJoints)) return "too many joints for one driver";
   if (machine.servo_period_ns <= 0) return "the servo period must be positive";
   period_s_ = static_cast<double>(machine.servo_period_ns) * 1e-9;
+  IniLookup ini(machine);
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const int j = joints[i];
     if (j < 0 || static_cast<std::size_t>(j) >= machine.joints.size()) {
       return "joint " + std::to_string(j) + " is not in the configuration";
     }
+    lag_s_[i].store(ini.real(joint_section(j), "SIM_LAG", 0.0, 0.0, 10.0));
+    if (!ini.error().empty()) return ini.error();
     const auto& joint = machine.joints[static_cast<std::size_t>(j)];
     const int direction = joint.home_search_vel > 0 ? 1 : joint.home_search_vel < 0 ? -1 : 0;
     set_home_switch(static_cast<int>(i), joint.home_offset, direction);
@@ -31,11 +36,11 @@ void SimDriver::write(const JointCommand* commands, int count) noexcept {
 }
 
 void SimDriver::read(JointFeedback* feedback, int count) noexcept {
-  const double lag = lag_s_.load(std::memory_order_relaxed);
-  // Exact discretization of a first-order lag: stable for any period.
-  const double alpha = lag > 0 ? 1.0 - std::exp(-period_s_ / lag) : 1.0;
   for (int i = 0; i < count && i < kMaxJoints; ++i) {
     const auto k = static_cast<std::size_t>(i);
+    const double lag = lag_s_[k].load(std::memory_order_relaxed);
+    // Exact discretization of a first-order lag: stable for any period.
+    const double alpha = lag > 0 ? 1.0 - std::exp(-period_s_ / lag) : 1.0;
     feedback[i].stale = stale_[k].load(std::memory_order_relaxed);
     feedback[i].fault = fault_[k].load(std::memory_order_relaxed);
     if (!feedback[i].stale) position_[k] += (commanded_[k] - position_[k]) * alpha;
@@ -62,6 +67,11 @@ bool SimDriver::fault_reason(char* out, std::size_t size) const noexcept {
     return true;
   }
   return false;
+}
+
+void SimDriver::set_lag(double time_constant_s) noexcept {
+  for (auto& lag : lag_s_)
+    lag.store(time_constant_s);
 }
 
 void SimDriver::set_fault(int index, bool fault) noexcept {

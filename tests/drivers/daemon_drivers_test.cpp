@@ -272,5 +272,39 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   EXPECT_EQ(done["position"]["commanded"]["x"], 20.0);
 }
 
+TEST(DriversEndToEnd, ASimulatedMotorThatLagsTripsTheFollowingError) {
+  TempDir dir;
+  const std::string ini = adapt(dir, "sim_mm.ini", {{"[JOINT_0]\n", "[JOINT_0]\nSIM_LAG = 0.5\n"}});
+  DaemonProcess daemon;
+  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
+  daemon::Client client;
+  ASSERT_EQ(client.connect(daemon.socket()), "");
+  result(client.call("machine.reset"));
+  result(client.call("machine.on"));
+  result(client.call("machine.home"));
+  const auto wait_until = [&](auto done) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    json s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      s = result(client.call("status.get"));
+      if (done(s)) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
+    return s;
+  };
+  wait_until([](const json& s) { return s["homed"][0] == true && s["motion"] == "idle"; });
+  const auto program = dir.write("lag.ngc", "G21 G90 G1 F3000 X50\nM2\n");
+  result(client.call("program.open", {{"path", program.string()}}));
+  result(client.call("program.run"));
+  const json end = wait_until([](const json& s) { return s["exec"] == "idle"; });
+  EXPECT_EQ(end["program"]["result"], "aborted") << end.dump();
+  EXPECT_NE(end["fault"].get<std::string>().find("joint 0: following error"), std::string::npos)
+      << end["fault"];
+  EXPECT_EQ(end["state"], "off");
+  EXPECT_EQ(end["joint_fault"][0], true);
+  EXPECT_LT(end["position"]["commanded"]["x"].get<double>(), 50.0);
+}
+
 }  // namespace
 }  // namespace cncd::test

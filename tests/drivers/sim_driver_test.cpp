@@ -1,12 +1,15 @@
 // The sim driver through the Driver interface: echo, lag, injected faults and switches.
 #include <atomic>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
+#include "test_util.hpp"
 
 namespace cncd::drivers {
 namespace {
@@ -75,6 +78,37 @@ TEST(SimDriver, LagIsFirstOrder) {
     sim.read(&feedback, 1);
     EXPECT_NEAR(feedback.position, 1 - std::exp(-n * 0.001 / 0.010), 1e-12) << n;
   }
+}
+
+TEST(SimDriver, EachJointTakesItsLagFromTheIni) {
+  test::TempDir dir;
+  // Joint 0 gets SIM_LAG = 0.00, joint 1 SIM_LAG = 0.01.
+  const auto loaded = test::load_machine(dir, 2, "DRIVER = sim\nSIM_LAG = 0.0{j}", "");
+  ASSERT_TRUE(loaded.config);
+  SimDriver sim;
+  ASSERT_EQ(sim.configure(*loaded.config, {0, 1}), "");
+  JointCommand commands[2] = {{0, 0, true}, {0, 0, true}};
+  sim.write(commands, 2);
+  commands[0].position = commands[1].position = 1;
+  sim.write(commands, 2);
+  JointFeedback feedback[2];
+  sim.read(feedback, 2);
+  EXPECT_EQ(feedback[0].position, 1.0);  // no SIM_LAG: an exact echo
+  EXPECT_NEAR(feedback[1].position, 1 - std::exp(-0.001 / 0.01), 1e-12);
+}
+
+TEST(SimDriver, ABadLagNamesItsFileAndLine) {
+  test::TempDir dir;
+  ASSERT_TRUE(test::load_machine(dir, 2, "DRIVER = sim\nSIM_LAG = 0.5", "").config);
+  std::ifstream in(dir.path() / "machine.ini");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("SIM_LAG = 0.5"), 13, "SIM_LAG = slow");
+  const auto loaded = config::load_machine_config(dir.write("lag.ini", text));
+  ASSERT_TRUE(loaded.config);
+  SimDriver sim;
+  const std::string problem = sim.configure(*loaded.config, {0, 1});
+  EXPECT_NE(problem.find("lag.ini:"), std::string::npos) << problem;
+  EXPECT_NE(problem.find("[JOINT_0] SIM_LAG"), std::string::npos) << problem;
 }
 
 TEST(SimDriver, InjectedFaultsStaleFeedbackLimitsAndEstop) {

@@ -15,7 +15,8 @@ class SimDriver final : public Driver {
  public:
   // Non-RT. Every joint with a HOME_SEARCH_VEL gets a home switch at motor position
   // HOME_OFFSET (as if the machine powered up with motor and joint positions equal), closed
-  // from there on in the search direction, like a cam that a search runs onto.
+  // from there on in the search direction, like a cam that a search runs onto. Each joint's
+  // `[JOINT_n] SIM_LAG` (seconds) sets its lag.
   std::string configure(const config::MachineConfig& machine,
                         const std::vector<int>& joints) override;
   void enable() override {}
@@ -35,8 +36,9 @@ class SimDriver final : public Driver {
   // The injection API below is for any thread; `index` is the joint's position in
   // configure()'s list, out-of-range indexes are ignored.
 
-  // Feedback lags the command with this time constant in seconds (0 = exact echo).
-  void set_lag(double time_constant_s) noexcept { lag_s_.store(time_constant_s); }
+  // Feedback of every joint lags the command with this time constant in seconds (0 = exact
+  // echo).
+  void set_lag(double time_constant_s) noexcept;
   void set_fault(int index, bool fault) noexcept;
   void set_stale(int index, bool stale) noexcept;
   void set_limit(int index, bool min_limit, bool max_limit) noexcept;
@@ -53,7 +55,7 @@ class SimDriver final : public Driver {
   static bool valid(int index) noexcept { return index >= 0 && index < kMaxJoints; }
 
   double period_s_ = 0.001;
-  std::atomic<double> lag_s_{0};
+  std::array<std::atomic<double>, kMaxJoints> lag_s_{};
   std::atomic<bool> estop_{false};
   std::array<std::atomic<bool>, kMaxJoints> fault_{};
   std::array<std::atomic<bool>, kMaxJoints> stale_{};
