@@ -67,6 +67,8 @@ std::string describe(const MachineConfig& c) {
   line(out, "Homing:       " + std::string(c.no_force_homing ? "not required before programs"
                                                              : "required before programs"));
   line(out, "Feed override: up to " + num(c.max_feed_override * 100) + " %");
+  line(out, "Spindle override: " + num(c.min_spindle_override * 100) + " to " +
+                num(c.max_spindle_override * 100) + " %");
   line(out, "Parameters:   " + or_none(c.parameter_file));
   line(out, "Tool table:   " + or_none(c.tool_table));
   line(out, "Positions:    " + or_none(c.position_file));

@@ -148,6 +148,8 @@ void load_general(TypedReader& r, MachineConfig& c) {
   c.no_force_homing = r.boolean("TRAJ", "NO_FORCE_HOMING").value_or(false);
 
   if (const auto v = r.real("DISPLAY", "MAX_FEED_OVERRIDE")) c.max_feed_override = *v;
+  if (const auto v = r.real("DISPLAY", "MIN_SPINDLE_OVERRIDE")) c.min_spindle_override = *v;
+  if (const auto v = r.real("DISPLAY", "MAX_SPINDLE_OVERRIDE")) c.max_spindle_override = *v;
   load_cncd(r, c.cncd);
 }
 

@@ -25,6 +25,17 @@ void check_limits(TypedReader& r, const std::string& section, double min, double
             "MIN_LIMIT " + format_number(min) + " must be below MAX_LIMIT " + format_number(max));
 }
 
+void check_spindle_override(TypedReader& r, const MachineConfig& c) {
+  if (c.min_spindle_override <= c.max_spindle_override ||
+      r.failed("DISPLAY", "MIN_SPINDLE_OVERRIDE") || r.failed("DISPLAY", "MAX_SPINDLE_OVERRIDE"))
+    return;
+  const bool min_given = r.given("DISPLAY", "MIN_SPINDLE_OVERRIDE");
+  r.problem("DISPLAY", min_given ? "MIN_SPINDLE_OVERRIDE" : "MAX_SPINDLE_OVERRIDE",
+            "MIN_SPINDLE_OVERRIDE " + format_number(c.min_spindle_override) +
+                (min_given ? "" : " (the default)") + " must not be above MAX_SPINDLE_OVERRIDE " +
+                format_number(c.max_spindle_override));
+}
+
 void check_joint(TypedReader& r, const MachineConfig& c, int index, const JointConfig& j) {
   const std::string s = "JOINT_" + std::to_string(index);
   check_limits(r, s, j.min_limit, j.max_limit);
@@ -184,6 +195,7 @@ void validate(TypedReader& r, const MachineConfig& c) {
     check_joint(r, c, static_cast<int>(i), c.joints[i]);
   }
   check_drivers(r, c);
+  check_spindle_override(r, c);
   if (c.joint_count == 0) return;
   for (const auto& header : r.ini().sections()) {
     const std::string_view name = header.name;

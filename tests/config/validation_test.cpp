@@ -186,6 +186,38 @@ TEST_F(ValidationTest, UnsupportedKinematics) {
                                               "supported; cncd supports trivkins"});
 }
 
+TEST_F(ValidationTest, DisplayOverrideLimitsAreRead) {
+  const auto result = load_machine_config(write(
+      "m.ini", minimal_ini() + "[DISPLAY]\nMAX_FEED_OVERRIDE = 1.2\nMIN_SPINDLE_OVERRIDE = 0.5\n"
+                               "MAX_SPINDLE_OVERRIDE = 1.5\n"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(result.config->max_feed_override, 1.2);
+  EXPECT_EQ(result.config->min_spindle_override, 0.5);
+  EXPECT_EQ(result.config->max_spindle_override, 1.5);
+  const auto defaults = load_machine_config(write("d.ini", minimal_ini()));
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults.config->max_feed_override, 1.0);
+  EXPECT_EQ(defaults.config->min_spindle_override, 1.0);
+  EXPECT_EQ(defaults.config->max_spindle_override, 1.0);
+}
+
+TEST_F(ValidationTest, SpindleOverrideRangeMustNotBeInverted) {
+  // Lines 42.. are the appended [DISPLAY] section.
+  EXPECT_EQ(problems_of(minimal_ini() +
+                        "[DISPLAY]\nMIN_SPINDLE_OVERRIDE = 1.2\nMAX_SPINDLE_OVERRIDE = 0.8\n"),
+            std::vector<std::string>{at(43) +
+                                     ": [DISPLAY] MIN_SPINDLE_OVERRIDE: MIN_SPINDLE_OVERRIDE 1.2 "
+                                     "must not be above MAX_SPINDLE_OVERRIDE 0.8"});
+  EXPECT_EQ(problems_of(minimal_ini() + "[DISPLAY]\nMAX_SPINDLE_OVERRIDE = 0.8\n"),
+            std::vector<std::string>{at(43) +
+                                     ": [DISPLAY] MAX_SPINDLE_OVERRIDE: MIN_SPINDLE_OVERRIDE 1 "
+                                     "(the default) must not be above MAX_SPINDLE_OVERRIDE 0.8"});
+  EXPECT_EQ(problems_of(minimal_ini() + "[DISPLAY]\nMAX_SPINDLE_OVERRIDE = -1\n"),
+            std::vector<std::string>{at(43) +
+                                     ": [DISPLAY] MAX_SPINDLE_OVERRIDE: -1 is out of range: must "
+                                     "be between 0 and 10 ratio"});
+}
+
 TEST_F(ValidationTest, MissingKinsKeys) {
   EXPECT_EQ(
       problems_of(replace_line(replace_line(minimal_ini(), 10, ""), 11, "")),

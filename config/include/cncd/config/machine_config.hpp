@@ -123,7 +123,9 @@ struct MachineConfig {
   int joint_count = 0;
   int extra_joints = 0;  // [EMCMOT] EMCMOT = motmod num_extrajoints=N
   // [DISPLAY]
-  double max_feed_override = 1.0;         // 1.0 = 100 %
+  double max_feed_override = 1.0;  // 1.0 = 100 %
+  double min_spindle_override = 1.0;
+  double max_spindle_override = 1.0;
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
