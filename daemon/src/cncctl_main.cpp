@@ -91,10 +91,15 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
     if (exec != "idle" && !json_output && (tty || line != last_line)) {
       const double progress = p.value("progress", 0.0);
       const int filled = static_cast<int>(progress * 20.0 + 0.5);
-      std::printf("%s[%.*s%.*s] %3.0f%%  line %d/%llu  %s  %.1f s%s", tty ? "\r\033[K" : "", filled,
-                  "####################", 20 - filled, "                    ", 100.0 * progress,
-                  line, static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
-                  axes_text(s["position"]["commanded"]).c_str(), p.value("elapsed_s", 0.0),
+      // Remaining time from the daemon's plan estimate, when it has one for this run.
+      char left[48] = "";
+      if (p.contains("remaining_s") && p["remaining_s"].is_number())
+        std::snprintf(left, sizeof left, "  %.1f s left", p["remaining_s"].get<double>());
+      std::printf("%s[%.*s%.*s] %3.0f%%  line %d/%llu  %s  %.1f s%s%s", tty ? "\r\033[K" : "",
+                  filled, "####################", 20 - filled, "                    ",
+                  100.0 * progress, line,
+                  static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
+                  axes_text(s["position"]["commanded"]).c_str(), p.value("elapsed_s", 0.0), left,
                   tty ? "" : "\n");
       std::fflush(stdout);
       last_line = line;

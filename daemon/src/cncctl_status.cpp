@@ -111,7 +111,11 @@ void print_status(const json& s) {
       std::printf("program   %s  line %d of %llu  %.0f%%  %.1f s", path.c_str(),
                   get<int>(p, "line", 0), total, 100.0 * get<double>(p, "progress", 0.0),
                   get<double>(p, "elapsed_s", 0.0));
+      if (p.contains("remaining_s") && p["remaining_s"].is_number())
+        std::printf("  %.1f s left", p["remaining_s"].get<double>());
     }
+    if (p.contains("estimated_s") && p["estimated_s"].is_number())
+      std::printf("  (estimated %.1f s)", p["estimated_s"].get<double>());
     const std::string result = get<std::string>(p, "result", "");
     if (!result.empty()) std::printf("  last run: %s", result.c_str());
     std::printf("\n");

@@ -44,7 +44,8 @@ Task::Task(const config::MachineConfig& config, EventLog& events, Completions& c
       motion_(config),
       feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
       interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))),
-      saved_tools_(interp_->tools()) {}
+      saved_tools_(interp_->tools()),
+      estimator_(config) {}
 
 Task::~Task() {
   shutdown();
@@ -135,6 +136,10 @@ void Task::open_program(const std::string& path) {
   std::ifstream probe(path);
   if (!probe) throw RpcError(kProgramError, "cannot open program '" + path + "': not readable");
   check_limits(path);
+  interp::Pose start{};
+  const motion::AxisPose here = motion_.status().commanded;
+  std::copy(here.begin(), here.end(), start.begin());
+  estimator_.start(path, interpreter_options(config_), start);
   program_path_ = path;
   program_lines_ = count_lines(path);
   last_result_.clear();
@@ -191,6 +196,7 @@ void Task::run_program(int from_line, bool step) {
   }
   start_run(Mode::automatic, status);
   skip_to_line_ = from_line > 1 ? from_line : 0;
+  from_top_ = skip_to_line_ == 0;
   skip_moved_ = false;
   stepping_ = step;
   step_budget_ = step ? 1 : 0;
@@ -232,7 +238,8 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   moves_enqueued_ = 0;
   moves_done_base_ = status.segments_done;
   mode_ = mode;
-  exec_ = ExecState::running;
+  paused_s_ = 0;
+  set_exec(ExecState::running);
   stepping_ = false;
   step_budget_ = 0;
   skip_to_line_ = 0;
@@ -241,14 +248,14 @@ void Task::start_run(Mode mode, const motion::Status& status) {
 void Task::pause() {
   if (exec_ != ExecState::running) throw RpcError(kWrongState, "no program is running");
   motion_.pause();
-  exec_ = ExecState::paused;
+  set_exec(ExecState::paused);
 }
 
 void Task::resume() {
   if (exec_ != ExecState::paused) throw RpcError(kWrongState, "the program is not paused");
   stepping_ = false;
   motion_.resume();
-  exec_ = ExecState::running;
+  set_exec(ExecState::running);
 }
 
 void Task::abort(std::uint64_t token) {
@@ -263,7 +270,7 @@ void Task::finish_program(const std::string& result, const std::string& error) {
   save_parameters();
   save_tools_if_changed();
   if (mode_ == Mode::mdi) {
-    exec_ = ExecState::idle;
+    set_exec(ExecState::idle);
     mode_ = Mode::manual;
     if (result == "done") {
       completions_.complete(mdi_token_, nlohmann::json{{"ok", true}});
@@ -277,7 +284,7 @@ void Task::finish_program(const std::string& result, const std::string& error) {
     return;
   }
   feeder_->pending.clear();
-  exec_ = ExecState::idle;
+  set_exec(ExecState::idle);
   stepping_ = false;
   skip_to_line_ = 0;
   moves_completed_ = motion_.status().segments_done - moves_done_base_;
@@ -356,7 +363,7 @@ void Task::poll() {
   if (feeder_->stop_seen) {
     // M0/M1/M60 reached: the machine has stopped at that point; resume continues.
     feeder_->stop_seen = false;
-    exec_ = ExecState::paused;
+    set_exec(ExecState::paused);
     events_.add("info", "program",
                 fmt::format("stopped by M0/M1/M60 at line {}", interp_->current_line()));
     return;
@@ -364,7 +371,7 @@ void Task::poll() {
   if (interp_done_) {
     finish_program("done", "");
   } else if (stepping_ && step_budget_ == 0) {
-    exec_ = ExecState::paused;  // program.step: the line has been carried out
+    set_exec(ExecState::paused);  // program.step: the line has been carried out
   }
 }
 

@@ -19,6 +19,7 @@
 #include "cncd/motion/controller.hpp"
 #include "event_log.hpp"
 #include "feeder.hpp"
+#include "plan_estimate.hpp"
 #include "rpc.hpp"
 
 namespace cncd::daemon {
@@ -99,6 +100,10 @@ class Task {
  private:
   void feed();
   void start_run(Mode mode, const motion::Status& status);
+  // Changes exec_, keeping count of the time spent paused (task_status.cpp).
+  void set_exec(ExecState next);
+  // The program's remaining_s and estimated_s (null when unknown) and why (task_status.cpp).
+  nlohmann::json time_estimate(std::uint64_t moves_done) const;
   void drain_servo_events();
   void save_parameters();
   void save_positions();
@@ -139,6 +144,10 @@ class Task {
   int step_budget_ = 0;    // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
+  PlanEstimator estimator_;  // the open program's running time, worked out in the background
+  bool from_top_ = false;    // the run started at the program's first line
+  std::chrono::steady_clock::time_point paused_since_{};
+  double paused_s_ = 0;         // time the current run has spent paused, up to paused_since_
   bool files_corrupt_ = false;  // load_files() failed: keep them as they are for the user
   bool started_ = false;        // motion started: its joint positions are worth saving
 };

@@ -43,7 +43,7 @@ void Task::step() {
     return;
   }
   motion_.resume();
-  exec_ = ExecState::running;
+  set_exec(ExecState::running);
   stepping_ = true;
   step_budget_ = 1;
   feed();

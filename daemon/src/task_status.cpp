@@ -115,6 +115,49 @@ std::string coord_system_name(int system) {
   return code_name('G', system < 7 ? 530 + 10 * system : 584 + system);
 }
 
+void Task::set_exec(ExecState next) {
+  const auto now = std::chrono::steady_clock::now();
+  if (exec_ == ExecState::paused && next != ExecState::paused)
+    paused_s_ += std::chrono::duration<double>(now - paused_since_).count();
+  if (exec_ != ExecState::paused && next == ExecState::paused) paused_since_ = now;
+  exec_ = next;
+}
+
+json Task::time_estimate(std::uint64_t moves_done) const {
+  const PlanEstimate estimate = estimator_.get();
+  json out = {{"estimated_s", nullptr}, {"remaining_s", nullptr}, {"remaining_reason", ""}};
+  if (program_path_.empty()) return out;
+  if (estimate.state != PlanEstimate::State::done) {
+    out["remaining_reason"] = estimate.reason;
+    return out;
+  }
+  const double total = estimate.estimated_s;
+  out["estimated_s"] = total;
+  if (exec_ == ExecState::idle || mode_ != Mode::automatic) {
+    out["remaining_s"] = last_result_ == "done" && exec_ == ExecState::idle ? 0.0 : total;
+    return out;
+  }
+  if (!from_top_) {
+    out["remaining_reason"] = "the estimate covers runs from the first line";
+    return out;
+  }
+  // Time spent moving: the run's time without its pauses, kept within the estimated window
+  // of the move under way so that a feed override or a hold cannot drift it away.
+  const auto moving_until =
+      exec_ == ExecState::paused ? paused_since_ : std::chrono::steady_clock::now();
+  const double active =
+      std::chrono::duration<double>(moving_until - started_at_).count() - paused_s_;
+  const auto& starts = *estimate.move_start_s;
+  if (moves_done >= starts.size()) {
+    out["remaining_s"] = 0.0;
+    return out;
+  }
+  const double begin = starts[moves_done];
+  const double end = moves_done + 1 < starts.size() ? starts[moves_done + 1] : total;
+  out["remaining_s"] = std::max(0.0, total - std::clamp(active, begin, std::max(begin, end)));
+  return out;
+}
+
 std::string Task::summary() const {
   const motion::Status s = motion_.status();
   std::string out = machine_state_name(s.machine);
@@ -149,6 +192,7 @@ json Task::status() const {
           ? (program_lines_ == 0 ? 0.0 : std::min(1.0, static_cast<double>(line) / program_lines_))
       : last_result_ == "done" ? 1.0
                                : 0.0;
+  const json times = time_estimate(moves);
   const interp::InterpState st = interp_->state();
   json tool_entry = nullptr;
   if (const auto entry = st.tool_in_spindle != 0 ? interp_->tool(st.tool_in_spindle) : std::nullopt)
@@ -179,6 +223,9 @@ json Task::status() const {
         {"stepping", stepping_},
         {"moves", moves},
         {"elapsed_s", elapsed},
+        {"estimated_s", times["estimated_s"]},
+        {"remaining_s", times["remaining_s"]},
+        {"remaining_reason", times["remaining_reason"]},
         {"result", last_result_},
         {"error", last_error_}}},
       {"spindle", {{"direction", feeder_->spindle_direction}, {"speed", feeder_->spindle_speed}}},

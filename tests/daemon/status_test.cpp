@@ -88,7 +88,10 @@ TEST_F(MachineTest, ProgressAndElapsedTime) {
   EXPECT_EQ(s["program"]["result"], "done");
   EXPECT_EQ(s["program"]["progress"], 1.0);
   EXPECT_GT(s["program"]["elapsed_s"].get<double>(), 1.0);  // 40 mm at 20 mm/s
-  EXPECT_FALSE(s["program"].contains("remaining_s"));
+  // The run took the time estimated at program.open; nothing remains.
+  EXPECT_EQ(s["program"]["remaining_s"], 0.0);
+  EXPECT_NEAR(s["program"]["estimated_s"].get<double>(), s["program"]["elapsed_s"].get<double>(),
+              0.05);
 }
 
 TEST_F(MachineTest, NewFieldsCanBeAskedForAndSubscribedTo) {

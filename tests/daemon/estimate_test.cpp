@@ -1,0 +1,136 @@
+// The open program's estimated and remaining time (status.get program.estimated_s and
+// remaining_s) against the real daemon on the simulated mill: a run takes the estimated time
+// within 1 %, remaining time counts down and stands still while paused.
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// About 4.8 s on sim_mm: rapids, a plunge, lines and arcs at 100 mm/s, a dwell, two G81 holes.
+constexpr const char* kPart =
+    "G21 G90 G64\n"
+    "G0 X10 Y10 Z5\n"
+    "G1 Z0 F1200\n"
+    "G1 X60 F6000\n"
+    "G2 X60 Y40 I0 J15\n"
+    "G1 X10\n"
+    "G3 X10 Y10 I0 J-15\n"
+    "G4 P0.3\n"
+    "G99 G81 X100 Y50 Z-5 R2 F1200\n"
+    "X110\n"
+    "G80 G0 Z10\n"
+    "M2\n";
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+class EstimateTest : public MachineTest {
+ protected:
+  // Opens `program` and waits for its estimate; returns the status then.
+  json open_and_estimate(const std::filesystem::path& program) {
+    result_of(call("program.open", {{"path", program.string()}}));
+    return wait_until([](const json& s) {
+      return !s["program"]["estimated_s"].is_null() ||
+             s["program"]["remaining_reason"] != "estimating";
+    });
+  }
+  // Polls every 5 ms until the program is idle; returns the last status.
+  json poll_until_idle() {
+    json s;
+    const auto deadline = Clock::now() + std::chrono::seconds(60);
+    do {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      s = status();
+    } while (s["exec"] != "idle" && Clock::now() < deadline);
+    return s;
+  }
+};
+
+TEST_F(EstimateTest, ARunTakesTheEstimatedTimeWithinOnePercent) {
+  ready_machine();
+  const json opened = open_and_estimate(dir_.write("part.ngc", kPart));
+  ASSERT_TRUE(opened["program"]["estimated_s"].is_number()) << opened.dump();
+  const double estimated = opened["program"]["estimated_s"].get<double>();
+  EXPECT_GT(estimated, 3.0);
+  EXPECT_EQ(opened["program"]["remaining_s"], estimated);
+
+  const auto start = Clock::now();
+  result_of(call("program.run"));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const json midway = status();
+  const double remaining = midway["program"]["remaining_s"].get<double>();
+  const double elapsed_mid = midway["program"]["elapsed_s"].get<double>();
+  // Within the window of the move under way: a move lasts at most a second here.
+  EXPECT_NEAR(remaining, estimated - elapsed_mid, 1.0) << midway.dump();
+  EXPECT_LT(remaining, estimated);
+
+  const json done = poll_until_idle();
+  const double measured = seconds_since(start);
+  ASSERT_EQ(done["program"]["result"], "done") << done.dump();
+  EXPECT_EQ(done["program"]["remaining_s"], 0.0);
+  // The daemon's own run time, and program.run to idle seen through the socket (polling every
+  // 5 ms, so up to that much, and a call's round trip, later).
+  EXPECT_NEAR(done["program"]["elapsed_s"].get<double>(), estimated, 0.01 * estimated);
+  EXPECT_NEAR(measured, estimated, 0.01 * estimated + 0.01) << "estimated " << estimated;
+  std::printf("estimated %.3f s, run %.3f s (daemon), %.3f s (program.run to idle)\n", estimated,
+              done["program"]["elapsed_s"].get<double>(), measured);
+}
+
+TEST_F(EstimateTest, RemainingTimeStandsStillWhilePaused) {
+  ready_machine();
+  const json opened =
+      open_and_estimate(dir_.write("line.ngc", "G21 G90\nG1 X50 F3000\nG1 X0\nG1 X50\nM2\n"));
+  const double estimated = opened["program"]["estimated_s"].get<double>();
+  result_of(call("program.run"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  result_of(call("program.pause"));
+  wait_until([](const json& s) { return s["motion"] == "paused"; });
+  const double held = status()["program"]["remaining_s"].get<double>();
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const json later = status();
+  EXPECT_NEAR(later["program"]["remaining_s"].get<double>(), held, 1e-9) << later.dump();
+  EXPECT_GT(held, 0.5);
+  EXPECT_LT(held, estimated - 1.0);
+  result_of(call("program.resume"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_LT(status()["program"]["remaining_s"].get<double>(), held);
+  const json done = poll_until_idle();
+  EXPECT_EQ(done["program"]["result"], "done");
+}
+
+TEST_F(EstimateTest, WithoutAnEstimateRemainingIsNullWithTheReason) {
+  ready_machine();
+  // The interpreter stops at line 3: no estimate, and the reason names the line.
+  json s = open_and_estimate(dir_.write("bad.ngc", "G21 G90\nG0 X5\nG1 X10\nM2\n"));
+  EXPECT_TRUE(s["program"]["estimated_s"].is_null()) << s.dump();
+  EXPECT_TRUE(s["program"]["remaining_s"].is_null());
+  EXPECT_NE(s["program"]["remaining_reason"].get<std::string>().find("bad.ngc:3:"),
+            std::string::npos)
+      << s.dump();
+  // A run from a line is not what the estimate covers.
+  s = open_and_estimate(dir_.write("two.ngc", "G21 G90\nG1 X20 F600\nG1 X0\nM2\n"));
+  ASSERT_TRUE(s["program"]["estimated_s"].is_number());
+  result_of(call("program.run", {{"from_line", 3}}));
+  s = status();
+  EXPECT_TRUE(s["program"]["remaining_s"].is_null()) << s.dump();
+  EXPECT_NE(s["program"]["remaining_reason"], "");
+  result_of(call("program.abort"));
+}
+
+TEST_F(EstimateTest, CncctlRunShowsTheRemainingTime) {
+  ready_machine();
+  const auto program = dir_.write("two.ngc", "G21 G90\nG1 X20 F1200\nG1 X0\nM2\n");
+  const auto r =
+      run_command({CNCCTL_BINARY, "--socket", daemon_.socket(), "run", program.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find(" s left\n"), std::string::npos) << r.out;
+  const auto s = run_command({CNCCTL_BINARY, "--socket", daemon_.socket(), "status"});
+  EXPECT_NE(s.out.find("(estimated 2."), std::string::npos) << s.out;
+}
+
+}  // namespace
+}  // namespace cncd::test
