@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "jog_methods.hpp"
+#include "override_methods.hpp"
 #include "server.hpp"
 #include "setup_methods.hpp"
 #include "version.hpp"
@@ -208,6 +209,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
   });
   register_setup_methods(dispatcher, task, config);
   register_jog_methods(dispatcher, task, config);
+  register_override_methods(dispatcher, task, config);
 }
 
 }  // namespace cncd::daemon

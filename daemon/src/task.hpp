@@ -70,6 +70,12 @@ class Task {
   void jog_start(int axis, double velocity);
   void jog_increment(int axis, double distance, double velocity);
   void jog_stop(int axis);
+  // Overrides, ratios with 1.0 = 100 % (override_methods.cpp checks their ranges). Feed and
+  // rapid reach the servo thread at once, as pause does, and act on the move under way; the
+  // spindle override scales the commanded spindle speed.
+  void set_feed_override(double ratio);
+  void set_rapid_override(double ratio);
+  void set_spindle_override(double ratio);
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 
@@ -140,6 +146,7 @@ class Task {
   int skip_to_line_ = 0;     // run from line: first line that moves, 0 = none
   bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
   motion::AxisPose skip_end_{};
+  double spindle_override_ = 1.0;
   bool stepping_ = false;  // program.step: one line, then pause
   int step_budget_ = 0;    // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};

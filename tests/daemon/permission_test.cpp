@@ -127,6 +127,15 @@ TEST_F(PermissionTest, ReaderMayListToolsAndOffsetsButNotChangeThem) {
   }
 }
 
+TEST_F(PermissionTest, ReaderMayNotSetOverrides) {
+  for (const char* method : {"override.feed", "override.rapid", "override.spindle"}) {
+    const json reply = json::parse(call_as({group_id("users")}, method));
+    EXPECT_EQ(reply["error"]["code"], 1005) << method << ": " << reply.dump();
+  }
+  const json control = json::parse(call_as({group_id("dialout")}, "override.feed"));
+  EXPECT_EQ(control["error"]["code"], -32602) << control.dump();  // allowed, but no value
+}
+
 TEST_F(PermissionTest, ControlGroupMayCommand) {
   const json command = json::parse(call_as({group_id("dialout")}, "machine.reset"));
   EXPECT_TRUE(command.contains("result")) << command.dump();
