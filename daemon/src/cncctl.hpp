@@ -47,6 +47,9 @@ int tools(daemon::Client& client, const Args& args, bool json_output);
 // `offsets` and `offsets set G54..G59.3 [X..W..] [R..]`
 int offsets(daemon::Client& client, const Args& args, bool json_output);
 
+// `override feed|rapid|spindle PERCENT`
+int override_command(daemon::Client& client, const Args& args, bool json_output);
+
 // `jog AXIS +/-VELOCITY`, `jog AXIS --increment DIST [--velocity V]`, `jog AXIS stop`
 int jog(daemon::Client& client, const Args& args, bool json_output);
 

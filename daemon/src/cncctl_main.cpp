@@ -44,6 +44,8 @@ void usage(std::FILE* out) {
       "  jog AXIS --increment DIST [--velocity V]\n"
       "                      move AXIS by DIST and wait until it is there\n"
       "  jog AXIS stop       stop a jog under control and wait until at rest\n"
+      "  override feed|rapid|spindle PERCENT\n"
+      "                      set an override, e.g. 'override feed 80' (100 = as programmed)\n"
       "  tools               list the tool table\n"
       "  tools set T<n> [P<pocket>] [Z<offset> ...] [D<diameter>] [;comment]\n"
       "                      change (or add) one tool\n"
@@ -175,8 +177,8 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     return kDone;
   }
-  static const std::vector<std::string> kTakeArgs = {"home",  "run",   "mdi",     "open", "step",
-                                                     "watch", "tools", "offsets", "jog"};
+  static const std::vector<std::string> kTakeArgs = {
+      "home", "run", "mdi", "open", "step", "watch", "tools", "offsets", "jog", "override"};
   if (args.size() > 1 &&
       std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
@@ -276,6 +278,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   }
   if (command == "watch") return watch(client, args, json_output);
   if (command == "jog") return jog(client, args, json_output);
+  if (command == "override") return override_command(client, args, json_output);
   if (command == "tools") return tools(client, args, json_output);
   if (command == "offsets") return offsets(client, args, json_output);
   std::fprintf(stderr, "cncctl: unknown command '%s'\n", command.c_str());

@@ -84,7 +84,15 @@ void print_status(const json& s) {
     std::printf("work      %s  (%s)\n", axes_text(work.value("commanded", json())).c_str(),
                 get<std::string>(offsets, "coord_system", "").c_str());
   }
-  std::printf("velocity  %.3f\n", get<double>(s, "velocity", 0.0));
+  std::printf("velocity  %.3f   to go %.4f\n", get<double>(s, "velocity", 0.0),
+              get<double>(s, "distance_to_go", 0.0));
+  const json overrides = s.value("overrides", json::object());
+  if (!overrides.empty()) {
+    std::printf("override  feed %.0f %%  rapid %.0f %%  spindle %.0f %%\n",
+                100.0 * get<double>(overrides, "feed", 1.0),
+                100.0 * get<double>(overrides, "rapid", 1.0),
+                100.0 * get<double>(overrides, "spindle", 1.0));
+  }
   const json tool = s.value("tool", json::object());
   const json spindle = s.value("spindle", json::object());
   const json coolant = s.value("coolant", json::object());

@@ -94,6 +94,26 @@ TEST_F(CncctlTest, WatchPrintsUpdatesAndStopsOnInterrupt) {
   EXPECT_EQ(cncctl({"watch", "--count", "0"}).exit_status, 64);
 }
 
+TEST_F(CncctlTest, OverrideSetsPercentagesAndStatusShowsThem) {
+  auto r = cncctl({"override", "feed", "50"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(r.out, "feed override 50 %\n");
+  r = cncctl({"--json", "override", "spindle", "120%"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["value"], 1.2);
+  EXPECT_EQ(cncctl({"override", "rapid", "25"}).exit_status, 0);
+  r = cncctl({"status"});
+  EXPECT_NE(r.out.find("override  feed 50 %  rapid 25 %  spindle 120 %"), std::string::npos)
+      << r.out;
+  r = cncctl({"override", "feed", "200"});  // above MAX_FEED_OVERRIDE 1.5
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("from 0 to 1.5"), std::string::npos) << r.err;
+  EXPECT_EQ(cncctl({"override", "feed", "fast"}).exit_status, 64);
+  EXPECT_EQ(cncctl({"override", "coolant", "50"}).exit_status, 64);
+  EXPECT_EQ(cncctl({"override", "feed"}).exit_status, 64);
+  EXPECT_EQ(json::parse(cncctl({"--json", "status"}).out)["overrides"]["feed"], 0.5);
+}
+
 TEST_F(CncctlTest, ExitCodesTellDoneRefusedFailedAndUnreachable) {
   auto r = cncctl({"--json", "estop"});
   EXPECT_EQ(r.exit_status, 0);
