@@ -53,8 +53,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       move.dwell_s = m.value;
       break;
     case interp::CanonKind::set_motion_control_mode:
-      // G61 and G64 go on at speed through tangent junctions; G61.1 stops after every move.
-      continuous_ = m.ivalue != static_cast<int>(interp::MotionMode::exact_stop);
+      // G61.1 stops after every move, G61 only where the path turns (and, as canned cycles
+      // run in G61, where a traverse meets a feed move), G64 blends corners within P.
+      path_mode_ = m.ivalue == static_cast<int>(interp::MotionMode::exact_stop)
+                       ? motion::Move::PathMode::exact_stop
+                   : m.ivalue == static_cast<int>(interp::MotionMode::exact_path)
+                       ? motion::Move::PathMode::exact_path
+                       : motion::Move::PathMode::blend;
+      tolerance_ = std::max(0.0, m.value * tracker_.length_factor());
       return;
     case interp::CanonKind::program_stop:
     case interp::CanonKind::optional_program_stop:
@@ -62,31 +68,40 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       stop_seen = true;
       return;
     case interp::CanonKind::start_spindle_clockwise:
+      add_stop_point();
       spindle_direction = 1;
       return;
     case interp::CanonKind::start_spindle_counterclockwise:
+      add_stop_point();
       spindle_direction = -1;
       return;
     case interp::CanonKind::stop_spindle_turning:
+      add_stop_point();
       spindle_direction = 0;
       return;
     case interp::CanonKind::set_spindle_speed:
+      add_stop_point();
       spindle_speed = m.value;
       return;
     case interp::CanonKind::mist_on:
+      add_stop_point();
       mist = true;
       return;
     case interp::CanonKind::mist_off:
+      add_stop_point();
       mist = false;
       return;
     case interp::CanonKind::flood_on:
+      add_stop_point();
       flood = true;
       return;
     case interp::CanonKind::flood_off:
+      add_stop_point();
       flood = false;
       return;
     case interp::CanonKind::change_tool:
     case interp::CanonKind::change_tool_number:
+      add_stop_point();
       tool = m.ivalue;
       return;
     case interp::CanonKind::message:
@@ -95,8 +110,17 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     default:
       return;
   }
-  move.continuous = continuous_;
+  move.path_mode = path_mode_;
+  move.tolerance = tolerance_;
   pending.push_back(move);
+}
+
+void ProgramFeeder::add_stop_point() {
+  if (!pending.empty() && stop_point(pending.back())) return;
+  motion::Move stop;
+  stop.kind = motion::Move::Kind::dwell;
+  stop.dwell_s = 0;
+  pending.push_back(stop);
 }
 
 }  // namespace cncd::daemon

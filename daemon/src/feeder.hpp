@@ -20,6 +20,11 @@ class ProgramFeeder final : public interp::CanonSink {
   void emit(const interp::CanonCommand& command) override;
   // Resets what a new program run must not inherit.
   void start_program();
+  // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
+  // planner is flushed there.
+  static bool stop_point(const motion::Move& move) {
+    return move.kind == motion::Move::Kind::dwell && !(move.dwell_s > 0);
+  }
 
   std::deque<motion::Move> pending;  // moves the planner had no room for yet
   bool stop_seen = false;            // M0/M1/M60 reached in the stream
@@ -32,9 +37,15 @@ class ProgramFeeder final : public interp::CanonSink {
  private:
   interp::MachineTracker tracker_;
   EventLog& events_;
-  // Path control mode as the interpreter last set it (it starts in G64 and keeps its modes
-  // from one program to the next, as this feeder does).
-  bool continuous_ = true;
+  // Queues a stop point (a zero dwell) where a spindle, coolant or tool event comes in the
+  // program, for the task to flush the planner there: the path comes to rest at that point
+  // instead of blending through it.
+  void add_stop_point();
+
+  // Path control mode and G64 P tolerance (machine units) as the interpreter last set them
+  // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).
+  motion::Move::PathMode path_mode_ = motion::Move::PathMode::blend;
+  double tolerance_ = 0;
 };
 
 }  // namespace cncd::daemon

@@ -236,7 +236,8 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   feeder_->start_program();
   interp_done_ = false;
   moves_enqueued_ = 0;
-  moves_done_base_ = status.segments_done;
+  moves_done_base_ = status.moves_done;
+  motion_.discard();
   mode_ = mode;
   paused_s_ = 0;
   set_exec(ExecState::running);
@@ -287,7 +288,7 @@ void Task::finish_program(const std::string& result, const std::string& error) {
   set_exec(ExecState::idle);
   stepping_ = false;
   skip_to_line_ = 0;
-  moves_completed_ = motion_.status().segments_done - moves_done_base_;
+  moves_completed_ = motion_.status().moves_done - moves_done_base_;
   elapsed_s_ = std::chrono::duration<double>(Clock::now() - started_at_).count();
   last_result_ = result;
   last_error_ = error;
@@ -305,6 +306,11 @@ void Task::feed() {
   constexpr int kMaxBlocksPerPoll = 2000;
   for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
     while (!feeder_->pending.empty()) {
+      if (ProgramFeeder::stop_point(feeder_->pending.front())) {
+        motion_.flush();  // what does not fit yet goes out before the next move
+        feeder_->pending.pop_front();
+        continue;
+      }
       const auto result = motion_.enqueue(feeder_->pending.front());
       if (result == motion::MotionController::EnqueueResult::full) return;
       if (result == motion::MotionController::EnqueueResult::refused) {
@@ -317,8 +323,12 @@ void Task::feed() {
       feeder_->pending.pop_front();
       ++moves_enqueued_;
     }
-    if (interp_done_ || feeder_->stop_seen) return;
-    if (stepping_ && step_budget_ == 0) return;
+    // The move held back for look-ahead goes out when no more come for now, so that the
+    // path ends at rest and the program's end, a stop or a step is seen.
+    if (interp_done_ || feeder_->stop_seen || (stepping_ && step_budget_ == 0)) {
+      motion_.flush();
+      return;
+    }
     const auto step = interp_->step(*feeder_);
     if (step == interp::Interpreter::Step::error) {
       const auto& error = interp_->error();
@@ -357,7 +367,7 @@ void Task::poll() {
   // Counting completed moves (rather than looking at an empty queue) cannot mistake the instant
   // between enqueue and the servo thread picking a move up for the end of the program.
   const bool drained = feeder_->pending.empty() &&
-                       status.segments_done - moves_done_base_ >= moves_enqueued_ &&
+                       status.moves_done - moves_done_base_ >= moves_enqueued_ &&
                        status.motion == motion::MotionState::idle;
   if (!drained) return;
   if (feeder_->stop_seen) {

@@ -186,7 +186,7 @@ json Task::status() const {
                    : stepping_ && exec_ == ExecState::paused ? interp_->current_line()
                                                              : s.line;
   const std::uint64_t moves =
-      exec_ == ExecState::idle ? moves_completed_ : s.segments_done - moves_done_base_;
+      exec_ == ExecState::idle ? moves_completed_ : s.moves_done - moves_done_base_;
   const double progress =
       exec_ != ExecState::idle
           ? (program_lines_ == 0 ? 0.0 : std::min(1.0, static_cast<double>(line) / program_lines_))

@@ -59,9 +59,19 @@ struct MotionController::Impl {
   std::atomic<bool> running{false};
   std::vector<std::string> warnings;
   std::string enqueue_error;
-  AxisPose plan_end{};
-  std::uint64_t enqueued = 0;
+  std::uint64_t pushed = 0;             // segments handed to the servo thread since start()
   std::vector<double> start_positions;  // empty = where the drives stand
+
+  // Hands the planner's final segments to the servo thread; false when the ring is full.
+  bool pump() {
+    auto& out = planner.output();
+    while (!out.empty()) {
+      if (!loop->segments().push(out.front())) return false;
+      out.pop_front();
+      ++pushed;
+    }
+    return true;
+  }
 
   // Hands a command to the servo thread and waits until a cycle has applied it (a period or
   // two), so that the caller's next status read already reflects it.
@@ -213,8 +223,8 @@ std::string MotionController::start() {
                               "): servo thread memory may be paged out; grant CAP_IPC_LOCK or "
                               "LimitMEMLOCK=infinity");
   }
-  impl_->enqueued = 0;
-  impl_->plan_end = AxisPose{};
+  impl_->pushed = 0;
+  impl_->planner.reset(AxisPose{});
   impl_->setup_done.store(false);
   impl_->running.store(true);
   impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });
@@ -257,18 +267,27 @@ MotionController::EnqueueResult MotionController::enqueue(const Move& move) {
                                                                      "after an abort";
     return EnqueueResult::refused;
   }
-  // With every queued segment done, the commanded position is where the next move starts
-  // (after homing, an abort or a jog it differs from the last planned end).
-  if (status.segments_done == impl_->enqueued) impl_->plan_end = status.commanded;
+  if (!impl_->pump()) return EnqueueResult::full;
+  // With nothing held back and every segment done, the commanded position is where the next
+  // move starts (after homing, an abort or a jog it differs from the last planned end).
+  if (!impl_->planner.holding() && status.segments_done == impl_->pushed)
+    impl_->planner.reset(status.commanded);
   bool homed = true;
   for (int j = 0; j < status.joint_count; ++j)
     homed = homed && status.homed[static_cast<std::size_t>(j)];
-  const auto segment = impl_->planner.plan(move, impl_->plan_end, homed, impl_->enqueue_error);
-  if (!segment) return EnqueueResult::refused;
-  if (!impl_->loop->segments().push(*segment)) return EnqueueResult::full;
-  impl_->plan_end = segment->end;
-  ++impl_->enqueued;
+  if (!impl_->planner.push(move, homed, impl_->enqueue_error)) return EnqueueResult::refused;
+  impl_->pump();
   return EnqueueResult::queued;
+}
+
+MotionController::EnqueueResult MotionController::flush() {
+  impl_->planner.flush();
+  if (!impl_->loop) return EnqueueResult::queued;
+  return impl_->pump() ? EnqueueResult::queued : EnqueueResult::full;
+}
+
+void MotionController::discard() {
+  impl_->planner.reset(impl_->planner.end());
 }
 
 const std::string& MotionController::enqueue_error() const {
@@ -296,6 +315,7 @@ void MotionController::home(std::uint32_t joint_mask) {
   impl_->send(Command::Kind::home, joint_mask);
 }
 void MotionController::abort() {
+  discard();
   impl_->send(Command::Kind::abort);
 }
 void MotionController::pause() {

@@ -56,6 +56,14 @@ AxisPose Segment::point_at(double s) const noexcept {
   if (kind == Kind::dwell || length <= 0) return end;
   const double f = std::clamp(s / length, 0.0, 1.0);
   AxisPose p{};
+  if (kind == Kind::blend) {
+    if (f >= 1.0) return end;
+    const double c = radius * std::cos(sweep * f);
+    const double n = radius * std::sin(sweep * f);
+    for (int i = 0; i < kAxes; ++i)
+      p[i] = blend_center[i] + c * blend_u[i] + n * blend_v[i];
+    return p;
+  }
   for (int i = 0; i < kAxes; ++i)
     p[i] = start[i] + (end[i] - start[i]) * f;
   if (kind == Kind::arc) {
@@ -225,15 +233,17 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   if (linear_motion && config_.max_linear_velocity > 0)
     v = std::min(v, config_.max_linear_velocity);
   if (centripetal_radius > 0) {
-    // Half the in-plane acceleration for speeding up and slowing down, half for turning:
-    // their sum stays within every in-plane axis's limit.
+    // In the plane the acceleration is the tangential part (path acceleration x cos b, b the
+    // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it:
+    // 0.6 of the in-plane limit for one and 0.8 for the other keeps their vector sum, and so
+    // every in-plane axis, within the limit (0.6^2 + 0.8^2 = 1).
     const double plane_a =
         std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
                  config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
-    a = std::min(a, 0.5 * plane_a);
-    v = std::min(v, std::sqrt(0.5 * plane_a * centripetal_radius));
+    const double in_plane = direction[seg.first_axis];  // cos b
+    a = std::min(a, kTangentialShare * plane_a / in_plane);
+    v = std::min(v, std::sqrt(kNormalShare * plane_a * centripetal_radius) / in_plane);
   }
-  seg.continuous = move.continuous;
   set_directions(seg);
   seg.axis_velocity = v;
   seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;

@@ -95,12 +95,18 @@ void ServoLoop::latch_fault(const char* reason) noexcept {
 
 void ServoLoop::flush_queue() noexcept {
   Segment dropped;
-  if (has_active_) ++status_.segments_done;
   has_active_ = false;
-  status_.segments_done += static_cast<std::uint64_t>(ahead_count_);
-  ahead_count_ = 0;
-  while (segments_.pop(dropped))
+  for (; window_count_ > 0; --window_count_, ++head_seq_) {
     ++status_.segments_done;
+    status_.moves_done += window_at(head_seq_).moves;
+  }
+  window_length_ = 0;
+  stop_length_ = 0;
+  pass_active_ = false;
+  while (segments_.pop(dropped)) {
+    ++status_.segments_done;
+    status_.moves_done += dropped.moves;
+  }
   path_s_ = 0;
   path_v_ = 0;
   pause_requested_ = false;
@@ -153,21 +159,26 @@ void ServoLoop::apply(const Command& command) noexcept {
       if (path_pending()) abort_requested_ = true;
       homing_.abort();
       jog_.stop_all();
+      soft_limits_changed();
       break;
     case Command::Kind::pause:
       pause_requested_ = true;
+      soft_limits_changed();
       break;
     case Command::Kind::resume:
       pause_requested_ = false;
+      soft_limits_changed();
       break;
     case Command::Kind::feed_override:
       // The controller clamps; a NaN would stall every later move.
       if (std::isfinite(command.velocity))
         status_.feed_override = std::clamp(command.velocity, 0.0, config_.max_feed_override);
+      soft_limits_changed();
       break;
     case Command::Kind::rapid_override:
       if (std::isfinite(command.velocity))
         status_.rapid_override = std::clamp(command.velocity, 0.0, 1.0);
+      soft_limits_changed();
       break;
     case Command::Kind::jog_start:
     case Command::Kind::jog_increment:
@@ -368,8 +379,8 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
 void ServoLoop::publish() noexcept {
   status_.sequence = status_.rt.cycles;
   status_.commanded = axis_pose_;
-  status_.queued = static_cast<std::uint32_t>(
-      segments_.size() + static_cast<std::size_t>(ahead_count_) + (has_active_ ? 1 : 0));
+  status_.queued =
+      static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
   status_.homed = joints_.homed;
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {

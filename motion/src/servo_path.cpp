@@ -40,21 +40,6 @@ bool ServoLoop::joints_on_their_axes() noexcept {
   return true;
 }
 
-namespace {
-
-// Whether the path may go on at speed from `from` into `to`: G61/G64 and the same direction
-// (within 1e-6 rad, so no axis changes speed by more than 1e-6 of the path speed at once).
-bool tangent(const Segment& from, const Segment& to) noexcept {
-  if (!from.continuous || from.kind == Segment::Kind::dwell || to.kind == Segment::Kind::dwell)
-    return false;
-  double dot = 0;
-  for (int i = 0; i < kAxes; ++i)
-    dot += from.end_direction[i] * to.start_direction[i];
-  return dot > 1.0 - 5e-13;
-}
-
-}  // namespace
-
 double ServoLoop::speed_limit(const Segment& segment) const noexcept {
   if (pause_requested_ || abort_requested_) return 0.0;
   // Overrides only ever lower the speed below what the axes allow (a feed override above 1
@@ -65,87 +50,149 @@ double ServoLoop::speed_limit(const Segment& segment) const noexcept {
   return segment.axis_velocity * status_.rapid_override;
 }
 
-void ServoLoop::refill_lookahead() noexcept {
-  while (ahead_count_ < kLookAhead &&
-         segments_.pop(ahead_[static_cast<std::size_t>((ahead_head_ + ahead_count_) % kLookAhead)]))
-    ++ahead_count_;
+void ServoLoop::soft_limits_changed() noexcept {
+  if (window_count_ < 2) return;
+  pass_active_ = true;
+  pass_seq_ = head_seq_ + static_cast<std::uint64_t>(window_count_) - 2;
+  pass_floor_ = head_seq_;
 }
 
-void ServoLoop::exit_speeds(double& soft, double& hard) const noexcept {
-  // Backwards from the window's last segment, which ends at rest: the machine can always
-  // stop on the path within what it holds. The hard chain never depends on the overrides,
-  // so lowering one never asks for more than the acceleration limit.
-  soft = 0;
-  hard = 0;
-  for (int k = ahead_count_ - 1; k >= 0; --k) {
-    const Segment& seg = ahead_[static_cast<std::size_t>((ahead_head_ + k) % kLookAhead)];
-    const Segment& before =
-        k == 0 ? active_ : ahead_[static_cast<std::size_t>((ahead_head_ + k - 1) % kLookAhead)];
-    if (!tangent(before, seg)) {
-      soft = 0;
-      hard = 0;
-      continue;
+void ServoLoop::run_pass() noexcept {
+  // Backwards from the end: a segment's exit speed is what the junction allows (0 unless the
+  // planner found the next segment tangent) and what the next segment can slow down from
+  // to its own exit speed. Values only rise as the window grows, so a segment whose speeds
+  // do not change ends the pass once the new segments are done.
+  while (pass_active_ && pass_budget_ > 0) {
+    if (pass_seq_ < head_seq_) {
+      pass_active_ = false;
+      break;
     }
-    const double reach = 2.0 * seg.max_acceleration * seg.length;
-    const double limit = std::min(before.axis_velocity, seg.axis_velocity);
-    hard = std::min(limit, std::sqrt(hard * hard + reach));
-    soft = std::min({limit, speed_limit(before), speed_limit(seg), std::sqrt(soft * soft + reach)});
+    --pass_budget_;
+    const std::uint64_t k = pass_seq_;
+    const Segment& seg = window_at(k);
+    const Segment& next = window_at(k + 1);
+    const std::size_t i = static_cast<std::size_t>(k % kWindow);
+    const std::size_t n = static_cast<std::size_t>((k + 1) % kWindow);
+    double hard = 0;
+    double soft = 0;
+    if (seg.continuous && seg.kind != Segment::Kind::dwell && next.kind != Segment::Kind::dwell) {
+      const double reach = 2.0 * next.max_acceleration * next.length;
+      const double limit = std::min(seg.axis_velocity, next.axis_velocity);
+      hard = std::min(limit, std::sqrt(exit_hard_[n] * exit_hard_[n] + reach));
+      soft = std::min({limit, speed_limit(seg), speed_limit(next),
+                       std::sqrt(exit_soft_[n] * exit_soft_[n] + reach)});
+    }
+    const bool same = hard == exit_hard_[i] && soft == exit_soft_[i];
+    exit_hard_[i] = hard;
+    exit_soft_[i] = soft;
+    if ((same && k < pass_floor_) || k == head_seq_) {
+      pass_active_ = false;
+    } else {
+      --pass_seq_;
+    }
   }
+}
+
+void ServoLoop::fill_window() noexcept {
+  for (;;) {
+    run_pass();
+    if (pass_active_) return;  // out of budget: the exit speeds so far are safe, only low
+    if (window_count_ == 0) {
+      window_length_ = 0;
+      stop_length_ = 0;
+    }
+    const std::uint64_t first_new = head_seq_ + static_cast<std::uint64_t>(window_count_);
+    // Twice the stopping distance from the fastest speed seen, so that the first segment's
+    // exit speed is not held down by the window's end.
+    while (pass_budget_ > 0 && window_count_ < kWindow &&
+           (window_length_ < 2.0 * stop_length_ || window_count_ < 2)) {
+      const std::uint64_t seq = head_seq_ + static_cast<std::uint64_t>(window_count_);
+      Segment& seg = window_at(seq);
+      if (!segments_.pop(seg)) break;
+      --pass_budget_;
+      exit_hard_[static_cast<std::size_t>(seq % kWindow)] = 0;
+      exit_soft_[static_cast<std::size_t>(seq % kWindow)] = 0;
+      ++window_count_;
+      window_length_ += seg.length;
+      if (seg.max_acceleration > 0) {
+        stop_length_ = std::max(
+            stop_length_, seg.axis_velocity * seg.axis_velocity / (2.0 * seg.max_acceleration));
+      }
+    }
+    const std::uint64_t end = head_seq_ + static_cast<std::uint64_t>(window_count_);
+    if (end == first_new) return;  // nothing taken
+    if (first_new > head_seq_) {
+      pass_active_ = true;
+      pass_seq_ = end - 2;
+      pass_floor_ = first_new - 1;
+    } else if (window_count_ >= 2) {
+      pass_active_ = true;
+      pass_seq_ = end - 2;
+      pass_floor_ = head_seq_;
+    }
+  }
+}
+
+void ServoLoop::finish_front() noexcept {
+  const Segment& done = window_at(head_seq_);
+  ++status_.segments_done;
+  status_.moves_done += done.moves;
+  window_length_ = std::max(0.0, window_length_ - done.length);
+  ++head_seq_;
+  --window_count_;
+  has_active_ = false;
 }
 
 bool ServoLoop::advance_path(double dt) noexcept {
   // Joints and axes agree at the start of a period (not between two moves inside one).
   bool resting = !has_active_;
   bool moved = has_active_;
-  refill_lookahead();
+  pass_budget_ = kPassBudget;
+  fill_window();
   // A period may finish one move and go on with the next: the profile's leftover time is
   // spent on the following segments, at the speed the junction allows, so short moves are not
   // slowed to one a period.
   while (dt > 0) {
     if (!has_active_) {
-      if ((abort_requested_ && path_v_ <= 0) || ahead_count_ == 0) break;
-      active_ = ahead_[static_cast<std::size_t>(ahead_head_)];
-      ahead_head_ = (ahead_head_ + 1) % kLookAhead;
-      --ahead_count_;
-      refill_lookahead();
+      if (window_count_ == 0) fill_window();
+      if ((abort_requested_ && path_v_ <= 0) || window_count_ == 0) break;
       has_active_ = true;
-      if ((resting && !joints_on_their_axes()) || !starts_here(active_)) return false;
+      if ((resting && !joints_on_their_axes()) || !starts_here(window_at(head_seq_))) return false;
       resting = false;
       moved = true;
       path_s_ = 0;
       dwell_elapsed_s_ = 0;
     }
-    status_.line = active_.line;
+    const Segment& active = window_at(head_seq_);
+    status_.line = active.line;
     bool done;
-    if (active_.kind == Segment::Kind::dwell) {
+    if (active.kind == Segment::Kind::dwell) {
       if (abort_requested_) {
         done = true;
       } else if (pause_requested_) {
         done = false;
         dt = 0;
       } else {
-        const double left = active_.dwell_s - dwell_elapsed_s_;
+        const double left = active.dwell_s - dwell_elapsed_s_;
         done = left <= dt + 1e-12;
         dwell_elapsed_s_ += done ? left : dt;
         dt = done ? std::max(0.0, dt - left) : 0;
       }
       path_v_ = 0;
     } else {
-      double soft = 0;
-      double hard = 0;
-      exit_speeds(soft, hard);
-      done = advance_profile(path_s_, path_v_, active_.length, speed_limit(active_),
-                             active_.max_acceleration, std::min(soft, hard), dt);
-      axis_pose_ = done ? active_.end : active_.point_at(path_s_);
-      if (done && hard <= 0) path_v_ = 0;
+      const std::size_t i = static_cast<std::size_t>(head_seq_ % kWindow);
+      done = advance_profile(path_s_, path_v_, active.length, speed_limit(active),
+                             active.max_acceleration, std::min(exit_soft_[i], exit_hard_[i]), dt);
+      axis_pose_ = done ? active.end : active.point_at(path_s_);
+      if (done && exit_hard_[i] <= 0) path_v_ = 0;
     }
     if (!done) break;
-    has_active_ = false;
-    ++status_.segments_done;
+    finish_front();
   }
   status_.velocity = path_v_;
-  status_.distance_to_go =
-      has_active_ && active_.kind != Segment::Kind::dwell ? active_.length - path_s_ : 0.0;
+  status_.distance_to_go = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell
+                               ? window_at(head_seq_).length - path_s_
+                               : 0.0;
   if (abort_requested_ && path_v_ == 0) {
     flush_queue();
     status_.motion = MotionState::idle;

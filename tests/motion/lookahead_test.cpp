@@ -26,36 +26,12 @@ void feed_all(VirtualMachine& m, const std::vector<Move>& moves) {
   }
 }
 
-// Largest ratio of any axis's speed and acceleration to its limit, by finite differences of
-// the recorded periods (starting from rest at `start`).
-struct Peaks {
-  double velocity = 0;
-  double acceleration = 0;
-};
-
-Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start) {
-  Peaks p;
-  const double dt = m.period_s();
-  std::vector<motion::AxisPose> points{start, start};
-  points.insert(points.end(), m.trajectory().begin(), m.trajectory().end());
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto& limits = m.config().axes[static_cast<std::size_t>(axis)];
-    for (std::size_t k = 2; k < points.size(); ++k) {
-      const double v = (points[k][axis] - points[k - 1][axis]) / dt;
-      const double v0 = (points[k - 1][axis] - points[k - 2][axis]) / dt;
-      p.velocity = std::max(p.velocity, std::abs(v) / limits.max_velocity);
-      p.acceleration = std::max(p.acceleration, std::abs(v - v0) / dt / limits.max_acceleration);
-    }
-  }
-  return p;
-}
-
 std::vector<Move> split_line(double length, double piece, double feed, bool continuous) {
   std::vector<Move> moves;
   const int n = static_cast<int>(std::lround(length / piece));
   for (int k = 1; k <= n; ++k) {
     Move move = line_to(Move::Kind::feed, length * k / n, 0, 0, feed);
-    move.continuous = continuous;
+    move.path_mode = continuous ? Move::PathMode::blend : Move::PathMode::exact_stop;
     moves.push_back(move);
   }
   return moves;
@@ -99,7 +75,7 @@ std::vector<Move> tangent_chain(std::mt19937& rng, int count, bool continuous) {
   double x = 0, y = 0, z = 0, heading = 0;
   for (int k = 0; k < count; ++k) {
     Move move;
-    move.continuous = continuous;
+    move.path_mode = continuous ? Move::PathMode::blend : Move::PathMode::exact_stop;
     move.feed = 5 + 250 * unit(rng);
     if (unit(rng) < 0.5) {
       const double length = 0.05 + 15 * unit(rng) * unit(rng);
@@ -171,15 +147,16 @@ TEST(LookAhead, TangentJunctionsAreCrossedAtSpeedOnlyWhenContinuous) {
     VirtualMachine m(small_mill());
     m.ready();
     Move line = line_to(Move::Kind::feed, 50, 0, 0, 100);
-    line.continuous = continuous;
+    line.path_mode = continuous ? Move::PathMode::blend : Move::PathMode::exact_stop;
     Move arc = line_to(Move::Kind::feed, 100, 50, 0, 100);
     arc.kind = Move::Kind::arc;
     arc.center_first = 50;
     arc.center_second = 50;
     arc.turns = 1;
-    arc.continuous = continuous;
+    arc.path_mode = continuous ? Move::PathMode::blend : Move::PathMode::exact_stop;
     m.queue(line);
     m.queue(arc);
+    m.flush();
     double slowest_at_junction = 1e9;
     for (int k = 0; k < 5000 && (k == 0 || m.status().queued > 0); ++k) {
       m.cycles(1);
@@ -202,13 +179,14 @@ TEST(LookAhead, TangentChainsRunFasterThanWithExactStops) {
   const auto chain = tangent_chain(rng, 40, true);
   auto stops = chain;
   for (auto& move : stops)
-    move.continuous = false;
+    move.path_mode = Move::PathMode::exact_stop;
   int cycles[2] = {};
   int crossed_moving[2] = {};
   for (int k = 0; k < 2; ++k) {
     VirtualMachine m(small_mill());
     m.ready();
     feed_all(m, k == 0 ? chain : stops);
+    m.flush();
     std::uint64_t done = 0;
     do {
       m.cycles(1);

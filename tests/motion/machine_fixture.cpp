@@ -1,5 +1,8 @@
 #include "machine_fixture.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace cncd::test {
@@ -69,21 +72,33 @@ void VirtualMachine::ready() {
   command(motion::Command::Kind::home, 0xFFFFFFFFu);
   run_until_idle();
   clear_trajectory();
-  plan_end_ = status().commanded;
-  queued_ = status().segments_done;
+  planner_.reset(status().commanded);
+  pushed_ = status().segments_done;
 }
 
 void VirtualMachine::queue(const motion::Move& move) {
-  // As MotionController does: with every queued move done, the next one starts where the
-  // machine stands (after an abort that is short of the last planned end).
+  // As MotionController does: with nothing held back and every queued segment done, the next
+  // move starts where the machine stands (after an abort that is short of the last planned
+  // end).
   const auto s = status();
-  if (s.segments_done == queued_) plan_end_ = s.commanded;
+  if (!planner_.holding() && s.segments_done == pushed_) planner_.reset(s.commanded);
   std::string error;
-  const auto segment = planner_.plan(move, plan_end_, true, error);
-  ASSERT_TRUE(segment.has_value()) << error;
-  ASSERT_TRUE(loop_->segments().push(*segment));
-  plan_end_ = segment->end;
-  ++queued_;
+  ASSERT_TRUE(planner_.push(move, true, error)) << error;
+  pump();
+}
+
+void VirtualMachine::flush() {
+  planner_.flush();
+  pump();
+}
+
+void VirtualMachine::pump() {
+  auto& out = planner_.output();
+  while (!out.empty()) {
+    ASSERT_TRUE(loop_->segments().push(out.front()));
+    out.pop_front();
+    ++pushed_;
+  }
 }
 
 void VirtualMachine::cycles(int n) {
@@ -94,6 +109,7 @@ void VirtualMachine::cycles(int n) {
 }
 
 int VirtualMachine::run_until_idle(int max_cycles) {
+  flush();
   for (int i = 0; i < max_cycles; ++i) {
     loop_->cycle(0);
     const auto s = loop_->status();
@@ -102,6 +118,24 @@ int VirtualMachine::run_until_idle(int max_cycles) {
   }
   ADD_FAILURE() << "motion did not finish within " << max_cycles << " cycles";
   return max_cycles;
+}
+
+Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start) {
+  Peaks p;
+  const double dt = m.period_s();
+  std::vector<motion::AxisPose> points{start, start};
+  points.insert(points.end(), m.trajectory().begin(), m.trajectory().end());
+  for (int axis = 0; axis < motion::kAxes; ++axis) {
+    const auto& limits = m.config().axes[static_cast<std::size_t>(axis)];
+    if (!limits.present) continue;
+    for (std::size_t k = 2; k < points.size(); ++k) {
+      const double v = (points[k][axis] - points[k - 1][axis]) / dt;
+      const double v0 = (points[k - 1][axis] - points[k - 2][axis]) / dt;
+      p.velocity = std::max(p.velocity, std::abs(v) / limits.max_velocity);
+      p.acceleration = std::max(p.acceleration, std::abs(v - v0) / dt / limits.max_acceleration);
+    }
+  }
+  return p;
 }
 
 motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed) {

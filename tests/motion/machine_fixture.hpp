@@ -56,8 +56,11 @@ class VirtualMachine {
                                                        drivers::kCapEstopInput);
   // Machine on and homed.
   void ready();
-  // Plans and queues; fails the test when the planner refuses.
+  // Plans and queues through the look-ahead planner (which may hold the move back until the
+  // next queue() or flush()); fails the test when the planner refuses.
   void queue(const motion::Move& move);
+  // Releases the move the planner holds back. run_until_idle() does this first.
+  void flush();
   // Runs cycles until the loop is idle with an empty queue, or `max_cycles`; records every
   // period's commanded pose. Returns the cycles run.
   int run_until_idle(int max_cycles = 2'000'000);
@@ -85,10 +88,18 @@ class VirtualMachine {
   std::unique_ptr<RecordingDriver> recorder_;
   std::unique_ptr<motion::ServoLoop> loop_;
   motion::Planner planner_;
-  motion::AxisPose plan_end_{};
-  std::uint64_t queued_ = 0;  // moves queued since the loop started
+  void pump();
+  std::uint64_t pushed_ = 0;  // segments pushed to the ring since the loop started
   std::vector<motion::AxisPose> trajectory_;
 };
+
+// Largest ratio of any axis's speed and acceleration to its limit, by finite differences of
+// the recorded periods (starting from rest at `start`).
+struct Peaks {
+  double velocity = 0;
+  double acceleration = 0;
+};
+Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start);
 
 motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed = 0);
 

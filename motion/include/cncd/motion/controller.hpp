@@ -40,7 +40,15 @@ class MotionController {
   // Queues one move (planned here, on the caller's thread). `full`: the segment queue has no
   // room, call again later. `refused`: the move cannot be made (machine not on, outside the
   // soft limits, zero feed ...); enqueue_error() says why.
+  // The planner may hold the newest move back until the next one (or flush()) shows how the
+  // two join; Status::moves_done counts the moves carried out.
   EnqueueResult enqueue(const Move& move);
+  // Releases the move held back for look-ahead, to end at rest: call before anything that
+  // must happen at rest or in order, and when no more moves come for now. `full`: part of it
+  // did not fit in the segment queue, call again later.
+  EnqueueResult flush();
+  // Forgets the move held back (a run that starts afresh or ended early). abort() does too.
+  void discard();
   const std::string& enqueue_error() const;
   // Free slots in the segment queue.
   std::size_t queue_space() const;

@@ -10,7 +10,8 @@
 namespace cncd::motion {
 
 struct Segment {
-  enum class Kind : std::uint8_t { line, arc, dwell };
+  // blend: an arc in any plane (the tangent arc the planner puts into a corner).
+  enum class Kind : std::uint8_t { line, arc, dwell, blend };
   Kind kind = Kind::line;
   AxisPose start{};
   AxisPose end{};
@@ -26,13 +27,22 @@ struct Segment {
   double radius = 0;
   double start_angle = 0;
   double sweep = 0;
+  // Blend: point(phi) = blend_center + radius (cos(phi) blend_u + sin(phi) blend_v) for phi
+  // from 0 to sweep; blend_u and blend_v are orthonormal over all axes.
+  AxisPose blend_center{};
+  AxisPose blend_u{};
+  AxisPose blend_v{};
   std::int32_t line = 0;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
-  // moves. With `continuous`, a next segment whose start tangent matches the end tangent is
-  // entered at speed.
+  // moves.
   AxisPose start_direction{};
   AxisPose end_direction{};
+  // The planner found the next segment tangent to this one (a blend arc included): the servo
+  // loop may cross this segment's end at speed. False: the path stops at the end.
   bool continuous = false;
+  // Programmed moves that are complete once this segment is (0 for a blend arc, more than 1
+  // when the planner folded zero-length moves into it).
+  std::uint32_t moves = 1;
 
   // Point at path distance s in [0, length]. RT-safe.
   AxisPose point_at(double s) const noexcept;

@@ -94,13 +94,19 @@ class ServoLoop {
   bool joints_on_their_axes() noexcept;                       // false: fault latched
   double speed_limit(const Segment& segment) const noexcept;  // with overrides and holds
   // Path motion under way or waiting, in the look-ahead window or in the ring.
-  bool path_pending() const noexcept {
-    return has_active_ || ahead_count_ > 0 || segments_.size() > 0;
+  bool path_pending() const noexcept { return window_count_ > 0 || segments_.size() > 0; }
+  Segment& window_at(std::uint64_t seq) noexcept {
+    return window_[static_cast<std::size_t>(seq % kWindow)];
   }
-  void refill_lookahead() noexcept;
-  // Fastest speeds the active segment may end at and still stop on the path within the
-  // window: with the overrides (`soft`) and with the axis limits alone (`hard`).
-  void exit_speeds(double& soft, double& hard) const noexcept;
+  // Takes segments from the ring while the window holds less than the path needs to stop
+  // from its fastest speed, and brings the exit speeds up to date, within this period's work
+  // budget.
+  void fill_window() noexcept;
+  // Continues the backward pass over the exit speeds for up to pass_budget_ steps.
+  void run_pass() noexcept;
+  // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
+  void soft_limits_changed() noexcept;
+  void finish_front() noexcept;  // the window's first segment is done
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
@@ -129,14 +135,26 @@ class ServoLoop {
 
   Status status_{};
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
-  Segment active_{};
+  // Look-ahead window: the segments taken from the ring, oldest first; the first is being
+  // executed once has_active_. Segment sequence number n lives in window_[n % kWindow];
+  // head_seq_ is the first's. exit_hard_ is the fastest speed at a segment's end from which
+  // the path can still stop within the window under the axis limits alone, exit_soft_ the
+  // same with the feed, the overrides and holds: the window's last segment always ends at
+  // rest. Both are kept by an incremental backward pass.
+  static constexpr int kWindow = 2048;
+  static constexpr int kPassBudget = 4096;  // pass steps and ring pops per period
   bool has_active_ = false;
-  // The segments after the active one, taken from the ring so that the path can go on at
-  // speed through tangent junctions: a ring buffer of ahead_count_ from ahead_head_.
-  static constexpr int kLookAhead = 256;
-  std::array<Segment, kLookAhead> ahead_{};
-  int ahead_head_ = 0;
-  int ahead_count_ = 0;
+  std::array<Segment, kWindow> window_{};
+  std::array<double, kWindow> exit_hard_{};
+  std::array<double, kWindow> exit_soft_{};
+  std::uint64_t head_seq_ = 0;
+  int window_count_ = 0;
+  double window_length_ = 0;  // path length of the window's segments
+  double stop_length_ = 0;    // longest stopping distance of the window's segments
+  bool pass_active_ = false;
+  std::uint64_t pass_seq_ = 0;    // next segment whose exit speeds the pass recomputes
+  std::uint64_t pass_floor_ = 0;  // the pass goes at least this far back
+  int pass_budget_ = 0;
   double path_s_ = 0;
   double path_v_ = 0;
   double dwell_elapsed_s_ = 0;

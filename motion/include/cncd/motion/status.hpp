@@ -39,7 +39,8 @@ struct Status {
   double rapid_override = 1.0;      // applied to traverses, 0 .. 1
   std::int32_t line = 0;            // source line of the segment being executed
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
-  std::uint64_t segments_done = 0;  // segments completed since start
+  std::uint64_t segments_done = 0;  // segments completed (or dropped by an abort) since start
+  std::uint64_t moves_done = 0;     // programmed moves completed (or dropped) since start
   char fault_reason[120] = {};      // latched fault, "" when none
   RtStats rt;
 };

@@ -29,9 +29,14 @@ struct Move {
   double center_second = 0;
   int turns = 0;
   double dwell_s = 0;  // dwell
-  // G61 / G64: the path goes on at speed through the end of this move when the next move
-  // starts in the same direction (a tangent junction); false (G61.1): stop at the end.
-  bool continuous = false;
+  // Path control in force for this move (G61.1, G61, G64), which decides how its end joins
+  // the next move: exact_stop always stops there; exact_path goes on at speed only into a
+  // tangent move of the same kind (feed or traverse); blend also rounds line-line corners
+  // with an arc that stays within `tolerance` of the corner (G64 P; 0 = the largest arc that
+  // uses at most half of each line).
+  enum class PathMode : std::uint8_t { exact_stop, exact_path, blend };
+  PathMode path_mode = PathMode::exact_stop;
+  double tolerance = 0;   // units
   std::int32_t line = 0;  // source line of the program, 0 = none
 };
 

@@ -1,0 +1,184 @@
+// The planner's look-ahead: holding the newest move back until the next one shows how the two
+// join, marking tangent junctions and rounding G64 line-line corners with a blend arc.
+#include <algorithm>
+#include <cmath>
+
+#include "cncd/motion/planner.hpp"
+
+namespace cncd::motion {
+namespace {
+
+// Junctions within 1e-6 rad are tangent: at the path speed limits no axis changes speed by
+// more than 1e-6 of the path speed at once.
+constexpr double kTangentCos = 1.0 - 5e-13;
+// Smaller blend arcs are not worth a segment: the corner stops instead.
+constexpr double kMinBlendRadius = 1e-6;
+
+double dot(const AxisPose& a, const AxisPose& b) {
+  double sum = 0;
+  for (int i = 0; i < kAxes; ++i)
+    sum += a[i] * b[i];
+  return sum;
+}
+
+// Whether a line's path length is its length over all axes: then a blend arc, measured over
+// all axes, keeps the feed's meaning. Lines that move rotary axes along with XYZ are not
+// blended.
+bool euclidean(const Segment& s) {
+  double sum = 0;
+  for (int i = 0; i < kAxes; ++i)
+    sum += (s.end[i] - s.start[i]) * (s.end[i] - s.start[i]);
+  return std::abs(std::sqrt(sum) - s.length) <= 1e-9 * std::max(1.0, s.length);
+}
+
+}  // namespace
+
+void Planner::reset(const AxisPose& start) {
+  end_ = start;
+  held_.reset();
+  output_.clear();
+}
+
+bool Planner::push(const Move& move, bool check_limits, std::string& error) {
+  auto planned = plan(move, end_, check_limits, error);
+  if (!planned) return false;
+  Segment seg = *planned;
+  end_ = seg.end;
+  if (seg.kind != Segment::Kind::dwell && seg.length == 0) {
+    // Nothing to move: the move is done with the one before it, which keeps its junction.
+    if (held_) {
+      ++held_->segment.moves;
+    } else {
+      output_.push_back(seg);
+    }
+    return true;
+  }
+  const double full_length = seg.length;
+  if (held_) join(seg, move);
+  if (seg.kind == Segment::Kind::dwell || move.path_mode == Move::PathMode::exact_stop) {
+    seg.continuous = false;
+    output_.push_back(seg);
+    return true;
+  }
+  held_ = Held{seg, move.path_mode, move.tolerance, full_length, move.kind == Move::Kind::traverse};
+  return true;
+}
+
+void Planner::flush() {
+  if (!held_) return;
+  held_->segment.continuous = false;
+  output_.push_back(held_->segment);
+  held_.reset();
+}
+
+void Planner::join(Segment& next, const Move& move) {
+  Held held = *held_;
+  held_.reset();
+  Segment& prev = held.segment;
+  prev.continuous = false;
+  const bool moving = next.kind != Segment::Kind::dwell;
+  const double c = dot(prev.end_direction, next.start_direction);
+  if (!moving || held.mode == Move::PathMode::exact_stop) {
+    output_.push_back(prev);
+    return;
+  }
+  if (c > kTangentCos) {
+    // Exact path (canned cycles) stops where a traverse meets a feed move, as LinuxCNC does.
+    const bool same_kind = held.traverse == (move.kind == Move::Kind::traverse);
+    prev.continuous = held.mode == Move::PathMode::blend || same_kind;
+    output_.push_back(prev);
+    return;
+  }
+  if (held.mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
+      next.kind != Segment::Kind::line || !euclidean(prev) || !euclidean(next)) {
+    output_.push_back(prev);
+    return;
+  }
+  // A tangent arc of radius R into a corner that turns by `turn` touches both lines at
+  // L = R tan(turn / 2) from the corner and passes R (1 / cos(turn / 2) - 1) from it. Each
+  // blend takes at most half of each line, so the blends at both ends of a line never meet.
+  const double turn = std::acos(std::clamp(c, -1.0, 1.0));
+  const double half = 0.5 * turn;
+  double reach = 0.5 * std::min(held.full_length, next.length);
+  if (held.tolerance > 0) {
+    const double s = std::sin(0.5 * half);
+    reach = std::min(reach, held.tolerance * std::sin(half) / (2.0 * s * s));
+  }
+  reach = std::min(reach, prev.length);
+  const double radius = reach / std::tan(half);
+  if (!(radius >= kMinBlendRadius) || !std::isfinite(radius)) {
+    output_.push_back(prev);
+    return;
+  }
+  const AxisPose corner = prev.end;
+  const AxisPose& d1 = prev.end_direction;
+  const AxisPose& d2 = next.start_direction;
+  // u: from the centre to where the arc leaves the first line, at right angles to d1 and away
+  // from the turn.
+  AxisPose u{};
+  double u_norm = 0;
+  for (int i = 0; i < kAxes; ++i) {
+    u[i] = -(d2[i] - c * d1[i]);
+    u_norm += u[i] * u[i];
+  }
+  u_norm = std::sqrt(u_norm);
+  Segment blend = prev;
+  blend.kind = Segment::Kind::blend;
+  for (int i = 0; i < kAxes; ++i) {
+    u[i] /= u_norm;
+    blend.start[i] = corner[i] - reach * d1[i];
+    blend.end[i] = corner[i] + reach * d2[i];
+    blend.blend_center[i] = blend.start[i] - radius * u[i];
+  }
+  blend.blend_u = u;
+  blend.blend_v = d1;
+  blend.radius = radius;
+  blend.sweep = turn;
+  blend.length = radius * turn;
+  blend.start_direction = d1;
+  blend.end_direction = d2;
+  blend.line = next.line;
+  blend.moves = 0;
+  blend.continuous = true;
+  if (prev.feed > 0 && next.feed > 0) {
+    blend.feed = std::min(prev.feed, next.feed);
+  } else {
+    blend.feed = std::max(prev.feed, next.feed);  // a traverse has none
+  }
+  set_blend_limits(blend);
+
+  prev.end = blend.start;
+  prev.length -= reach;
+  prev.continuous = true;
+  next.start = blend.end;
+  next.length -= reach;
+  if (prev.length > 1e-12) {
+    output_.push_back(prev);
+  } else {
+    blend.moves += prev.moves;  // the blend took all that was left of it
+  }
+  output_.push_back(blend);
+}
+
+void Planner::set_blend_limits(Segment& blend) const {
+  // Per axis the arc's velocity and acceleration are at most their in-plane size times
+  // w = |(u_i, v_i)|, the axis's share of the plane.
+  double v = 1e300;
+  double plane_a = 1e300;
+  bool linear = false;
+  for (int i = 0; i < kAxes; ++i) {
+    const double w = std::hypot(blend.blend_u[i], blend.blend_v[i]);
+    if (w <= 1e-12) continue;
+    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
+    v = std::min(v, axis.max_velocity / w);
+    plane_a = std::min(plane_a, axis.max_acceleration / w);
+    linear = linear || i < 3;
+  }
+  if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
+  v = std::min(v, std::sqrt(kNormalShare * plane_a * blend.radius));
+  blend.axis_velocity = v;
+  blend.max_velocity = blend.feed > 0 ? std::min(v, blend.feed) : v;
+  blend.max_acceleration = kTangentialShare * plane_a;
+}
+
+}  // namespace cncd::motion

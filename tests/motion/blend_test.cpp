@@ -1,0 +1,263 @@
+// Blending in virtual time: random programs of lines, arcs, helices, corners and dwells under
+// random G61.1 / G61 / G64 P never take an axis over its velocity or acceleration limit (finite
+// differences of the positions of every period), stay within P of the programmed path, stop
+// where they must, hold every dwell and end exactly at the programmed end.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using motion::AxisPose;
+using motion::Command;
+using motion::Move;
+
+double distance(const AxisPose& a, const AxisPose& b) {
+  double sum = 0;
+  for (int i = 0; i < 3; ++i)
+    sum += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(sum);
+}
+
+// Distance from `p` to the programmed move from `from` (a line, or an arc or helix in XY of
+// less than a turn).
+double distance_to_move(const AxisPose& p, const AxisPose& from, const Move& move) {
+  if (move.kind == Move::Kind::arc) {
+    const double cx = move.center_first, cy = move.center_second;
+    const double a0 = std::atan2(from[1] - cy, from[0] - cx);
+    const double a1 = std::atan2(move.end[1] - cy, move.end[0] - cx);
+    const double two_pi = 2 * std::numbers::pi;
+    double sweep = a1 - a0;
+    if (move.turns > 0 && sweep <= 0) sweep += two_pi;
+    if (move.turns < 0 && sweep >= 0) sweep -= two_pi;
+    double phi = std::atan2(p[1] - cy, p[0] - cx) - a0;
+    while (sweep > 0 && phi < 0)
+      phi += two_pi;
+    while (sweep < 0 && phi > 0)
+      phi -= two_pi;
+    const double f = std::clamp(phi / sweep, 0.0, 1.0);
+    const double r = std::hypot(from[0] - cx, from[1] - cy);
+    const AxisPose on{cx + r * std::cos(a0 + f * sweep), cy + r * std::sin(a0 + f * sweep),
+                      from[2] + (move.end[2] - from[2]) * f};
+    return std::min({distance(p, on), distance(p, from), distance(p, move.end)});
+  }
+  double len_sq = 0, t = 0;
+  for (int i = 0; i < 3; ++i) {
+    len_sq += (move.end[i] - from[i]) * (move.end[i] - from[i]);
+    t += (p[i] - from[i]) * (move.end[i] - from[i]);
+  }
+  t = len_sq > 0 ? std::clamp(t / len_sq, 0.0, 1.0) : 0.0;
+  AxisPose on{};
+  for (int i = 0; i < 3; ++i)
+    on[i] = from[i] + (move.end[i] - from[i]) * t;
+  return distance(p, on);
+}
+
+struct Program {
+  std::vector<Move> moves;     // line = index + 1
+  std::vector<AxisPose> from;  // start of each move
+};
+
+// Lines (feeds and traverses, some continuing straight on), arcs and helices tangent or not
+// to what comes before, and a few dwells, each move with its own path mode and tolerance.
+Program random_program(std::mt19937& rng, int count) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  Program prog;
+  AxisPose at{};
+  double heading = 0;
+  for (int k = 0; k < count; ++k) {
+    Move move;
+    move.line = k + 1;
+    const double mode = unit(rng);
+    move.path_mode = mode < 0.1   ? Move::PathMode::exact_stop
+                     : mode < 0.3 ? Move::PathMode::exact_path
+                                  : Move::PathMode::blend;
+    move.tolerance = unit(rng) < 0.25 ? 0.0 : 0.005 + 0.5 * unit(rng) * unit(rng);
+    move.feed = 10 + 240 * unit(rng);
+    move.end = at;
+    const double pick = unit(rng);
+    if (pick < 0.05 && k > 0) {
+      move.kind = Move::Kind::dwell;
+      move.dwell_s = 0.005 + 0.03 * unit(rng);
+    } else if (pick < 0.6) {
+      move.kind = unit(rng) < 0.25 ? Move::Kind::traverse : Move::Kind::feed;
+      if (unit(rng) > 0.3) heading += (unit(rng) - 0.5) * 2 * std::numbers::pi;
+      const double length = 0.05 + 20 * unit(rng) * unit(rng);
+      move.end[0] += length * std::cos(heading);
+      move.end[1] += length * std::sin(heading);
+      if (unit(rng) < 0.2) move.end[2] += (unit(rng) - 0.5) * 4;
+    } else {
+      move.kind = Move::Kind::arc;
+      if (unit(rng) < 0.3) heading += (unit(rng) - 0.5) * 2;  // a corner onto the arc
+      const double r = 0.5 + 15 * unit(rng);
+      const double sweep = 0.1 + 4 * unit(rng);
+      const double side = unit(rng) < 0.5 ? 1 : -1;
+      const double cx = at[0] - side * r * std::sin(heading);
+      const double cy = at[1] + side * r * std::cos(heading);
+      const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
+      move.end[0] = cx + r * std::cos(a1);
+      move.end[1] = cy + r * std::sin(a1);
+      heading += side * sweep;
+      move.center_first = cx;
+      move.center_second = cy;
+      move.turns = side > 0 ? 1 : -1;
+      if (unit(rng) < 0.3) move.end[2] += (unit(rng) - 0.5) * 6;  // a helix
+    }
+    prog.from.push_back(at);
+    prog.moves.push_back(move);
+    at = move.end;
+  }
+  return prog;
+}
+
+struct Recorded {
+  std::vector<AxisPose> points;
+  std::vector<int> lines;
+};
+
+// Queues the program and runs it to the end, recording every period's position and line;
+// `pause_at` > 0: a pause at that period and a resume 300 periods later; `override_at` > 0:
+// the feed override drops to 0.3 there and goes to 1.5 400 periods later.
+Recorded run_program(VirtualMachine& m, const Program& prog, int pause_at, int override_at) {
+  Recorded run;
+  int period = 0;
+  auto step = [&] {
+    ++period;
+    if (period == pause_at) m.loop().commands().push(Command{Command::Kind::pause, 0});
+    if (period == pause_at + 300) m.loop().commands().push(Command{Command::Kind::resume, 0});
+    Command command;
+    command.kind = Command::Kind::feed_override;
+    command.velocity = period == override_at ? 0.3 : 1.5;
+    if (override_at > 0 && (period == override_at || period == override_at + 400))
+      m.loop().commands().push(command);
+    m.cycles(1);
+    run.points.push_back(m.status().commanded);
+    run.lines.push_back(m.status().line);
+  };
+  for (const auto& move : prog.moves) {
+    while (m.loop().segments().size() >= 1000)
+      step();
+    m.queue(move);
+  }
+  m.flush();
+  do {
+    step();
+  } while (period < 400000 &&
+           (m.status().queued > 0 || m.status().motion != motion::MotionState::idle));
+  return run;
+}
+
+TEST(Blend, RandomProgramsStayWithinLimitsToleranceAndStops) {
+  std::mt19937 rng(2026);
+  const auto config = small_mill();
+  for (int round = 0; round < 16; ++round) {
+    const Program prog = random_program(rng, 40);
+    VirtualMachine m(config);
+    m.ready();
+    const AxisPose start = m.status().commanded;
+    const Recorded run = run_program(m, prog, round % 4 == 1 ? 700 : 0, round % 4 == 2 ? 500 : 0);
+    SCOPED_TRACE("round " + std::to_string(round));
+
+    const auto p = peaks(m, start);
+    EXPECT_LE(p.velocity, 1.001);
+    EXPECT_LE(p.acceleration, 1.001);
+    for (int axis = 0; axis < 3; ++axis)
+      EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
+    EXPECT_EQ(m.status().moves_done, prog.moves.size());
+
+    // Within P of the programmed path: a period's position lies on its line's move, or on a
+    // blend into it from the move before.
+    for (std::size_t k = 0; k < run.points.size(); ++k) {
+      const int line = run.lines[k];
+      if (line < 1) continue;
+      const auto i = static_cast<std::size_t>(line - 1);
+      double d = distance_to_move(run.points[k], prog.from[i], prog.moves[i]);
+      double allowed = 1e-6;
+      if (i > 0) {
+        const Move& before = prog.moves[i - 1];
+        d = std::min(d, distance_to_move(run.points[k], prog.from[i - 1], before));
+        if (before.path_mode == Move::PathMode::blend)
+          allowed = before.tolerance > 0 ? before.tolerance + 1e-6 : 1e9;
+      }
+      ASSERT_LE(d, allowed) << "period " << k << " line " << line;
+    }
+
+    // At rest where a move ends under G61.1 or before a dwell; dwells held in full.
+    const double dt = m.period_s();
+    for (std::size_t i = 0; i + 1 < prog.moves.size(); ++i) {
+      const Move& move = prog.moves[i];
+      const Move& next = prog.moves[i + 1];
+      if (move.kind == Move::Kind::dwell) continue;
+      if (move.path_mode != Move::PathMode::exact_stop && next.kind != Move::Kind::dwell) continue;
+      std::size_t nearest = 0;
+      for (std::size_t k = 1; k < run.points.size(); ++k) {
+        if (run.lines[k] != move.line && run.lines[k] != next.line) continue;
+        if (nearest == 0 ||
+            distance(run.points[k], move.end) < distance(run.points[nearest], move.end))
+          nearest = k;
+      }
+      ASSERT_GT(nearest, 0u) << "end of line " << move.line;
+      const double speed = distance(run.points[nearest], run.points[nearest - 1]) / dt;
+      EXPECT_LE(speed, 2 * 2000 * dt * std::sqrt(3.0)) << "end of line " << move.line;
+      if (next.kind == Move::Kind::dwell) {
+        int held = 0, longest = 0;
+        for (const auto& point : run.points) {
+          held = point == move.end ? held + 1 : 0;
+          longest = std::max(longest, held);
+        }
+        EXPECT_GE(longest + 1, static_cast<int>(next.dwell_s / dt)) << "dwell " << next.line;
+      }
+    }
+  }
+}
+
+// Lines at right angles (a staircase of 10 mm legs at F6000): in G64 P1 the corners are
+// rounded by exactly P (the random test checks that the path stays within P) and the run is
+// faster than in G61, which stops at every corner.
+TEST(Blend, CornersAreRoundedWithinTheToleranceAndFaster) {
+  int periods[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    VirtualMachine m(small_mill());
+    m.ready();
+    const AxisPose start = m.status().commanded;
+    std::vector<AxisPose> corners;
+    for (int leg = 1; leg <= 20; ++leg) {
+      Move move = line_to(Move::Kind::feed, 10.0 * ((leg + 1) / 2), 10.0 * (leg / 2), 0, 100);
+      move.path_mode = k == 0 ? Move::PathMode::blend : Move::PathMode::exact_path;
+      move.tolerance = 1.0;
+      m.queue(move);
+      corners.push_back(move.end);
+    }
+    periods[k] = m.run_until_idle();
+    const auto p = peaks(m, start);
+    EXPECT_LE(p.velocity, 1.001);
+    EXPECT_LE(p.acceleration, 1.001);
+    EXPECT_DOUBLE_EQ(m.status().commanded[0], 100);
+    EXPECT_DOUBLE_EQ(m.status().commanded[1], 100);
+    double nearest = 1e9;  // of the corners inside the path, the closest approach
+    for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
+      double d = 1e9;
+      for (const auto& point : m.trajectory())
+        d = std::min(d, distance(point, corners[c]));
+      nearest = std::min(nearest, d);
+    }
+    // The closest point of a blend arc is its middle, P from the corner; the sampled
+    // positions come no closer.
+    if (k == 0) {
+      EXPECT_GE(nearest, 1.0 - 1e-9);
+    } else {
+      EXPECT_LE(nearest, 0.1);
+    }
+  }
+  EXPECT_LT(periods[0], 0.9 * periods[1]) << periods[0] << " vs " << periods[1];
+}
+
+}  // namespace
+}  // namespace cncd::test
