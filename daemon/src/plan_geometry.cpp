@@ -64,6 +64,20 @@ double distance_to_path(const motion::Segment& segment, const motion::AxisPose& 
       nearest[i] = segment.start[i] + f * (segment.end[i] - segment.start[i]);
     return xyz_distance(nearest, point);
   }
+  if (segment.kind == Kind::blend) {
+    // The programmed path here is the corner the blend arc rounds: from where the arc leaves
+    // the first line to the corner, and on to where it joins the second.
+    const double reach = segment.radius * std::tan(0.5 * segment.sweep);
+    motion::Segment in = segment;
+    in.kind = Kind::line;
+    for (int i = 0; i < motion::kAxes; ++i)
+      in.end[i] = segment.start[i] + reach * segment.start_direction[i];
+    in.length = reach;
+    motion::Segment out = in;
+    out.start = in.end;
+    out.end = segment.end;
+    return std::min(distance_to_path(in, point), distance_to_path(out, point));
+  }
   // Arc: the candidates are the ends and, on every turn the sweep covers, the point at the
   // sample's angle about the centre.
   double best = std::min(xyz_distance(segment.start, point), xyz_distance(segment.end, point));

@@ -74,7 +74,8 @@ class Simulation {
       if (!feed()) return;
       const motion::Status before = loop_->status();
       const std::uint64_t done_before = before.segments_done - base_;
-      if (interp_done_ && feeder_.pending.empty() && done_before >= pushed_ &&
+      if (interp_done_ && feeder_.pending.empty() && !planner_.holding() &&
+          planner_.output().empty() && done_before >= pushed_ &&
           before.motion == motion::MotionState::idle)
         break;
       if ((cycle & 1023) == 0 && over_budget(before.line)) break;
@@ -138,32 +139,36 @@ class Simulation {
       return false;
     }
     base_ = status.segments_done;
-    plan_end_ = status.commanded;
+    planner_.reset(status.commanded);
     previous_ = status.commanded;
     return true;
   }
 
   // Fills the segment queue as far as it goes, reading the program as needed. False on error.
+  // As Task::feed() does: the planner holds the newest move back for look-ahead and is
+  // flushed at stop points, program stops and the program's end.
   bool feed() {
-    auto& ring = loop_->segments();
     for (int blocks = 0;; ++blocks) {
       while (!feeder_.pending.empty()) {
-        if (ring.size() >= ring.capacity()) return true;
+        if (!pump()) return true;
         const motion::Move& move = feeder_.pending.front();
+        if (ProgramFeeder::stop_point(move)) {
+          planner_.flush();
+          feeder_.pending.pop_front();
+          continue;
+        }
         std::string error;
         const double cpu_start = thread_cpu_s();
-        const auto segment = planner_.plan(move, plan_end_, true, error);
+        const bool planned = planner_.push(move, true, error);
         result_.planner_cpu_s += thread_cpu_s() - cpu_start;
-        if (!segment) {
+        if (!planned) {
           result_.error = CheckProblem{program_, move.line, error};
           return false;
         }
-        if (!ring.push(*segment)) return true;
-        account(*segment);
-        plan_end_ = segment->end;
         feeder_.pending.pop_front();
       }
-      if (interp_done_) return true;
+      if (interp_done_) planner_.flush();
+      if (!pump() || interp_done_) return true;
       // A program reading thousands of blocks without a move still answers the budget.
       if ((blocks & 4095) == 4095 && over_budget(interp_.current_line())) return false;
       const auto step = interp_.step(sink_);
@@ -173,15 +178,32 @@ class Simulation {
                               : CheckProblem{program_, interp_.current_line(), "interpreter error"};
         return false;
       }
-      // M0/M1/M60 wait for the operator: the estimate leaves that time out.
+      // M0/M1/M60 wait for the operator: the estimate leaves that time out, but the machine
+      // comes to rest there.
+      if (feeder_.stop_seen) {
+        motion::Move stop;
+        stop.kind = motion::Move::Kind::dwell;
+        feeder_.pending.push_back(stop);
+      }
       feeder_.stop_seen = false;
       if (step == interp::Interpreter::Step::end) interp_done_ = true;
     }
   }
 
+  // Hands the planner's final segments to the servo loop; false when the ring is full.
+  bool pump() {
+    auto& out = planner_.output();
+    while (!out.empty()) {
+      if (!loop_->segments().push(out.front())) return false;
+      account(out.front());
+      out.pop_front();
+    }
+    return true;
+  }
+
   void account(const motion::Segment& segment) {
     ++pushed_;
-    ++result_.moves;
+    result_.moves += segment.moves;  // a blend arc is part of the moves it joins
     result_.move_line.push_back(segment.line);
     result_.move_start_s.push_back(pushed_ == 1 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
     if (segment.kind == motion::Segment::Kind::dwell) {
@@ -260,7 +282,6 @@ class Simulation {
   std::uint64_t base_ = 0;    // segments done before the program
   std::uint64_t pushed_ = 0;  // segments queued by the program
   bool interp_done_ = false;
-  motion::AxisPose plan_end_{};
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};
   std::deque<motion::Segment> window_;  // queued segments from index window_first_ on

@@ -69,7 +69,7 @@ struct PlanSimResult {
   // For each planned move in order: its source line and when it starts (s, virtual time).
   std::vector<std::int32_t> move_line;
   std::vector<double> move_start_s;
-  double planner_cpu_s = 0;  // thread CPU time spent in Planner::plan
+  double planner_cpu_s = 0;  // thread CPU time spent in Planner::push
   double servo_cpu_s = 0;    // thread CPU time spent in ServoLoop::cycle (with `measure`)
   double wall_s = 0;         // wall-clock time of the whole simulation
 };
