@@ -1,0 +1,176 @@
+// Planner benchmark: cycle time of the real planner and servo loop (plan_sim, virtual time)
+// over the feed-limited bound on a small fast mill, peak axis velocity and acceleration over
+// the limits, path deviation and CPU time per move; side by side with LinuxCNC running the
+// same programs on the same limits (through /work/shared/tools/linuxcnc-bench/run.sh, in real
+// time, when it is there). Programs and INIs are generated (planner_programs.cpp).
+//
+//   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH]
+//
+// A benchmark: it prints figures and never fails on them.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "cncd/config/machine_config.hpp"
+#include "plan_sim.hpp"
+#include "planner_programs.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kAxisMm =
+    "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/axis_mm.ini";
+constexpr const char* kChips = "/usr/share/doc/linuxcnc/examples/nc_files/3D_Chips.ngc";
+constexpr const char* kRunSh = "/work/shared/tools/linuxcnc-bench/run.sh";
+
+struct LinuxcncRun {
+  double run_s = 0;     // cycle start until the interpreter is idle
+  double moving_s = 0;  // servo cycles with the machine out of position
+};
+
+// Runs LinuxCNC's harness; nullopt (with what it said) when it fails.
+std::optional<LinuxcncRun> run_linuxcnc(const std::string& run_sh, const fs::path& ini,
+                                        const fs::path& program, const fs::path& log) {
+  const std::string command = "BENCH_TIMEOUT=600 '" + run_sh + "' '" + ini.string() + "' '" +
+                              program.string() + "' >'" + log.string() + "' 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream in(log);
+  LinuxcncRun run;
+  bool found = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("linuxcnc_run_s=", 0) == 0) {
+      run.run_s = std::atof(line.c_str() + 15);
+      found = true;
+    } else if (line.rfind("# moving_s=", 0) == 0) {
+      run.moving_s = std::atof(line.c_str() + 11);
+    }
+  }
+  if (status != 0 || !found) {
+    std::fprintf(stderr, "  LinuxCNC run failed (%s): see %s\n", program.c_str(), log.c_str());
+    return std::nullopt;
+  }
+  return run;
+}
+
+double worst_ratio(const cncd::config::MachineConfig& machine, const cncd::motion::AxisPose& peaks,
+                   bool acceleration) {
+  double worst = 0;
+  for (std::size_t i = 0; i < cncd::config::kAxisLetters.size(); ++i) {
+    const auto& axis = machine.axes[i];
+    if (!axis.present) continue;
+    worst = std::max(worst, peaks[i] / (acceleration ? axis.max_acceleration : axis.max_velocity));
+  }
+  return worst;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool linuxcnc = true;
+  bool keep = false;
+  std::string run_sh = kRunSh;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--no-linuxcnc") {
+      linuxcnc = false;
+    } else if (arg == "--keep") {
+      keep = true;
+    } else if (arg == "--run-sh" && i + 1 < argc) {
+      run_sh = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH]\n");
+      return 64;
+    }
+  }
+  char pattern[] = "/tmp/cncd-planner-bench-XXXXXX";
+  if (mkdtemp(pattern) == nullptr) {
+    std::perror("mkdtemp");
+    return 1;
+  }
+  const fs::path dir = pattern;
+  const fs::path ini = cncd::bench::write_cncd_ini(dir);
+  const auto loaded = cncd::config::load_machine_config(ini);
+  if (!loaded.ok()) {
+    for (const auto& problem : loaded.problems)
+      std::fprintf(stderr, "%s\n", problem.to_string().c_str());
+    return 1;
+  }
+  const auto& machine = *loaded.config;
+  const auto programs = cncd::bench::write_programs(dir, kChips);
+  std::error_code ec;
+  std::string lcnc_error;
+  fs::path lcnc_ini;
+  if (linuxcnc && access(run_sh.c_str(), X_OK) != 0) {
+    std::printf("LinuxCNC: %s not found, cncd only\n", run_sh.c_str());
+    linuxcnc = false;
+  }
+  if (linuxcnc) {
+    lcnc_ini = cncd::bench::write_linuxcnc_ini(dir, kAxisMm, lcnc_error);
+    if (lcnc_ini.empty()) {
+      std::printf("LinuxCNC: %s, cncd only\n", lcnc_error.c_str());
+      linuxcnc = false;
+    }
+  }
+#ifdef NDEBUG
+  const char* build = "optimised build";
+#else
+  const char* build = "debug build: CPU figures are pessimistic";
+#endif
+  std::printf(
+      "machine: X/Y 200 mm/s 2000 mm/s^2, Z 100 mm/s 1000 mm/s^2, 1 ms servo period (%s)\n"
+      "files in %s\n\n",
+      build, dir.c_str());
+  for (const auto& program : programs) {
+    cncd::daemon::PlanSimOptions options;
+    options.interp = cncd::daemon::interpreter_options(machine);
+    options.start_machine = cncd::interp::Pose{};
+    const auto r = cncd::daemon::simulate_plan(machine, program.path, options);
+    std::printf("%s  (%s)\n", program.name.c_str(), program.path.filename().c_str());
+    if (!r.complete()) {
+      std::printf("  cncd: %s\n\n",
+                  (r.error ? r.error->to_string() : r.stopped->to_string()).c_str());
+      continue;
+    }
+    const double moves = static_cast<double>(r.moves);
+    std::printf("  cncd      cycle %.3f s  feed bound %.3f s  ratio %.4f", r.cycle_time_s,
+                r.feed_bound_s, r.cycle_time_s / r.feed_bound_s);
+    if (program.exact_stop)
+      std::printf("  exact-stop bound %.3f s  ratio %.4f", r.exact_stop_bound_s,
+                  r.cycle_time_s / r.exact_stop_bound_s);
+    std::printf(
+        "\n            peak v %.3f %%  peak a %.3f %% (worst axis, of its limit)  "
+        "X/Y/Z a %.1f/%.1f/%.1f %%  max deviation %.4f mm\n",
+        100 * worst_ratio(machine, r.peak_velocity, false),
+        100 * worst_ratio(machine, r.peak_acceleration, true),
+        100 * r.peak_acceleration[0] / machine.axes[0].max_acceleration,
+        100 * r.peak_acceleration[1] / machine.axes[1].max_acceleration,
+        100 * r.peak_acceleration[2] / machine.axes[2].max_acceleration, r.max_deviation);
+    std::printf(
+        "            %zu moves; CPU per move: planner %.3f us, servo loop %.3f us "
+        "(%.3f us per period); simulated in %.2f s\n",
+        r.moves, r.planner_cpu_s * 1e6 / moves, r.servo_cpu_s * 1e6 / moves,
+        r.servo_cpu_s * 1e6 / static_cast<double>(r.cycles), r.wall_s);
+    if (linuxcnc) {
+      std::fflush(stdout);
+      const fs::path log = dir / (program.path.stem().string() + ".linuxcnc.log");
+      if (const auto l = run_linuxcnc(run_sh, lcnc_ini, program.path, log)) {
+        std::printf("  LinuxCNC  run %.3f s (moving %.3f s)  ratio %.4f", l->run_s, l->moving_s,
+                    l->run_s / r.feed_bound_s);
+        if (program.exact_stop)
+          std::printf("  over exact-stop bound %.4f", l->run_s / r.exact_stop_bound_s);
+        std::printf("  cncd/LinuxCNC %.4f\n", r.cycle_time_s / l->run_s);
+      }
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  if (!keep) fs::remove_all(dir, ec);
+  return 0;
+}
