@@ -145,21 +145,30 @@ void Server::accept_clients() {
   }
 }
 
+void Server::drop(Client& client) {
+  client.out.clear();
+  client.session.open_requests.clear();
+  client.closing = true;
+}
+
+void Server::stop_reading(Client& client) {
+  client.closing = true;
+  client.close_by = Clock::now() + kCloseGrace;
+}
+
 void Server::read_client(Client& client) {
   char buffer[65536];
   for (;;) {
     const ssize_t n = ::read(client.fd, buffer, sizeof buffer);
     if (n == 0) {
-      client.closing = true;
-      client.out.clear();
+      // A peer that only shut down its sending side (as socat and nc -N do) still gets the
+      // answers to what it sent; one that has gone makes the next send fail.
+      stop_reading(client);
       return;
     }
     if (n < 0) {
       if (errno == EINTR) continue;
-      if (errno != EAGAIN && errno != EWOULDBLOCK) {
-        client.closing = true;
-        client.out.clear();
-      }
+      if (errno != EAGAIN && errno != EWOULDBLOCK) drop(client);
       return;
     }
     client.in.append(buffer, static_cast<std::size_t>(n));
@@ -185,7 +194,7 @@ void Server::read_client(Client& client) {
           {"error", RpcDispatcher::error_object(kRequestTooLarge, "request longer than 1 MiB")}};
       client.out += error.dump() + "\n";
       client.in.clear();
-      client.closing = true;
+      stop_reading(client);
       return;
     }
   }
@@ -196,25 +205,22 @@ void Server::write_client(Client& client) {
     const ssize_t n = ::send(client.fd, client.out.data(), client.out.size(), MSG_NOSIGNAL);
     if (n < 0) {
       if (errno == EINTR) continue;
-      if (errno != EAGAIN && errno != EWOULDBLOCK) {
-        client.out.clear();
-        client.closing = true;
-      }
+      if (errno != EAGAIN && errno != EWOULDBLOCK) drop(client);
       break;
     }
     client.out.erase(0, static_cast<std::size_t>(n));
   }
   if (client.out.size() > kMaxBacklogBytes) {
     spdlog::warn("control client not reading: {} bytes unsent, disconnecting", client.out.size());
-    // Best effort: tell the client why, then drop what it never read.
+    // What it never read is dropped; the reason is sent once it reads what the socket holds
+    // (within kCloseGrace). The newline ends a line the last send may have cut.
     const nlohmann::json notice = {
         {"jsonrpc", "2.0"},
         {"method", "connection.closing"},
         {"params", {{"reason", "client does not read its messages: backlog over 4 MiB"}}}};
-    const std::string line = "\n" + notice.dump() + "\n";
-    [[maybe_unused]] const ssize_t n = ::send(client.fd, line.data(), line.size(), MSG_NOSIGNAL);
-    client.out.clear();
-    client.closing = true;
+    drop(client);
+    client.out = "\n" + notice.dump() + "\n";
+    stop_reading(client);
   }
 }
 
@@ -303,7 +309,7 @@ void Server::deliver_completions() {
         response["error"] = RpcDispatcher::error_object(done.error_code, done.error_message);
       }
       open.erase(it);
-      if (client.closing) break;
+      if (client.closing) client.close_by = Clock::now() + kCloseGrace;
       client.out += response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
       client.out += '\n';
       write_client(client);
@@ -336,7 +342,8 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   for (const auto& client : clients_) {
     short events = client.closing ? 0 : POLLIN;
     if (!client.out.empty()) events |= POLLOUT;
-    fds.push_back({client.fd, events, 0});
+    // Left out while it waits for a deferred answer: a hung-up peer would wake poll at once.
+    fds.push_back({events != 0 ? client.fd : -1, events, 0});
   }
   const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
   if (ready > 0) {
@@ -344,7 +351,7 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
     for (std::size_t i = 0; i < known; ++i) {
       const short revents = fds[i + 2].revents;
       Client& client = clients_[i];
-      if (revents & (POLLIN | POLLHUP | POLLERR)) read_client(client);
+      if (!client.closing && (revents & (POLLIN | POLLHUP | POLLERR))) read_client(client);
       if (!client.out.empty()) write_client(client);
     }
     if (fds[0].revents & POLLIN) accept_clients();
@@ -353,8 +360,10 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   push_events();
   push_updates(Clock::now());
   requests_handled_ = false;
-  std::erase_if(clients_, [](const Client& client) {
-    if (client.closing && client.out.empty()) {
+  const auto now = Clock::now();
+  std::erase_if(clients_, [now](const Client& client) {
+    const bool done = client.out.empty() && client.session.open_requests.empty();
+    if (client.closing && (done || (!client.out.empty() && now >= client.close_by))) {
       ::close(client.fd);
       return true;
     }

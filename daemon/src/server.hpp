@@ -26,6 +26,8 @@ class Server {
   // Unsent output past which a client that does not read is disconnected.
   static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
   static constexpr int kMinSubscribeIntervalMs = 10;
+  // How long a closing connection may take to read what is still owed to it.
+  static constexpr std::chrono::seconds kCloseGrace{5};
 
   // `status` produces the full status object for subscriptions (called at most once a loop);
   // every entry added to `events` is pushed to every client as an "event" notification.
@@ -54,7 +56,10 @@ class Server {
     Session session;
     std::string in;
     std::string out;
-    bool closing = false;           // close once `out` is flushed
+    // Reads no more; closed once `out` is flushed and no deferred answer is owed, or when
+    // `out` is still unsent at `close_by`.
+    bool closing = false;
+    Clock::time_point close_by;
     nlohmann::json last_sent;       // status as this client last saw it
     Clock::time_point next_update;  // when the next status update is due
     Clock::time_point last_update;  // when the last one was sent
@@ -62,6 +67,9 @@ class Server {
     std::uint64_t event_seq = 0;  // last event pushed to this client
   };
   void accept_clients();
+  // The peer is gone or misbehaves: nothing more is sent to it.
+  static void drop(Client& client);
+  static void stop_reading(Client& client);
   void read_client(Client& client);
   void write_client(Client& client);
   void push_updates(Clock::time_point now);
