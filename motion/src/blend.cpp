@@ -78,18 +78,21 @@ void Planner::join(Segment& next, const Move& move) {
   prev.continuous = false;
   const bool moving = next.kind != Segment::Kind::dwell;
   const double c = dot(prev.end_direction, next.start_direction);
-  if (!moving || held.mode == Move::PathMode::exact_stop) {
+  // The stricter of the two moves' modes rules the junction: a canned cycle (G61) is entered
+  // and left as exact path even from and into G64 moves.
+  const Move::PathMode mode = std::min(held.mode, move.path_mode);
+  if (!moving || mode == Move::PathMode::exact_stop) {
     output_.push_back(prev);
     return;
   }
   if (c > kTangentCos) {
     // Exact path (canned cycles) stops where a traverse meets a feed move, as LinuxCNC does.
     const bool same_kind = held.traverse == (move.kind == Move::Kind::traverse);
-    prev.continuous = held.mode == Move::PathMode::blend || same_kind;
+    prev.continuous = mode == Move::PathMode::blend || same_kind;
     output_.push_back(prev);
     return;
   }
-  if (held.mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
+  if (mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
       next.kind != Segment::Kind::line || !euclidean(prev) || !euclidean(next)) {
     output_.push_back(prev);
     return;
