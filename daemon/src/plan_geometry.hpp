@@ -12,9 +12,9 @@ struct MoveLimits {
   double acceleration = 0;  // fastest path acceleration the axes allow (units/s^2)
 };
 
-// From the axis limits alone (never from a planner's choices), so that the bounds hold for
-// any planner: along a line the direction is fixed; along an arc an axis is credited with its
-// chord's share of the length, which no point of the arc can undercut.
+// From the programmed move and the axis limits alone (never from a planner's choices, such as
+// blends that cut a corner short): along a line the direction is fixed; along an arc an axis is
+// credited with its chord's share of the length, which no point of the arc can undercut.
 MoveLimits move_limits(const config::MachineConfig& machine, const motion::Segment& segment);
 
 // Time to cover `length` from rest to rest at most at `velocity` and `acceleration`.

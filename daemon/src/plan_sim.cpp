@@ -74,6 +74,7 @@ class Simulation {
       if (!feed()) return;
       const motion::Status before = loop_->status();
       const std::uint64_t done_before = before.segments_done - base_;
+      const std::uint64_t moves_before = before.moves_done - moves_base_;
       if (interp_done_ && feeder_.pending.empty() && !planner_.holding() &&
           planner_.output().empty() && done_before >= pushed_ &&
           before.motion == motion::MotionState::idle)
@@ -90,7 +91,10 @@ class Simulation {
         break;
       }
       const std::uint64_t done = s.segments_done - base_;
-      for (std::uint64_t i = done_before + 1; i <= done && i < pushed_; ++i)
+      // Move i starts when move i - 1 is complete: the daemon counts moves the same way.
+      const std::uint64_t moves_done = s.moves_done - moves_base_;
+      for (std::uint64_t i = moves_before + 1; i <= moves_done && i < result_.move_start_s.size();
+           ++i)
         result_.move_start_s[i] = begin_s;
       const double t = static_cast<double>(cycle) * result_.period_s;
       if (options_.on_sample) options_.on_sample(t, s.commanded);
@@ -139,6 +143,8 @@ class Simulation {
       return false;
     }
     base_ = status.segments_done;
+    moves_base_ = status.moves_done;
+    programmed_end_ = status.commanded;
     planner_.reset(status.commanded);
     previous_ = status.commanded;
     return true;
@@ -157,6 +163,7 @@ class Simulation {
           feeder_.pending.pop_front();
           continue;
         }
+        bound(move);
         std::string error;
         const double cpu_start = thread_cpu_s();
         const bool planned = planner_.push(move, true, error);
@@ -203,20 +210,32 @@ class Simulation {
 
   void account(const motion::Segment& segment) {
     ++pushed_;
-    result_.moves += segment.moves;  // a blend arc is part of the moves it joins
-    result_.move_line.push_back(segment.line);
-    result_.move_start_s.push_back(pushed_ == 1 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
-    if (segment.kind == motion::Segment::Kind::dwell) {
-      result_.feed_bound_s += segment.dwell_s;
-      result_.exact_stop_bound_s += segment.dwell_s;
-    } else {
-      const MoveLimits limits = move_limits(machine_, segment);
-      if (segment.length > 0 && limits.velocity < 1e300)
-        result_.feed_bound_s += segment.length / limits.velocity;
-      result_.exact_stop_bound_s +=
-          rest_to_rest_s(segment.length, limits.velocity, limits.acceleration);
+    // A blend arc is part of the moves it joins; a segment may also complete several moves.
+    for (std::uint32_t k = 0; k < segment.moves; ++k) {
+      result_.move_line.push_back(segment.line);
+      result_.move_start_s.push_back(result_.moves == 0 ? 0.0
+                                                        : std::numeric_limits<double>::quiet_NaN());
+      ++result_.moves;
     }
     if (options_.measure) window_.push_back(segment);
+  }
+
+  // Adds the programmed move (not the planner's segments, which blends shorten) to the bounds.
+  void bound(const motion::Move& move) {
+    std::string error;
+    const auto segment = planner_.plan(move, programmed_end_, false, error);
+    if (!segment) return;  // push() reports it
+    programmed_end_ = segment->end;
+    if (segment->kind == motion::Segment::Kind::dwell) {
+      result_.feed_bound_s += segment->dwell_s;
+      result_.exact_stop_bound_s += segment->dwell_s;
+    } else {
+      const MoveLimits limits = move_limits(machine_, *segment);
+      if (segment->length > 0 && limits.velocity < 1e300)
+        result_.feed_bound_s += segment->length / limits.velocity;
+      result_.exact_stop_bound_s +=
+          rest_to_rest_s(segment->length, limits.velocity, limits.acceleration);
+    }
   }
 
   // Sets `stopped` and returns true when a budget is used up or the caller cancelled.
@@ -278,9 +297,11 @@ class Simulation {
   drivers::SimDriver sim_;
   std::unique_ptr<motion::ServoLoop> loop_;
   const Clock::time_point wall_start_ = Clock::now();
-  std::uint64_t cycle_ = 0;   // servo periods since the program started
-  std::uint64_t base_ = 0;    // segments done before the program
-  std::uint64_t pushed_ = 0;  // segments queued by the program
+  std::uint64_t cycle_ = 0;            // servo periods since the program started
+  std::uint64_t base_ = 0;             // segments done before the program
+  std::uint64_t moves_base_ = 0;       // moves done before the program
+  motion::AxisPose programmed_end_{};  // where the last programmed move ends
+  std::uint64_t pushed_ = 0;           // segments queued by the program
   bool interp_done_ = false;
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};

@@ -51,8 +51,9 @@ struct PlanSimResult {
   double period_s = 0;
   std::uint64_t cycles = 0;  // servo periods from the program's start until motion ended
   double cycle_time_s = 0;   // cycles * period
-  // Sum over the moves of length / programmed feed (capped by the axis limits along the move),
-  // traverses at the fastest speed the axes allow along them, dwells included.
+  // Sum over the programmed moves of length / feed (capped by the axis limits along the move),
+  // traverses at the fastest speed the axes allow along them, dwells included. Blends that
+  // cut corners short may come in a little under it.
   double feed_bound_s = 0;
   // Every move a rest-to-rest trapezoid at that speed within the axes' accelerations, dwells
   // included: what a planner stopping after every move needs at least.
@@ -66,7 +67,8 @@ struct PlanSimResult {
   // way (units), and the program line where it happened.
   double max_deviation = 0;
   int max_deviation_line = 0;
-  // For each planned move in order: its source line and when it starts (s, virtual time).
+  // For each programmed move in order (as Status::moves_done counts them): its source line
+  // and when it starts (s, virtual time), which is when the move before it is complete.
   std::vector<std::int32_t> move_line;
   std::vector<double> move_start_s;
   double planner_cpu_s = 0;  // thread CPU time spent in Planner::push

@@ -9,7 +9,8 @@ namespace {
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-// About 4.8 s on sim_mm: rapids, a plunge, lines and arcs at 100 mm/s, a dwell, two G81 holes.
+// About 5 s on sim_mm: rapids, a plunge, lines and arcs at 100 mm/s, blended corners, a dwell,
+// two G81 holes.
 constexpr const char* kPart =
     "G21 G90 G64\n"
     "G0 X10 Y10 Z5\n"
@@ -18,6 +19,7 @@ constexpr const char* kPart =
     "G2 X60 Y40 I0 J15\n"
     "G1 X10\n"
     "G3 X10 Y10 I0 J-15\n"
+    "G64 P0.05 G1 X20 Y20\nX30 Y10\nX40 Y20\nX50 Y10\n"
     "G4 P0.3\n"
     "G99 G81 X100 Y50 Z-5 R2 F1200\n"
     "X110\n"

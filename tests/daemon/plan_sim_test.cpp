@@ -90,6 +90,23 @@ TEST_F(PlanSimTest, ArcsAndDwellsAreFollowedAndEachMoveGetsItsStartTime) {
   EXPECT_NEAR(times.front(), r.period_s, 1e-12);
 }
 
+TEST_F(PlanSimTest, BlendedCornersKeepTheProgrammedBoundsAndOneStartTimePerMove) {
+  // A 20 mm square at 20 mm/s under G64 P0.1: the bounds are the programmed path's.
+  const auto r = simulate("G21 G90 G64 P0.1\nG1 X20 F1200\nY20\nX0\nY0\nM2\n");
+  ASSERT_TRUE(r.complete());
+  EXPECT_EQ(r.moves, 4u);
+  EXPECT_NEAR(r.feed_bound_s, 4.0, 1e-9);
+  EXPECT_NEAR(r.exact_stop_bound_s, 4.0 + 4 * 0.01, 1e-9);
+  // Blend arcs cut the corners a little short of the programmed 80 mm.
+  EXPECT_GE(r.cycle_time_s, r.feed_bound_s * 0.99);
+  EXPECT_LT(r.cycle_time_s, r.exact_stop_bound_s + 2 * r.period_s);
+  EXPECT_LE(r.max_deviation, 0.1 + 1e-6);
+  ASSERT_EQ(r.move_start_s.size(), 4u);
+  EXPECT_EQ(r.move_line, (std::vector<std::int32_t>{2, 3, 4, 5}));
+  for (std::size_t i = 1; i < r.move_start_s.size(); ++i)
+    EXPECT_GT(r.move_start_s[i], r.move_start_s[i - 1]) << i;
+}
+
 TEST_F(PlanSimTest, StartsWhereTheMachineStands) {
   options_.start_machine = interp::Pose{50, 60, 0};
   const auto r = simulate("G21 G91\nG1 X10 F600\nM2\n");
