@@ -333,6 +333,9 @@ void Server::push_events() {
 }
 
 void Server::poll_once(int timeout_ms, int extra_fd) {
+  // Answers posted since the last call (program.abort at rest, mdi.execute done) go out now,
+  // not after the wait.
+  deliver_completions();
   const int update_in = next_update_in_ms(Clock::now());
   if (update_in >= 0 && update_in < timeout_ms) timeout_ms = update_in;
   std::vector<pollfd> fds;
