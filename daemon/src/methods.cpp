@@ -48,10 +48,12 @@ std::uint32_t joint_mask(const json& params, int joint_count) {
   if (!joints->is_array()) throw RpcError(kInvalidParams, "\"joints\" must be an array of numbers");
   std::uint32_t mask = 0;
   for (const auto& j : *joints) {
-    if (!j.is_number_integer() || j.get<int>() < 0 || j.get<int>() >= joint_count) {
+    // As a 64-bit number: 4294967296 must not wrap to joint 0.
+    if (!j.is_number_integer() || j.get<std::int64_t>() < 0 ||
+        j.get<std::int64_t>() >= joint_count) {
       throw RpcError(kInvalidParams, "\"joints\" holds an unknown joint: " + j.dump());
     }
-    mask |= 1u << j.get<int>();
+    mask |= 1u << j.get<std::int64_t>();
   }
   return mask;
 }

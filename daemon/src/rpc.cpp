@@ -1,6 +1,7 @@
 #include "rpc.hpp"
 
 #include <exception>
+#include <string>
 
 namespace cncd::daemon {
 
@@ -20,6 +21,32 @@ json RpcDispatcher::error_object(int code, const std::string& message) {
 }
 
 namespace {
+// Deeper nesting is refused before parsing: copying or printing such a value recurses once per
+// level, and a 1 MiB line of brackets would exhaust the stack.
+constexpr int kMaxNesting = 64;
+
+bool nested_too_deep(const std::string& line) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) return true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return false;
+}
+
 json error_response(const json& id, int code, const std::string& message) {
   return json{
       {"jsonrpc", "2.0"}, {"id", id}, {"error", RpcDispatcher::error_object(code, message)}};
@@ -81,6 +108,11 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
 
 std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
                                                       Session& session) const {
+  if (nested_too_deep(line)) {
+    return error_response(nullptr, kInvalidRequest,
+                          "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
+        .dump();
+  }
   json request = json::parse(line, nullptr, /*allow_exceptions=*/false);
   if (request.is_discarded()) {
     return error_response(nullptr, kParseError, "parse error: not valid JSON").dump();

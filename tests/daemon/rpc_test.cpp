@@ -49,6 +49,19 @@ TEST_F(RpcTest, ScalarParamsAreInvalid) {
   EXPECT_EQ(r["error"]["code"], kInvalidParams);
 }
 
+TEST_F(RpcTest, DeepNestingIsRefusedBeforeParsing) {
+  const std::string deep = std::string(100'000, '[') + std::string(100'000, ']');
+  json r = call(R"({"jsonrpc":"2.0","id":)" + deep + R"(,"method":"echo"})");
+  EXPECT_EQ(r["error"]["code"], kInvalidRequest);
+  EXPECT_EQ(r["error"]["message"], "request nested deeper than 64 levels");
+  // Brackets inside strings do not count; 64 levels are fine.
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"s":")" + deep + R"(\""}})");
+  EXPECT_TRUE(r.contains("result")) << r.dump().substr(0, 200);
+  const std::string levels_64 = std::string(63, '[') + std::string(63, ']');
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":)" + levels_64 + "}");
+  EXPECT_TRUE(r.contains("result")) << r.dump().substr(0, 200);
+}
+
 TEST_F(RpcTest, HandlerErrorKeepsItsCode) {
   const json r = call(R"({"jsonrpc":"2.0","id":7,"method":"refuse"})");
   EXPECT_EQ(r["error"]["code"], kWrongState);
