@@ -123,6 +123,26 @@ TEST_F(EstimateTest, WithoutAnEstimateRemainingIsNullWithTheReason) {
   result_of(call("program.abort"));
 }
 
+TEST_F(EstimateTest, OpeningAgainOrStoppingCancelsTheEstimateUnderWay) {
+  ready_machine();
+  // 40,000 short moves: long enough to be still estimating when the next open comes.
+  std::string text = "G21 G90 F3000\n";
+  for (int i = 0; i < 20000; ++i)
+    text += "G1 X" + std::to_string(10 + i % 2) + " Y" + std::to_string(i % 100) + "\nX0\n";
+  text += "M2\n";
+  const auto big = dir_.write("big.ngc", text);
+  result_of(call("program.open", {{"path", big.string()}}));
+  EXPECT_EQ(status()["program"]["remaining_reason"], "estimating");
+  const auto small = dir_.write("small.ngc", "G21 G90\nG1 X20 F1200\nM2\n");
+  const json s = open_and_estimate(small);
+  ASSERT_TRUE(s["program"]["estimated_s"].is_number()) << s.dump();
+  EXPECT_NEAR(s["program"]["estimated_s"].get<double>(), 1.01, 0.01);
+  result_of(call("program.open", {{"path", big.string()}}));
+  const auto start = Clock::now();
+  EXPECT_EQ(daemon_.stop(), 0) << daemon_.log();
+  EXPECT_LT(seconds_since(start), 5.0);
+}
+
 TEST_F(EstimateTest, CncctlRunShowsTheRemainingTime) {
   ready_machine();
   const auto program = dir_.write("two.ngc", "G21 G90\nG1 X20 F1200\nG1 X0\nM2\n");
