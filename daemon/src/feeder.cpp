@@ -62,6 +62,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
                        : motion::Move::PathMode::blend;
       tolerance_ = std::max(0.0, m.value * tracker_.length_factor());
       return;
+    case interp::CanonKind::set_naivecam_tolerance:
+      merge_tolerance_ = std::max(0.0, m.value * tracker_.length_factor());
+      return;
     case interp::CanonKind::program_stop:
     case interp::CanonKind::optional_program_stop:
     case interp::CanonKind::pallet_shuttle:
@@ -112,6 +115,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   }
   move.path_mode = path_mode_;
   move.tolerance = tolerance_;
+  move.merge_tolerance = path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
   pending.push_back(move);
 }
 

@@ -46,6 +46,7 @@ class ProgramFeeder final : public interp::CanonSink {
   // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).
   motion::Move::PathMode path_mode_ = motion::Move::PathMode::blend;
   double tolerance_ = 0;
+  double merge_tolerance_ = 0;  // G64 Q
 };
 
 }  // namespace cncd::daemon

@@ -35,6 +35,7 @@ bool euclidean(const Segment& s) {
 
 void Planner::reset(const AxisPose& start) {
   end_ = start;
+  merge_.reset();
   held_.reset();
   output_.clear();
 }
@@ -42,29 +43,99 @@ void Planner::reset(const AxisPose& start) {
 bool Planner::push(const Move& move, bool check_limits, std::string& error) {
   auto planned = plan(move, end_, check_limits, error);
   if (!planned) return false;
-  Segment seg = *planned;
-  end_ = seg.end;
+  const AxisPose start = end_;
+  end_ = planned->end;
+  if (merge_ && extends_merge(move, *planned)) {
+    merge_->points.push_back(merge_->move.end);
+    merge_->move.end = planned->end;
+    ++merge_->moves;
+    return true;
+  }
+  release_merge();
+  if (mergeable(move, *planned)) {
+    merge_ = Merge{move, start, {}, 1};
+    merge_->move.end = planned->end;
+    return true;
+  }
+  take(*planned, move);
+  return true;
+}
+
+bool Planner::mergeable(const Move& move, const Segment& seg) const {
+  return move.kind == Move::Kind::feed && move.path_mode == Move::PathMode::blend &&
+         move.merge_tolerance > 0 && seg.kind == Segment::Kind::line && seg.length > 0 &&
+         euclidean(seg);
+}
+
+bool Planner::extends_merge(const Move& move, const Segment& seg) const {
+  const Merge& m = *merge_;
+  if (!mergeable(move, seg) || move.feed != m.move.feed ||
+      move.merge_tolerance != m.move.merge_tolerance || move.tolerance != m.move.tolerance ||
+      m.points.size() >= kMaxMerged)
+    return false;
+  // Every point the merged line skips stays within Q of it, in order along it.
+  AxisPose d{};
+  double len_sq = 0;
+  for (int i = 0; i < kAxes; ++i) {
+    d[i] = seg.end[i] - m.start[i];
+    len_sq += d[i] * d[i];
+  }
+  if (len_sq <= 0) return false;
+  double last_t = 0;
+  auto close = [&](const AxisPose& p) {
+    double t = 0;
+    for (int i = 0; i < kAxes; ++i)
+      t += (p[i] - m.start[i]) * d[i];
+    t /= len_sq;
+    if (t < last_t || t > 1) return false;
+    last_t = t;
+    double off = 0;
+    for (int i = 0; i < kAxes; ++i) {
+      const double e = p[i] - m.start[i] - t * d[i];
+      off += e * e;
+    }
+    return off <= m.move.merge_tolerance * m.move.merge_tolerance;
+  };
+  for (const auto& p : m.points) {
+    if (!close(p)) return false;
+  }
+  return close(m.move.end);
+}
+
+void Planner::release_merge() {
+  if (!merge_) return;
+  const Merge m = *merge_;
+  merge_.reset();
+  std::string error;
+  // Its parts were checked one by one; the merged line lies within their hull.
+  auto seg = plan(m.move, m.start, false, error);
+  if (!seg) return;
+  seg->moves = m.moves;
+  take(*seg, m.move);
+}
+
+void Planner::take(Segment seg, const Move& move) {
   if (seg.kind != Segment::Kind::dwell && seg.length == 0) {
     // Nothing to move: the move is done with the one before it, which keeps its junction.
     if (held_) {
-      ++held_->segment.moves;
+      held_->segment.moves += seg.moves;
     } else {
       output_.push_back(seg);
     }
-    return true;
+    return;
   }
   const double full_length = seg.length;
   if (held_) join(seg, move);
   if (seg.kind == Segment::Kind::dwell || move.path_mode == Move::PathMode::exact_stop) {
     seg.continuous = false;
     output_.push_back(seg);
-    return true;
+    return;
   }
   held_ = Held{seg, move.path_mode, move.tolerance, full_length, move.kind == Move::Kind::traverse};
-  return true;
 }
 
 void Planner::flush() {
+  release_merge();
   if (!held_) return;
   held_->segment.continuous = false;
   output_.push_back(held_->segment);
@@ -178,10 +249,12 @@ void Planner::set_blend_limits(Segment& blend) const {
     linear = linear || i < 3;
   }
   if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
-  v = std::min(v, std::sqrt(kNormalShare * plane_a * blend.radius));
+  const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
+  double a = 0;
+  curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v, a);
   blend.axis_velocity = v;
   blend.max_velocity = blend.feed > 0 ? std::min(v, blend.feed) : v;
-  blend.max_acceleration = kTangentialShare * plane_a;
+  blend.max_acceleration = a;
 }
 
 }  // namespace cncd::motion

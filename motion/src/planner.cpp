@@ -80,6 +80,18 @@ AxisPose Segment::point_at(double s) const noexcept {
 
 Planner::Planner(const config::MachineConfig& config) : config_(config) {}
 
+void Planner::curve_limits(double fastest, double radius, double plane_a, double max_normal,
+                           double& v, double& a) {
+  // The tangential and centripetal parts are at right angles: shares t and n of the in-plane
+  // limit with t^2 + n^2 = 1 keep their sum, and so every axis of the plane, within it. The
+  // centripetal part gets what the fastest speed needs (the rest speeds up and slows down),
+  // at most `max_normal`; beyond, the curve limits the speed.
+  const double needed = fastest * fastest / (radius * plane_a);
+  const double normal = std::min(needed, max_normal);
+  if (needed >= max_normal) v = std::min(v, std::sqrt(max_normal * plane_a * radius));
+  a = std::sqrt(1.0 - normal * normal) * plane_a;
+}
+
 bool Planner::within_limits(const Segment& segment, std::string& error) const {
   // Lines are convex: their ends suffice. Arcs are sampled densely enough that a bulge past a
   // limit is found (the chord error of 256 steps is below 1e-4 of the radius).
@@ -234,15 +246,19 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
     v = std::min(v, config_.max_linear_velocity);
   if (centripetal_radius > 0) {
     // In the plane the acceleration is the tangential part (path acceleration x cos b, b the
-    // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it:
-    // 0.6 of the in-plane limit for one and 0.8 for the other keeps their vector sum, and so
-    // every in-plane axis, within the limit (0.6^2 + 0.8^2 = 1).
+    // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it.
     const double plane_a =
         std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
                  config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
     const double in_plane = direction[seg.first_axis];  // cos b
-    a = std::min(a, kTangentialShare * plane_a / in_plane);
-    v = std::min(v, std::sqrt(kNormalShare * plane_a * centripetal_radius) / in_plane);
+    const double fastest =
+        move.kind == Move::Kind::traverse ? v : std::min(v, move.feed * config_.max_feed_override);
+    double v_plane = v * in_plane;
+    double a_plane = 0;
+    curve_limits(fastest * in_plane, centripetal_radius, plane_a, kArcNormalShare, v_plane,
+                 a_plane);
+    a = std::min(a, a_plane / in_plane);
+    v = std::min(v, v_plane / in_plane);
   }
   set_directions(seg);
   seg.axis_velocity = v;

@@ -259,5 +259,52 @@ TEST(Blend, CornersAreRoundedWithinTheToleranceAndFaster) {
   EXPECT_LT(periods[0], 0.9 * periods[1]) << periods[0] << " vs " << periods[1];
 }
 
+// G64 Q: a line of 0.1 mm steps zigzagging by 0.004 mm runs as one line when Q allows it,
+// and as its steps (blended) when it does not; both end exactly at the end.
+TEST(Blend, CollinearLinesWithinQAreMerged) {
+  for (const double q : {0.01, 0.001}) {
+    VirtualMachine m(small_mill());
+    m.ready();
+    motion::Planner planner(m.config());
+    planner.reset(m.status().commanded);
+    std::vector<Move> moves;
+    for (int k = 1; k <= 200; ++k) {
+      Move move = line_to(Move::Kind::feed, 0.1 * k, k % 2 ? 0.004 : 0.0, 0, 100);
+      move.path_mode = Move::PathMode::blend;
+      move.tolerance = 0.01;
+      move.merge_tolerance = q;
+      moves.push_back(move);
+      std::string error;
+      ASSERT_TRUE(planner.push(move, true, error)) << error;
+    }
+    planner.flush();
+    std::uint32_t counted = 0;
+    for (const auto& seg : planner.output())
+      counted += seg.moves;
+    EXPECT_EQ(counted, 200u);
+    if (q > 0.004) {
+      EXPECT_EQ(planner.output().size(), 1u);
+    } else {
+      EXPECT_GT(planner.output().size(), 200u);
+    }
+    const AxisPose start = m.status().commanded;
+    for (const auto& move : moves)
+      m.queue(move);
+    m.run_until_idle();
+    const auto p = peaks(m, start);
+    EXPECT_LE(p.velocity, 1.001);
+    EXPECT_LE(p.acceleration, 1.001);
+    EXPECT_DOUBLE_EQ(m.status().commanded[0], 20);
+    EXPECT_EQ(m.status().moves_done, 200u);
+    // Within Q + P of the programmed steps.
+    for (const auto& point : m.trajectory()) {
+      double d = 1e9;
+      for (std::size_t k = 0; k < moves.size(); ++k)
+        d = std::min(d, distance_to_move(point, k == 0 ? start : moves[k - 1].end, moves[k]));
+      ASSERT_LE(d, q + 0.01 + 1e-9);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace cncd::test

@@ -12,6 +12,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/motion/segment.hpp"
@@ -40,17 +41,26 @@ class Planner {
   // interpreter has to give now).
   void flush();
   // Whether a move is held back.
-  bool holding() const { return held_.has_value(); }
+  bool holding() const { return held_.has_value() || merge_.has_value(); }
   // Where the last pushed move ends.
   const AxisPose& end() const { return end_; }
   // Final segments, oldest first, for the caller to take from the front.
   std::deque<Segment>& output() { return output_; }
 
  private:
-  // Shares of a curve's in-plane acceleration limit for the tangential and the centripetal
-  // part: at right angles, their sum stays within the limit (0.6^2 + 0.8^2 = 1).
-  static constexpr double kTangentialShare = 0.6;
-  static constexpr double kNormalShare = 0.8;
+  // Largest share of a curve's in-plane acceleration limit for the centripetal part, the rest
+  // (t = sqrt(1 - n^2)) being left for speeding up and slowing down. Programmed arcs are long
+  // enough to change speed on; a blend arc is short and mostly run at the speed its curvature
+  // allows.
+  static constexpr double kArcNormalShare = 0.8;
+  static constexpr double kBlendNormalShare = 0.95;
+  // A curve of `radius` in a plane whose acceleration limit is `plane_a`, never faster than
+  // `fastest` (in-plane speed, units/s): the centripetal part gets what `fastest` needs, at
+  // most `max_normal` of the limit, and the tangential part what is left, at right angles, so
+  // their sum and every axis of the plane stay within the limit. Lowers the in-plane speed
+  // limit `v` where the curvature needs it and sets the in-plane tangential limit `a`.
+  static void curve_limits(double fastest, double radius, double plane_a, double max_normal,
+                           double& v, double& a);
 
   bool within_limits(const Segment& segment, std::string& error) const;
   // Path speed and acceleration limits of a blend arc (blend_u, blend_v and radius set).
@@ -58,6 +68,14 @@ class Planner {
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
   // a blend arc (trimming both lines), or leaves a stop. Emits the held segment.
   void join(Segment& next, const Move& move);
+  // Takes a planned segment (of `move`) into the look-ahead: joins it to the held one and
+  // holds it, or emits it.
+  void take(Segment seg, const Move& move);
+  // G64 Q: whether `move` (planned as `seg`) may start or extend a run of merged lines.
+  bool mergeable(const Move& move, const Segment& seg) const;
+  bool extends_merge(const Move& move, const Segment& seg) const;
+  // Plans the merged run as one line and takes it.
+  void release_merge();
 
   struct Held {
     Segment segment;
@@ -67,8 +85,19 @@ class Planner {
     bool traverse = false;
   };
 
+  // Consecutive G1 lines of the same feed whose points all lie within Q of the line from the
+  // first start to the last end, merged into that line.
+  struct Merge {
+    Move move;  // the first move, with the last move's end
+    AxisPose start{};
+    std::vector<AxisPose> points;  // the ends skipped so far
+    std::uint32_t moves = 0;
+  };
+  static constexpr std::size_t kMaxMerged = 256;
+
   const config::MachineConfig& config_;
   AxisPose end_{};
+  std::optional<Merge> merge_;
   std::optional<Held> held_;
   std::deque<Segment> output_;
 };

@@ -36,8 +36,11 @@ struct Move {
   // uses at most half of each line).
   enum class PathMode : std::uint8_t { exact_stop, exact_path, blend };
   PathMode path_mode = PathMode::exact_stop;
-  double tolerance = 0;   // units
-  std::int32_t line = 0;  // source line of the program, 0 = none
+  double tolerance = 0;  // units
+  // G64 Q: consecutive feed lines of the same feed whose points all lie within this of one
+  // straight line are run as that line; 0 = no merging.
+  double merge_tolerance = 0;  // units
+  std::int32_t line = 0;       // source line of the program, 0 = none
 };
 
 }  // namespace cncd::motion
