@@ -24,6 +24,8 @@ namespace {
 // Deeper nesting is refused before parsing: copying or printing such a value recurses once per
 // level, and a 1 MiB line of brackets would exhaust the stack.
 constexpr int kMaxNesting = 64;
+// A longer batch would be answered in one piece, holding up every other client meanwhile.
+constexpr std::size_t kMaxBatch = 256;
 
 bool nested_too_deep(const std::string& line) {
   int depth = 0;
@@ -119,6 +121,11 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
   }
   if (request.is_array()) {
     if (request.empty()) return error_response(nullptr, kInvalidRequest, "empty batch").dump();
+    if (request.size() > kMaxBatch) {
+      return error_response(nullptr, kInvalidRequest,
+                            "a batch may hold at most " + std::to_string(kMaxBatch) + " requests")
+          .dump();
+    }
     json responses = json::array();
     session.in_batch = true;
     for (const auto& one : request) {

@@ -146,6 +146,7 @@ void Server::accept_clients() {
 }
 
 void Server::drop(Client& client) {
+  client.in.clear();
   client.out.clear();
   client.session.open_requests.clear();
   client.closing = true;
@@ -156,9 +157,16 @@ void Server::stop_reading(Client& client) {
   client.close_by = Clock::now() + kCloseGrace;
 }
 
+bool Server::has_pending_line(const Client& client) {
+  return client.in.find('\n') != std::string::npos;
+}
+
+// Reads until a complete line is in: serve_lines() serves lines a few at a time, and what the
+// client sends meanwhile stays in the socket.
 void Server::read_client(Client& client) {
   char buffer[65536];
-  for (;;) {
+  bool line_complete = has_pending_line(client);
+  while (!line_complete) {
     const ssize_t n = ::read(client.fd, buffer, sizeof buffer);
     if (n == 0) {
       // A peer that only shut down its sending side (as socat and nc -N do) still gets the
@@ -172,22 +180,8 @@ void Server::read_client(Client& client) {
       return;
     }
     client.in.append(buffer, static_cast<std::size_t>(n));
-    std::size_t start = 0;
-    for (;;) {
-      const std::size_t newline = client.in.find('\n', start);
-      if (newline == std::string::npos) break;
-      std::string line = client.in.substr(start, newline - start);
-      start = newline + 1;
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (line.find_first_not_of(" \t") == std::string::npos) continue;
-      requests_handled_ = true;
-      if (auto response = dispatcher_.handle_line(line, client.session)) {
-        client.out += *response;
-        client.out += '\n';
-      }
-    }
-    client.in.erase(0, start);
-    if (client.in.size() > kMaxLineBytes) {
+    line_complete = std::memchr(buffer, '\n', static_cast<std::size_t>(n)) != nullptr;
+    if (!line_complete && client.in.size() > kMaxLineBytes) {
       nlohmann::json error = {
           {"jsonrpc", "2.0"},
           {"id", nullptr},
@@ -198,6 +192,25 @@ void Server::read_client(Client& client) {
       return;
     }
   }
+}
+
+void Server::serve_lines(Client& client) {
+  std::size_t start = 0;
+  for (int served = 0; served < kRequestsPerTurn && client.out.size() <= kMaxBacklogBytes;
+       ++served) {
+    const std::size_t newline = client.in.find('\n', start);
+    if (newline == std::string::npos) break;
+    std::string line = client.in.substr(start, newline - start);
+    start = newline + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    requests_handled_ = true;
+    if (auto response = dispatcher_.handle_line(line, client.session)) {
+      client.out += *response;
+      client.out += '\n';
+    }
+  }
+  client.in.erase(0, start);
 }
 
 void Server::write_client(Client& client) {
@@ -343,29 +356,33 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   fds.push_back({listen_fd_, POLLIN, 0});
   fds.push_back({extra_fd, POLLIN, 0});
   for (const auto& client : clients_) {
-    short events = client.closing ? 0 : POLLIN;
+    // A client with requests still to serve is not read from meanwhile: back-pressure.
+    const bool pending = has_pending_line(client);
+    if (pending) timeout_ms = 0;
+    short events = client.closing || pending ? 0 : POLLIN;
     if (!client.out.empty()) events |= POLLOUT;
     // Left out while it waits for a deferred answer: a hung-up peer would wake poll at once.
     fds.push_back({events != 0 ? client.fd : -1, events, 0});
   }
   const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
-  if (ready > 0) {
-    const std::size_t known = clients_.size();
-    for (std::size_t i = 0; i < known; ++i) {
-      const short revents = fds[i + 2].revents;
-      Client& client = clients_[i];
-      if (!client.closing && (revents & (POLLIN | POLLHUP | POLLERR))) read_client(client);
-      if (!client.out.empty()) write_client(client);
-    }
-    if (fds[0].revents & POLLIN) accept_clients();
+  const std::size_t known = clients_.size();
+  for (std::size_t i = 0; i < known; ++i) {
+    const short revents = ready > 0 ? fds[i + 2].revents : 0;
+    Client& client = clients_[i];
+    if ((fds[i + 2].events & POLLIN) && (revents & (POLLIN | POLLHUP | POLLERR)))
+      read_client(client);
+    serve_lines(client);
+    if (!client.out.empty()) write_client(client);
   }
+  if (ready > 0 && (fds[0].revents & POLLIN)) accept_clients();
   deliver_completions();
   push_events();
   push_updates(Clock::now());
   requests_handled_ = false;
   const auto now = Clock::now();
   std::erase_if(clients_, [now](const Client& client) {
-    const bool done = client.out.empty() && client.session.open_requests.empty();
+    const bool done =
+        client.out.empty() && client.session.open_requests.empty() && !has_pending_line(client);
     if (client.closing && (done || (!client.out.empty() && now >= client.close_by))) {
       ::close(client.fd);
       return true;

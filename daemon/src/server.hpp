@@ -26,6 +26,9 @@ class Server {
   // Unsent output past which a client that does not read is disconnected.
   static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
   static constexpr int kMinSubscribeIntervalMs = 10;
+  // Requests (lines) served from one client per loop turn, so that a burst from one client
+  // does not hold up the others.
+  static constexpr int kRequestsPerTurn = 32;
   // How long a closing connection may take to read what is still owed to it.
   static constexpr std::chrono::seconds kCloseGrace{5};
 
@@ -70,7 +73,9 @@ class Server {
   // The peer is gone or misbehaves: nothing more is sent to it.
   static void drop(Client& client);
   static void stop_reading(Client& client);
+  static bool has_pending_line(const Client& client);
   void read_client(Client& client);
+  void serve_lines(Client& client);
   void write_client(Client& client);
   void push_updates(Clock::time_point now);
   void push_events();

@@ -155,5 +155,26 @@ TEST_F(MachineTest, AClientThatNeverReadsIsDisconnectedWithTheReason) {
   EXPECT_EQ(status()["state"], "estop");
 }
 
+TEST_F(MachineTest, ABurstFromOneClientDoesNotHoldUpAnother) {
+  // 1 MiB of requests in one go: served a few at a time, between other clients' requests.
+  std::string burst;
+  while (burst.size() < (1u << 20) - 100)
+    burst += request(1, "status.get");
+  RawSocket greedy(daemon_.socket());
+  ASSERT_TRUE(greedy.connected());
+  std::size_t sent = 0;
+  for (int tries = 0; tries < 100 && sent < burst.size(); ++tries) {
+    sent += greedy.send_some(burst.substr(sent));
+    if (sent < burst.size()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::chrono::steady_clock::duration slowest{};
+  for (int i = 0; i < 20; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(status()["state"], "estop");
+    slowest = std::max(slowest, std::chrono::steady_clock::now() - t0);
+  }
+  EXPECT_LT(slowest, std::chrono::milliseconds(1000));
+}
+
 }  // namespace
 }  // namespace cncd::test

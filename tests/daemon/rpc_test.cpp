@@ -62,6 +62,19 @@ TEST_F(RpcTest, DeepNestingIsRefusedBeforeParsing) {
   EXPECT_TRUE(r.contains("result")) << r.dump().substr(0, 200);
 }
 
+TEST_F(RpcTest, BatchOfMoreThan256IsRefused) {
+  const auto batch = [](int n) {
+    std::string out = "[";
+    for (int i = 0; i < n; ++i)
+      out += std::string(i > 0 ? "," : "") + R"({"jsonrpc":"2.0","id":1,"method":"echo"})";
+    return out + "]";
+  };
+  EXPECT_EQ(call(batch(256)).size(), 256u);
+  const json r = call(batch(257));
+  EXPECT_EQ(r["error"]["code"], kInvalidRequest);
+  EXPECT_EQ(r["error"]["message"], "a batch may hold at most 256 requests");
+}
+
 TEST_F(RpcTest, HandlerErrorKeepsItsCode) {
   const json r = call(R"({"jsonrpc":"2.0","id":7,"method":"refuse"})");
   EXPECT_EQ(r["error"]["code"], kWrongState);
