@@ -52,7 +52,9 @@ void usage(std::FILE* out) {
       "  offsets             list the coordinate systems G54..G59.3 and G92\n"
       "  offsets set G55 [X<origin> ...] [R<rotation>]\n"
       "                      set one coordinate system's origin (machine coordinates)\n"
-      "  errors              list recent errors and events\n"
+      "  errors [--since SEQ]\n"
+      "                      list recent errors and events (those after SEQ)\n"
+      "  info                cncd's version and the machine it runs\n"
       "\n"
       "--json prints cncd's answer (or the final status) as JSON.\n"
       "The socket defaults to $CNCD_SOCKET, else /run/cncd/cncd.sock.\n"
@@ -177,8 +179,9 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     return kDone;
   }
-  static const std::vector<std::string> kTakeArgs = {
-      "home", "run", "mdi", "open", "step", "watch", "tools", "offsets", "jog", "override"};
+  static const std::vector<std::string> kTakeArgs = {"home", "run",      "mdi",   "open",
+                                                     "step", "watch",    "tools", "offsets",
+                                                     "jog",  "override", "errors"};
   if (args.size() > 1 &&
       std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
@@ -210,7 +213,13 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     return kDone;
   }
   if (command == "errors") {
-    const json list = result_of(client.call("errors.list", json{{"since", 0}}));
+    if (args.size() != 1 && (args.size() != 3 || args[1] != "--since"))
+      throw UsageError{"errors takes only --since SEQ"};
+    const double since = args.size() == 3 ? number_arg(args[2], "--since") : 0.0;
+    if (since < 0 || since != static_cast<double>(static_cast<long long>(since)))
+      throw UsageError{"--since needs an event sequence number"};
+    const json list = result_of(
+        client.call("errors.list", json{{"since", static_cast<unsigned long long>(since)}}));
     if (json_output) {
       std::printf("%s\n", list.dump(2).c_str());
       return kDone;
@@ -279,6 +288,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "watch") return watch(client, args, json_output);
   if (command == "jog") return jog(client, args, json_output);
   if (command == "override") return override_command(client, args, json_output);
+  if (command == "info") return info(client, args, json_output);
   if (command == "tools") return tools(client, args, json_output);
   if (command == "offsets") return offsets(client, args, json_output);
   std::fprintf(stderr, "cncctl: unknown command '%s'\n", command.c_str());

@@ -114,6 +114,31 @@ TEST_F(CncctlTest, OverrideSetsPercentagesAndStatusShowsThem) {
   EXPECT_EQ(json::parse(cncctl({"--json", "status"}).out)["overrides"]["feed"], 0.5);
 }
 
+TEST_F(CncctlTest, InfoAndErrorsSince) {
+  auto r = cncctl({"info"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("machine   cncd sim mill (mm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("axes      X Y Z (mm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("joints    3: sim sim sim"), std::string::npos) << r.out;
+  r = cncctl({"--json", "info"});
+  EXPECT_EQ(json::parse(r.out)["protocol_version"], 1);
+  EXPECT_EQ(cncctl({"info", "extra"}).exit_status, 64);
+  // Two events, then only those after the first.
+  ASSERT_EQ(cncctl({"tools", "set", "T2", "Z1"}).exit_status, 0);
+  ASSERT_EQ(cncctl({"tools", "set", "T3", "Z2"}).exit_status, 0);
+  const json all = json::parse(cncctl({"--json", "errors"}).out);
+  ASSERT_GE(all["events"].size(), 2u);
+  const auto first = all["events"][all["events"].size() - 2]["seq"].get<unsigned long long>();
+  r = cncctl({"--json", "errors", "--since", std::to_string(first)});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  const json later = json::parse(r.out);
+  ASSERT_EQ(later["events"].size(), 1u) << r.out;
+  EXPECT_EQ(later["events"][0]["message"], "tool 3 changed");
+  EXPECT_EQ(cncctl({"errors", "--since", "x"}).exit_status, 64);
+  EXPECT_EQ(cncctl({"errors", "--since", "-1"}).exit_status, 64);
+  EXPECT_EQ(cncctl({"errors", "all"}).exit_status, 64);
+}
+
 TEST_F(CncctlTest, ExitCodesTellDoneRefusedFailedAndUnreachable) {
   auto r = cncctl({"--json", "estop"});
   EXPECT_EQ(r.exit_status, 0);
