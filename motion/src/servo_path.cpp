@@ -104,12 +104,13 @@ void ServoLoop::fill_window() noexcept {
     const std::uint64_t first_new = head_seq_ + static_cast<std::uint64_t>(window_count_);
     // Twice the stopping distance from the fastest speed seen, so that the first segment's
     // exit speed is not held down by the window's end.
-    while (pass_budget_ > 0 && window_count_ < kWindow &&
+    while (pass_budget_ > 0 && pulls_left_ > 0 && window_count_ < kWindow &&
            (window_length_ < 2.0 * stop_length_ || window_count_ < 2)) {
       const std::uint64_t seq = head_seq_ + static_cast<std::uint64_t>(window_count_);
       Segment& seg = window_at(seq);
       if (!segments_.pop(seg)) break;
       --pass_budget_;
+      --pulls_left_;
       exit_hard_[static_cast<std::size_t>(seq % kWindow)] = 0;
       exit_soft_[static_cast<std::size_t>(seq % kWindow)] = 0;
       ++window_count_;
@@ -148,6 +149,7 @@ bool ServoLoop::advance_path(double dt) noexcept {
   bool resting = !has_active_;
   bool moved = has_active_;
   pass_budget_ = kPassBudget;
+  pulls_left_ = kMaxPulls;
   fill_window();
   // A period may finish one move and go on with the next: the profile's leftover time is
   // spent on the following segments, at the speed the junction allows, so short moves are not

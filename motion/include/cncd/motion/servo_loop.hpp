@@ -143,6 +143,7 @@ class ServoLoop {
   // rest. Both are kept by an incremental backward pass.
   static constexpr int kWindow = 2048;
   static constexpr int kPassBudget = 4096;  // pass steps and ring pops per period
+  static constexpr int kMaxPulls = 256;     // ring pops per period (each copies a segment)
   bool has_active_ = false;
   std::array<Segment, kWindow> window_{};
   std::array<double, kWindow> exit_hard_{};
@@ -155,6 +156,7 @@ class ServoLoop {
   std::uint64_t pass_seq_ = 0;    // next segment whose exit speeds the pass recomputes
   std::uint64_t pass_floor_ = 0;  // the pass goes at least this far back
   int pass_budget_ = 0;
+  int pulls_left_ = 0;
   double path_s_ = 0;
   double path_v_ = 0;
   double dwell_elapsed_s_ = 0;
