@@ -34,6 +34,8 @@ void PlanEstimator::start(const std::filesystem::path& program,
       estimate.estimated_s = result.cycle_time_s;
       estimate.move_start_s =
           std::make_shared<const std::vector<double>>(std::move(result.move_start_s));
+      estimate.move_line =
+          std::make_shared<const std::vector<std::int32_t>>(std::move(result.move_line));
     } else {
       estimate.state = PlanEstimate::State::failed;
       estimate.reason = result.error ? result.error->to_string() : result.stopped->to_string();

@@ -24,6 +24,7 @@ struct PlanEstimate {
   double estimated_s = 0;  // the whole program, when done
   // When each move of a run from the top starts (s), in queue order, when done.
   std::shared_ptr<const std::vector<double>> move_start_s;
+  std::shared_ptr<const std::vector<std::int32_t>> move_line;  // each move's source line
   std::string reason;  // why there is no estimate (running, failed)
 };
 

@@ -172,6 +172,9 @@ class Simulation {
           result_.error = CheckProblem{program_, move.line, error};
           return false;
         }
+        // Every pushed move is counted once in Status::moves_done, whichever segment (a
+        // blend arc, a merged line) completes it: its line is its own, not that segment's.
+        result_.move_line.push_back(move.line);
         feeder_.pending.pop_front();
       }
       if (interp_done_) planner_.flush();
@@ -212,7 +215,6 @@ class Simulation {
     ++pushed_;
     // A blend arc is part of the moves it joins; a segment may also complete several moves.
     for (std::uint32_t k = 0; k < segment.moves; ++k) {
-      result_.move_line.push_back(segment.line);
       result_.move_start_s.push_back(result_.moves == 0 ? 0.0
                                                         : std::numeric_limits<double>::quiet_NaN());
       ++result_.moves;

@@ -197,6 +197,8 @@ void Task::run_program(int from_line, bool step) {
   start_run(Mode::automatic, status);
   skip_to_line_ = from_line > 1 ? from_line : 0;
   from_top_ = skip_to_line_ == 0;
+  run_from_line_ = skip_to_line_;
+  approach_done_s_.reset();
   skip_moved_ = false;
   stepping_ = step;
   step_budget_ = step ? 1 : 0;
@@ -361,6 +363,9 @@ void Task::poll() {
     finish_program("error", status.fault_reason);
     return;
   }
+  // Run from line: the remaining time counts from when the traverse to the line has ended.
+  if (skip_moved_ && !approach_done_s_ && status.moves_done > moves_done_base_)
+    approach_done_s_ = moving_s();
   if (exec_ == ExecState::paused) return;
   feed();
   if (exec_ != ExecState::running) return;

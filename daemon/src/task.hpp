@@ -110,6 +110,8 @@ class Task {
   void set_exec(ExecState next);
   // The program's remaining_s and estimated_s (null when unknown) and why (task_status.cpp).
   nlohmann::json time_estimate(std::uint64_t moves_done) const;
+  // Time the current run has spent moving: since it started, without its pauses.
+  double moving_s() const;
   void drain_servo_events();
   void save_parameters();
   void save_positions();
@@ -153,6 +155,9 @@ class Task {
   double elapsed_s_ = 0;
   PlanEstimator estimator_;  // the open program's running time, worked out in the background
   bool from_top_ = false;    // the run started at the program's first line
+  int run_from_line_ = 0;    // run from line: the line it started at
+  // Run from line with a traverse to the line's start: the moving time when it ended.
+  std::optional<double> approach_done_s_;
   std::chrono::steady_clock::time_point paused_since_{};
   double paused_s_ = 0;         // time the current run has spent paused, up to paused_since_
   bool files_corrupt_ = false;  // load_files() failed: keep them as they are for the user

@@ -137,17 +137,28 @@ json Task::time_estimate(std::uint64_t moves_done) const {
     out["remaining_s"] = last_result_ == "done" && exec_ == ExecState::idle ? 0.0 : total;
     return out;
   }
-  if (!from_top_) {
-    out["remaining_reason"] = "the estimate covers runs from the first line";
-    return out;
-  }
-  // Time spent moving: the run's time without its pauses, kept within the estimated window
-  // of the move under way so that a feed override or a hold cannot drift it away.
-  const auto moving_until =
-      exec_ == ExecState::paused ? paused_since_ : std::chrono::steady_clock::now();
-  const double active =
-      std::chrono::duration<double>(moving_until - started_at_).count() - paused_s_;
   const auto& starts = *estimate.move_start_s;
+  // Time spent moving, kept within the estimated window of the move under way so that a feed
+  // override or a hold cannot drift it away.
+  double active = moving_s();
+  if (!from_top_) {
+    // Run from line: the estimate from the line's first move on. The traverse to the line's
+    // start was not estimated: until it ends the whole rest of the program remains.
+    const auto& lines = *estimate.move_line;
+    const auto first = std::find_if(lines.begin(), lines.end(),
+                                    [&](std::int32_t line) { return line >= run_from_line_; });
+    if (first == lines.end() || starts.size() != lines.size()) {
+      out["remaining_s"] = 0.0;
+      return out;
+    }
+    const auto k0 = static_cast<std::uint64_t>(first - lines.begin());
+    if (skip_moved_ && !approach_done_s_) {
+      out["remaining_s"] = total - starts[k0];
+      return out;
+    }
+    moves_done += k0 - (skip_moved_ ? 1 : 0);
+    active += starts[k0] - approach_done_s_.value_or(0.0);
+  }
   if (moves_done >= starts.size()) {
     out["remaining_s"] = 0.0;
     return out;
@@ -156,6 +167,11 @@ json Task::time_estimate(std::uint64_t moves_done) const {
   const double end = moves_done + 1 < starts.size() ? starts[moves_done + 1] : total;
   out["remaining_s"] = std::max(0.0, total - std::clamp(active, begin, std::max(begin, end)));
   return out;
+}
+
+double Task::moving_s() const {
+  const auto until = exec_ == ExecState::paused ? paused_since_ : std::chrono::steady_clock::now();
+  return std::chrono::duration<double>(until - started_at_).count() - paused_s_;
 }
 
 std::string Task::summary() const {

@@ -107,20 +107,31 @@ TEST_F(EstimateTest, RemainingTimeStandsStillWhilePaused) {
 TEST_F(EstimateTest, WithoutAnEstimateRemainingIsNullWithTheReason) {
   ready_machine();
   // The interpreter stops at line 3: no estimate, and the reason names the line.
-  json s = open_and_estimate(dir_.write("bad.ngc", "G21 G90\nG0 X5\nG1 X10\nM2\n"));
+  const json s = open_and_estimate(dir_.write("bad.ngc", "G21 G90\nG0 X5\nG1 X10\nM2\n"));
   EXPECT_TRUE(s["program"]["estimated_s"].is_null()) << s.dump();
   EXPECT_TRUE(s["program"]["remaining_s"].is_null());
   EXPECT_NE(s["program"]["remaining_reason"].get<std::string>().find("bad.ngc:3:"),
             std::string::npos)
       << s.dump();
-  // A run from a line is not what the estimate covers.
-  s = open_and_estimate(dir_.write("two.ngc", "G21 G90\nG1 X20 F600\nG1 X0\nM2\n"));
-  ASSERT_TRUE(s["program"]["estimated_s"].is_number());
-  result_of(call("program.run", {{"from_line", 3}}));
-  s = status();
-  EXPECT_TRUE(s["program"]["remaining_s"].is_null()) << s.dump();
-  EXPECT_NE(s["program"]["remaining_reason"], "");
-  result_of(call("program.abort"));
+}
+
+TEST_F(EstimateTest, ARunFromALineCountsDownFromThatLine) {
+  ready_machine();
+  const json opened = open_and_estimate(
+      dir_.write("three.ngc", "G21 G90\nG1 X20 F1200\nG1 X0\nG0 Y5\nG1 X20 Y0 F1200\nM2\n"));
+  const double estimated = opened["program"]["estimated_s"].get<double>();
+  // From line 5: a traverse to where it starts (X0 Y5), then about 1 s of feed.
+  result_of(call("program.run", {{"from_line", 5}}));
+  const json early = status();
+  ASSERT_TRUE(early["program"]["remaining_s"].is_number()) << early.dump();
+  EXPECT_LT(early["program"]["remaining_s"].get<double>(), estimated - 1.5);
+  EXPECT_GT(early["program"]["remaining_s"].get<double>(), 0.9);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const json midway = status();
+  EXPECT_NEAR(midway["program"]["remaining_s"].get<double>(), 0.5, 0.15) << midway.dump();
+  const json done = poll_until_idle();
+  EXPECT_EQ(done["program"]["result"], "done");
+  EXPECT_EQ(done["program"]["remaining_s"], 0.0);
 }
 
 TEST_F(EstimateTest, OpeningAgainOrStoppingCancelsTheEstimateUnderWay) {
