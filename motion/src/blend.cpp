@@ -125,13 +125,16 @@ void Planner::take(Segment seg, const Move& move) {
     return;
   }
   const double full_length = seg.length;
+  next_reserved_ = false;
   if (held_) join(seg, move);
   if (seg.kind == Segment::Kind::dwell || move.path_mode == Move::PathMode::exact_stop) {
     seg.continuous = false;
     output_.push_back(seg);
     return;
   }
-  held_ = Held{seg, move.path_mode, move.tolerance, full_length, move.kind == Move::Kind::traverse};
+  held_ = Held{
+      seg,           move.path_mode, move.tolerance, full_length, move.kind == Move::Kind::traverse,
+      next_reserved_};
 }
 
 void Planner::flush() {
@@ -165,6 +168,7 @@ void Planner::join(Segment& next, const Move& move) {
   }
   if (mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
       next.kind != Segment::Kind::line || !euclidean(prev) || !euclidean(next)) {
+    if (mode == Move::PathMode::blend) kink(prev, held.reserved, next);
     output_.push_back(prev);
     return;
   }
@@ -232,6 +236,35 @@ void Planner::join(Segment& next, const Move& move) {
     blend.moves += prev.moves;  // the blend took all that was left of it
   }
   output_.push_back(blend);
+}
+
+void Planner::kink(Segment& prev, bool prev_reserved, Segment& next) {
+  // The direction jumps at the junction: crossing it at speed v changes each axis's speed by
+  // v |d2_i - d1_i| at once, which the servo period spreads over one period. Both segments
+  // give up kKinkReserve of their acceleration (and the matching part of a curve's speed
+  // limit) for it; each kink may use half of that, so two kinks close together still fit.
+  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
+  double v = 1e300;
+  for (int i = 0; i < kAxes; ++i) {
+    const double jump = std::abs(next.start_direction[i] - prev.end_direction[i]);
+    if (jump <= 1e-15) continue;
+    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
+    v = std::min(v, 0.5 * kKinkReserve * axis.max_acceleration * dt / jump);
+  }
+  // Kinks at least a period apart: at most two fall in any estimate of the acceleration.
+  v = std::min({v, prev.length / dt, next.length / dt});
+  // A kink that must be crossed this slowly is a corner: it stops.
+  if (!(v > 0.01 * std::min(prev.max_velocity, next.max_velocity))) return;
+  auto reserve = [](Segment& seg) {
+    seg.max_acceleration *= 1.0 - kKinkReserve;
+    if (seg.kind == Segment::Kind::arc) seg.axis_velocity *= std::sqrt(1.0 - kKinkReserve);
+    seg.max_velocity = std::min(seg.max_velocity, seg.axis_velocity);
+  };
+  if (!prev_reserved) reserve(prev);
+  reserve(next);
+  next_reserved_ = true;
+  prev.continuous = true;
+  prev.junction_velocity = v;
 }
 
 void Planner::set_blend_limits(Segment& blend) const {

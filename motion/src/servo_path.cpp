@@ -77,7 +77,7 @@ void ServoLoop::run_pass() noexcept {
     double soft = 0;
     if (seg.continuous && seg.kind != Segment::Kind::dwell && next.kind != Segment::Kind::dwell) {
       const double reach = 2.0 * next.max_acceleration * next.length;
-      const double limit = std::min(seg.axis_velocity, next.axis_velocity);
+      const double limit = std::min({seg.axis_velocity, next.axis_velocity, seg.junction_velocity});
       hard = std::min(limit, std::sqrt(exit_hard_[n] * exit_hard_[n] + reach));
       soft = std::min({limit, speed_limit(seg), speed_limit(next),
                        std::sqrt(exit_soft_[n] * exit_soft_[n] + reach)});

@@ -306,5 +306,59 @@ TEST(Blend, CollinearLinesWithinQAreMerged) {
   }
 }
 
+// Lines into arcs and arcs into arcs a little off tangent (as rounded coordinates leave them):
+// under G64 the kinks are crossed at speed within every limit; under G61 each stops.
+TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Move> chain;
+  double x = 0, y = 0, heading = 0;
+  for (int k = 0; k < 40; ++k) {
+    heading += (unit(rng) < 0.5 ? -1 : 1) * std::pow(10.0, -5 + 3.5 * unit(rng));  // the kink
+    Move move;
+    move.feed = 250;
+    move.tolerance = 0.01;
+    if (k % 2 == 0) {
+      const double length = 2 + 8 * unit(rng);
+      x += length * std::cos(heading);
+      y += length * std::sin(heading);
+      move.kind = Move::Kind::feed;
+    } else {
+      const double r = 5 + 10 * unit(rng);
+      const double sweep = 0.3 + unit(rng);
+      const double side = unit(rng) < 0.5 ? 1 : -1;
+      const double cx = x - side * r * std::sin(heading);
+      const double cy = y + side * r * std::cos(heading);
+      const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
+      x = cx + r * std::cos(a1);
+      y = cy + r * std::sin(a1);
+      heading += side * sweep;
+      move.kind = Move::Kind::arc;
+      move.center_first = cx;
+      move.center_second = cy;
+      move.turns = side > 0 ? 1 : -1;
+    }
+    move.end = {x, y, 0, 0, 0, 0, 0, 0, 0};
+    chain.push_back(move);
+  }
+  int periods[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    VirtualMachine m(small_mill());
+    m.ready();
+    const AxisPose start = m.status().commanded;
+    for (auto move : chain) {
+      move.path_mode = k == 0 ? Move::PathMode::blend : Move::PathMode::exact_path;
+      m.queue(move);
+    }
+    periods[k] = m.run_until_idle();
+    const auto p = peaks(m, start);
+    EXPECT_LE(p.velocity, 1.001);
+    EXPECT_LE(p.acceleration, 1.001);
+    EXPECT_DOUBLE_EQ(m.status().commanded[0], chain.back().end[0]);
+    EXPECT_DOUBLE_EQ(m.status().commanded[1], chain.back().end[1]);
+  }
+  EXPECT_LT(periods[0] * 1.3, periods[1]) << periods[0] << " vs " << periods[1];
+}
+
 }  // namespace
 }  // namespace cncd::test

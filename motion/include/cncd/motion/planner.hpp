@@ -68,6 +68,11 @@ class Planner {
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
   // a blend arc (trimming both lines), or leaves a stop. Emits the held segment.
   void join(Segment& next, const Move& move);
+  // G64 junctions off tangent where no blend arc fits (a line into an arc, arcs): crossed at
+  // the speed whose jump in direction the axes absorb within a servo period, with both
+  // segments' accelerations reduced to leave room for it.
+  void kink(Segment& prev, bool prev_reserved, Segment& next);
+  static constexpr double kKinkReserve = 0.1;
   // Takes a planned segment (of `move`) into the look-ahead: joins it to the held one and
   // holds it, or emits it.
   void take(Segment seg, const Move& move);
@@ -83,6 +88,7 @@ class Planner {
     double tolerance = 0;
     double full_length = 0;  // before any blend trimmed it
     bool traverse = false;
+    bool reserved = false;  // its acceleration is already reduced for a kink
   };
 
   // Consecutive G1 lines of the same feed whose points all lie within Q of the line from the
@@ -99,6 +105,7 @@ class Planner {
   AxisPose end_{};
   std::optional<Merge> merge_;
   std::optional<Held> held_;
+  bool next_reserved_ = false;  // join() reduced the next segment's limits for a kink
   std::deque<Segment> output_;
 };
 

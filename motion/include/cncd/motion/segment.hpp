@@ -40,6 +40,8 @@ struct Segment {
   // The planner found the next segment tangent to this one (a blend arc included): the servo
   // loop may cross this segment's end at speed. False: the path stops at the end.
   bool continuous = false;
+  // Highest speed at the end junction when continuous (a kink), units/s.
+  double junction_velocity = 1e300;
   // Programmed moves that are complete once this segment is (0 for a blend arc, more than 1
   // when the planner folded zero-length moves into it).
   std::uint32_t moves = 1;
