@@ -102,10 +102,11 @@ void ServoLoop::fill_window() noexcept {
       stop_length_ = 0;
     }
     const std::uint64_t first_new = head_seq_ + static_cast<std::uint64_t>(window_count_);
-    // Twice the stopping distance from the fastest speed seen, so that the first segment's
-    // exit speed is not held down by the window's end.
+    // Eight times the longest stopping distance of a segment taken so far (one segment's
+    // own acceleration can be well above those of the curves after it), so that the first
+    // segment's exit speed is not held down by the window's end.
     while (pass_budget_ > 0 && pulls_left_ > 0 && window_count_ < kWindow &&
-           (window_length_ < 2.0 * stop_length_ || window_count_ < 2)) {
+           (window_length_ < 8.0 * stop_length_ || window_count_ < 2)) {
       const std::uint64_t seq = head_seq_ + static_cast<std::uint64_t>(window_count_);
       Segment& seg = window_at(seq);
       if (!segments_.pop(seg)) break;
