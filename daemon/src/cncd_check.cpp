@@ -114,8 +114,12 @@ int check_plan(const cncd::config::MachineConfig& machine, const std::string& pr
     options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose) { csv->add(t, pose); };
   }
   const auto result = cncd::daemon::simulate_plan(machine, program, options);
-  std::cout << (json ? cncd::daemon::plan_json(machine, result) + "\n"
-                     : cncd::daemon::describe_plan(machine, result));
+  // A program that stopped before it moved has no figures worth a report (JSON always has one).
+  if (json) {
+    std::cout << cncd::daemon::plan_json(machine, result) << '\n';
+  } else if (result.complete() || result.cycles > 0) {
+    std::cout << cncd::daemon::describe_plan(machine, result);
+  }
   std::cout.flush();
   bool ok = result.complete();
   if (result.error) std::cerr << result.error->to_string() << '\n';

@@ -183,6 +183,7 @@ TEST_F(PlanSimTest, CncdCheckPlanRefusesBadUseAndReportsProgramErrors) {
   auto r = run_command({CNCD_CHECK_BINARY, "--plan", "--ini", ini_.string(), program.string()});
   EXPECT_EQ(r.exit_status, 1);
   EXPECT_NE(r.err.find(program.string() + ":2:"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");  // it stopped before anything moved
   const auto good = dir_.write("good.ngc", "G0 X1\nM2\n");
   r = run_command({CNCD_CHECK_BINARY, "--plan", "--trajectory", "/nonexistent/dir/t.csv", "--ini",
                    ini_.string(), good.string()});
