@@ -57,7 +57,8 @@ TEST_F(MachineTest, MachineOffEndsAProgramAndStopsTheMachine) {
   // Off is not estop: on again without a reset.
   result_of(call("machine.on"));
   EXPECT_EQ(status()["state"], "on");
-  for (const auto& homed : status()["homed"])
+  const json after = status();
+  for (const auto& homed : after["homed"])
     EXPECT_TRUE(homed.get<bool>());
 }
 
