@@ -18,6 +18,11 @@ std::uint32_t home_switch_joints(const std::vector<DriverBinding>& drivers) {
   return mask;
 }
 
+template <std::size_t N>
+void copy_name(char (&out)[N], const char* name) {
+  std::snprintf(out, N, "%s", name);
+}
+
 }  // namespace
 
 ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBinding> drivers)
@@ -34,7 +39,9 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
   }
   for (const auto& binding : drivers_) {
     for (int j : binding.joints) {
-      if (j >= 0 && j < kJoints) joint_driver_[static_cast<std::size_t>(j)] = binding.driver;
+      if (j < 0 || j >= kJoints) continue;
+      joint_driver_[static_cast<std::size_t>(j)] = binding.driver;
+      copy_name(status_.joints[static_cast<std::size_t>(j)].driver, binding.driver->name());
     }
   }
   status_.joint_count = joint_count_;
@@ -374,26 +381,6 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
   }
   write_drivers();
   publish();
-}
-
-void ServoLoop::publish() noexcept {
-  status_.sequence = status_.rt.cycles;
-  status_.commanded = axis_pose_;
-  status_.queued =
-      static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
-  status_.homed = joints_.homed;
-  std::array<bool, kAxes> seen{};
-  for (int j = 0; j < joint_count_; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    status_.joint_commanded[k] = joints_.command[k];
-    status_.joint_actual[k] = joints_.feedback[k];
-    const int axis = joint_axis_[k];
-    if (axis >= 0 && !seen[static_cast<std::size_t>(axis)]) {
-      seen[static_cast<std::size_t>(axis)] = true;
-      status_.actual[static_cast<std::size_t>(axis)] = joints_.feedback[k];
-    }
-  }
-  published_.store(status_);
 }
 
 }  // namespace cncd::motion

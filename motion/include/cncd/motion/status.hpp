@@ -22,6 +22,21 @@ struct RtStats {
   bool memory_locked = false;  // mlockall succeeded
 };
 
+// One joint's switches and drive as the servo thread saw them in the last period.
+struct JointStatus {
+  bool min_limit = false;  // limit switch inputs as read this period
+  bool max_limit = false;
+  bool home_switch = false;  // home switch input as read this period
+  bool enabled = false;      // the servo thread commands the drive enabled
+  bool drive_fault = false;  // the driver reports a drive fault this period
+  bool stale = false;        // the driver has no fresh feedback within its deadline
+  // Homed, and the commanded position stands at the joint's soft limit ([JOINT_n] MIN_LIMIT /
+  // MAX_LIMIT, within a micron or so).
+  bool at_min_soft_limit = false;
+  bool at_max_soft_limit = false;
+  char driver[12] = {};  // the driver's name ("sim", "gpio", "modbus"), "" when none
+};
+
 struct Status {
   std::uint64_t sequence = 0;  // servo cycle count at publication
   MachineState machine = MachineState::estop;
@@ -29,6 +44,7 @@ struct Status {
   int joint_count = 0;
   std::array<bool, kJoints> homed{};
   std::array<bool, kJoints> joint_fault{};
+  std::array<JointStatus, kJoints> joints{};
   AxisPose commanded{};  // machine units, machine coordinates
   AxisPose actual{};
   JointArray joint_commanded{};

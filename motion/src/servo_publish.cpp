@@ -1,0 +1,42 @@
+// ServoLoop::publish(): the servo thread's status snapshot, once per period (RT).
+#include "cncd/motion/servo_loop.hpp"
+
+namespace cncd::motion {
+namespace {
+// Commanded positions within this of a soft limit count as standing on it (joint units).
+constexpr double kAtSoftLimit = 1e-6;
+}  // namespace
+
+void ServoLoop::publish() noexcept {
+  status_.sequence = status_.rt.cycles;
+  status_.commanded = axis_pose_;
+  status_.queued =
+      static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
+  status_.homed = joints_.homed;
+  std::array<bool, kAxes> seen{};
+  for (int j = 0; j < joint_count_; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    status_.joint_commanded[k] = joints_.command[k];
+    status_.joint_actual[k] = joints_.feedback[k];
+    const int axis = joint_axis_[k];
+    if (axis >= 0 && !seen[static_cast<std::size_t>(axis)]) {
+      seen[static_cast<std::size_t>(axis)] = true;
+      status_.actual[static_cast<std::size_t>(axis)] = joints_.feedback[k];
+    }
+    const auto& fb = feedback_[k];
+    const auto& joint = config_.joints[k];
+    JointStatus& out = status_.joints[k];
+    out.min_limit = fb.min_limit;
+    out.max_limit = fb.max_limit;
+    out.home_switch = fb.home_switch;
+    out.enabled = commands_out_[k].enable;
+    out.drive_fault = fb.fault;
+    out.stale = fb.stale;
+    const bool homed = joints_.homed[k];
+    out.at_min_soft_limit = homed && joints_.command[k] <= joint.min_limit + kAtSoftLimit;
+    out.at_max_soft_limit = homed && joints_.command[k] >= joint.max_limit - kAtSoftLimit;
+  }
+  published_.store(status_);
+}
+
+}  // namespace cncd::motion
