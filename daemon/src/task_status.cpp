@@ -102,6 +102,27 @@ json active_g_codes(const interp::InterpState& st) {
   return out;
 }
 
+// Each joint's switches and drive, as the servo thread read them in its last period.
+json joints_array(const motion::Status& s) {
+  json out = json::array();
+  for (int j = 0; j < s.joint_count; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const motion::JointStatus& joint = s.joints[k];
+    out.push_back({{"homed", s.homed[k]},
+                   {"fault", s.joint_fault[k]},
+                   {"min_limit", joint.min_limit},
+                   {"max_limit", joint.max_limit},
+                   {"home_switch", joint.home_switch},
+                   {"at_min_soft_limit", joint.at_min_soft_limit},
+                   {"at_max_soft_limit", joint.at_max_soft_limit},
+                   {"driver", std::string(joint.driver)},
+                   {"enabled", joint.enabled},
+                   {"drive_fault", joint.drive_fault},
+                   {"stale", joint.stale}});
+  }
+  return out;
+}
+
 json active_m_codes(const interp::InterpState& st) {
   json out = json::array();
   for (std::size_t i = 1; i < st.mcodes.size(); ++i) {
@@ -223,6 +244,7 @@ json Task::status() const {
       {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
       {"homed", homed},
       {"joint_fault", joint_fault},
+      {"joints", joints_array(s)},
       {"fault", std::string(s.fault_reason)},
       {"position",
        {{"commanded", axes_object(config_, s.commanded)},
