@@ -1,6 +1,8 @@
 // cncctl: helpers and the readable status view shared by `status` and `watch`.
 #include <cstdio>
 #include <cstdlib>
+#include <string>
+#include <utility>
 
 #include "cncctl.hpp"
 
@@ -62,18 +64,45 @@ T get(const json& object, const char* key, T fallback) {
     return fallback;
   }
 }
+
+// One line per joint: driver, drive enable, homed, then the switches and flags that are set.
+void print_joints(const json& joints) {
+  static constexpr std::pair<const char*, const char*> kFlags[] = {
+      {"min_limit", "min-limit"},
+      {"max_limit", "max-limit"},
+      {"home_switch", "home-switch"},
+      {"at_min_soft_limit", "at-soft-min"},
+      {"at_max_soft_limit", "at-soft-max"},
+      {"drive_fault", "drive-fault"},
+      {"stale", "stale"},
+      {"fault", "fault"}};
+  int j = 0;
+  for (const auto& joint : joints) {
+    std::string flags;
+    for (const auto& [key, label] : kFlags) {
+      if (get<bool>(joint, key, false)) flags += (flags.empty() ? "" : " ") + std::string(label);
+    }
+    const std::string driver = get<std::string>(joint, "driver", "");
+    std::printf("joint %-3d %-7s %-4s %-8s %s\n", j++, driver.empty() ? "-" : driver.c_str(),
+                get<bool>(joint, "enabled", false) ? "on" : "off",
+                get<bool>(joint, "homed", false) ? "homed" : "unhomed",
+                flags.empty() ? "ok" : flags.c_str());
+  }
+}
 }  // namespace
 
 void print_status(const json& s) {
   std::printf("state     %s\n", get<std::string>(s, "state", "").c_str());
   std::printf("exec      %s (motion %s, mode %s)\n", get<std::string>(s, "exec", "").c_str(),
               get<std::string>(s, "motion", "").c_str(), get<std::string>(s, "mode", "").c_str());
-  std::string homed;
-  if (s.contains("homed")) {
+  if (s.contains("joints") && s["joints"].is_array()) {
+    print_joints(s["joints"]);
+  } else if (s.contains("homed")) {
+    std::string homed;
     for (const auto& h : s["homed"])
-      homed += h.get<bool>() ? "H " : "- ";
+      homed += h.is_boolean() && h.get<bool>() ? "H " : "- ";
+    std::printf("homed     %s\n", homed.c_str());
   }
-  std::printf("homed     %s\n", homed.c_str());
   const json position = s.value("position", json::object());
   const json work = s.value("work_position", json::object());
   std::printf("commanded %s  (%s)\n", axes_text(position.value("commanded", json())).c_str(),
