@@ -20,6 +20,7 @@
 #include "server.hpp"
 #include "task.hpp"
 #include "version.hpp"
+#include "watchdog_gate.hpp"
 
 namespace {
 
@@ -145,22 +146,16 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
                config.path.string(), serving, config.servo_period_ns);
   sd_notify(0, "READY=1\nSTATUS=ready");
 
-  // The watchdog is fed only while the servo loop's heartbeat advances, so systemd restarts a
-  // daemon whose servo thread has died or hangs.
+  // Fed only while the servo heartbeat advances (watchdog_gate.hpp).
   std::uint64_t watchdog_usec = 0;
   const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
-  auto last_watchdog = std::chrono::steady_clock::now();
-  std::uint64_t last_heartbeat = task.servo_heartbeat();
+  WatchdogGate watchdog_gate(std::chrono::microseconds(watchdog_usec / 2),
+                             std::chrono::steady_clock::now(), task.servo_heartbeat());
   std::string last_summary;
   for (;;) {
     server.poll_once(task.busy() ? 2 : 50, signal_fd);
     const auto now = std::chrono::steady_clock::now();
-    if (watchdog && now - last_watchdog >= std::chrono::microseconds(watchdog_usec / 2)) {
-      const std::uint64_t heartbeat = task.servo_heartbeat();
-      if (heartbeat != last_heartbeat) sd_notify(0, "WATCHDOG=1");
-      last_heartbeat = heartbeat;
-      last_watchdog = now;
-    }
+    if (watchdog && watchdog_gate.feed(now, task.servo_heartbeat())) sd_notify(0, "WATCHDOG=1");
     if (std::string summary = task.summary(); summary != last_summary) {
       sd_notifyf(0, "STATUS=%s", summary.c_str());
       last_summary = std::move(summary);
