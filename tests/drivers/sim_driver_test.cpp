@@ -2,7 +2,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
-#include <iterator>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -101,7 +101,9 @@ TEST(SimDriver, ABadLagNamesItsFileAndLine) {
   test::TempDir dir;
   ASSERT_TRUE(test::load_machine(dir, 2, "DRIVER = sim\nSIM_LAG = 0.5", "").config);
   std::ifstream in(dir.path() / "machine.ini");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::stringstream contents;
+  contents << in.rdbuf();
+  std::string text = contents.str();
   text.replace(text.find("SIM_LAG = 0.5"), 13, "SIM_LAG = slow");
   const auto loaded = config::load_machine_config(dir.write("lag.ini", text));
   ASSERT_TRUE(loaded.config);
