@@ -74,10 +74,11 @@ TEST_F(EstimateTest, ARunTakesTheEstimatedTimeWithinOnePercent) {
   const double measured = seconds_since(start);
   ASSERT_EQ(done["program"]["result"], "done") << done.dump();
   EXPECT_EQ(done["program"]["remaining_s"], 0.0);
-  // The daemon's own run time, and program.run to idle seen through the socket (polling every
-  // 5 ms, so up to that much, and a call's round trip, later).
+  // The daemon's own run time, and program.run to idle seen through the socket: polling every
+  // 5 ms and two calls' round trips, which on a busy shared machine (sanitizer builds running
+  // beside this test) take up to a few tens of milliseconds.
   EXPECT_NEAR(done["program"]["elapsed_s"].get<double>(), estimated, 0.01 * estimated);
-  EXPECT_NEAR(measured, estimated, 0.01 * estimated + 0.01) << "estimated " << estimated;
+  EXPECT_NEAR(measured, estimated, 0.01 * estimated + 0.05) << "estimated " << estimated;
   std::printf("estimated %.3f s, run %.3f s (daemon), %.3f s (program.run to idle)\n", estimated,
               done["program"]["elapsed_s"].get<double>(), measured);
 }
