@@ -82,6 +82,21 @@ json result(const json& response) {
   return response.value("result", json());
 }
 
+// Polls status.get every few milliseconds until `done(status)` or `seconds` pass (a test
+// failure that shows the last status and the daemon's log); returns the last status.
+template <typename Done>
+json wait_for(daemon::Client& client, const DaemonProcess& daemon, int seconds, Done done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  json s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    s = result(client.call("status.get"));
+    if (done(s)) return s;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
+  return s;
+}
+
 // Runs the example program on `ini` (already adapted) and returns the final status.
 json run_example(const TempDir& dir, const std::string& ini) {
   DaemonProcess daemon;
@@ -90,17 +105,7 @@ json run_example(const TempDir& dir, const std::string& ini) {
   if (!error.empty()) return json();
   daemon::Client client;
   EXPECT_EQ(client.connect(daemon.socket()), "");
-  const auto wait_until = [&](auto done) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    json s;
-    while (std::chrono::steady_clock::now() < deadline) {
-      s = result(client.call("status.get"));
-      if (done(s)) return s;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
-    return s;
-  };
+  const auto wait_until = [&](auto done) { return wait_for(client, daemon, 60, done); };
   result(client.call("machine.reset"));
   result(client.call("machine.on"));
   result(client.call("machine.home"));
@@ -201,17 +206,7 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
   daemon::Client client;
   ASSERT_EQ(client.connect(daemon.socket()), "");
-  const auto wait_until = [&](auto done) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    json s;
-    while (std::chrono::steady_clock::now() < deadline) {
-      s = result(client.call("status.get"));
-      if (done(s)) return s;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
-    return s;
-  };
+  const auto wait_until = [&](auto done) { return wait_for(client, daemon, 30, done); };
   const auto home = [&] {
     result(client.call("machine.home"));
     wait_until([](const json& s) {
@@ -282,17 +277,7 @@ TEST(DriversEndToEnd, ASimulatedMotorThatLagsTripsTheFollowingError) {
   result(client.call("machine.reset"));
   result(client.call("machine.on"));
   result(client.call("machine.home"));
-  const auto wait_until = [&](auto done) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    json s;
-    while (std::chrono::steady_clock::now() < deadline) {
-      s = result(client.call("status.get"));
-      if (done(s)) return s;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
-    return s;
-  };
+  const auto wait_until = [&](auto done) { return wait_for(client, daemon, 30, done); };
   wait_until([](const json& s) { return s["homed"][0] == true && s["motion"] == "idle"; });
   const auto program = dir.write("lag.ngc", "G21 G90 G1 F3000 X50\nM2\n");
   result(client.call("program.open", {{"path", program.string()}}));
