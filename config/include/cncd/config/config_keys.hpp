@@ -19,7 +19,8 @@ enum class KeyType {
 };
 
 struct KeySpec {
-  std::string_view section;  // "TRAJ"; "JOINT_n" / "AXIS_L" / "MODBUS_n" stand for every joint / axis / bus
+  std::string_view
+      section;  // "TRAJ"; "JOINT_n" / "AXIS_L" / "MODBUS_n" stand for every joint / axis / bus
   std::string_view key;
   KeyType type;
   std::string_view default_value;  // as it would be written in the INI; empty: see help
