@@ -44,7 +44,10 @@ constexpr std::array kKeys{
   KeySpec{"TRAJ", "MAX_LINEAR_ACCELERATION", real, "", 0, kInf, true, "units/s^2", "",
           "Limit of the path acceleration; unset: the highest linear axis acceleration"},
   KeySpec{"TRAJ", "MAX_LINEAR_JERK", real, "0", 0, kInf, false, "units/s^3", "",
-          "Limit of the path jerk; 0 = unlimited"},
+          "Limit of the path jerk (S-curve profiles); 0 = unlimited (trapezoidal profiles)"},
+  KeySpec{"TRAJ", "PLANNER_TYPE", integer, "", 0, 1, false, "", "",
+          "0 = trapezoidal profiles; 1 = S-curve (needs MAX_LINEAR_JERK >= 1); unset: S-curve "
+          "when MAX_LINEAR_JERK is set"},
   KeySpec{"TRAJ", "POSITION_FILE", path, "", 0, 0, false, "", "",
           "File that keeps joint positions across restarts; empty: start at zero"},
   KeySpec{"TRAJ", "NO_FORCE_HOMING", boolean, "0", 0, 0, false, "", "",

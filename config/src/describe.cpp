@@ -63,7 +63,8 @@ std::string describe(const MachineConfig& c) {
   line(out, "Trajectory:   max velocity " + num(c.max_linear_velocity) + " " + lu +
                 "/s, max acceleration " + num(c.max_linear_acceleration) + " " + lu +
                 "/s^2, default velocity " + num(c.default_linear_velocity) + " " + lu + "/s" +
-                (c.max_linear_jerk > 0 ? ", max jerk " + num(c.max_linear_jerk) : ""));
+                (c.scurve ? ", S-curve with max jerk " + num(c.max_linear_jerk) + " " + lu + "/s^3"
+                          : ", trapezoidal profiles"));
   line(out, "Homing:       " + std::string(c.no_force_homing ? "not required before programs"
                                                              : "required before programs"));
   line(out, "Feed override: up to " + num(c.max_feed_override * 100) + " %");

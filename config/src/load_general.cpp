@@ -32,6 +32,25 @@ void load_linear_units(TypedReader& r, MachineConfig& c) {
   c.linear_units = (*units == "mm" || *units == "metric") ? LinearUnits::mm : LinearUnits::inch;
 }
 
+// LinuxCNC's PLANNER_TYPE = 1 asks for S-curve profiles and needs MAX_LINEAR_JERK >= 1, else
+// it plans trapezoids and says so; unset, a MAX_LINEAR_JERK alone asks for them.
+void load_planner_type(TypedReader& r, MachineConfig& c) {
+  const auto type = r.integer("TRAJ", "PLANNER_TYPE");
+  if (!type) {
+    c.scurve = c.max_linear_jerk > 0;
+  } else if (*type == 0) {
+    if (c.max_linear_jerk > 0)
+      r.warning("TRAJ", "PLANNER_TYPE",
+                "PLANNER_TYPE = 0 plans trapezoidal profiles: MAX_LINEAR_JERK is not applied");
+  } else if (c.max_linear_jerk >= 1.0) {
+    c.scurve = true;
+  } else {
+    r.warning("TRAJ", "PLANNER_TYPE",
+              "PLANNER_TYPE = 1 (S-curve) needs MAX_LINEAR_JERK >= 1 (got " +
+                  format_number(c.max_linear_jerk) + "): planning trapezoidal profiles");
+  }
+}
+
 void load_angular_units(TypedReader& r, MachineConfig& c) {
   double factor = 0;
   if (const IniEntry* e = r.entry("TRAJ", "ANGULAR_UNITS");
@@ -144,6 +163,7 @@ void load_general(TypedReader& r, MachineConfig& c) {
   c.default_linear_acceleration = r.real("TRAJ", "DEFAULT_LINEAR_ACCELERATION").value_or(0);
   c.max_linear_acceleration = r.real("TRAJ", "MAX_LINEAR_ACCELERATION").value_or(0);
   c.max_linear_jerk = r.real("TRAJ", "MAX_LINEAR_JERK").value_or(0);
+  load_planner_type(r, c);
   c.position_file = r.path("TRAJ", "POSITION_FILE").value_or("");
   c.no_force_homing = r.boolean("TRAJ", "NO_FORCE_HOMING").value_or(false);
 

@@ -33,6 +33,7 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config) {
   joint_axis_.fill(-1);
+  if (config.scurve) jerk_ = config.max_linear_jerk;
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
         config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
@@ -116,6 +117,7 @@ void ServoLoop::flush_queue() noexcept {
   }
   path_s_ = 0;
   path_v_ = 0;
+  path_a_ = 0;
   pause_requested_ = false;
   abort_requested_ = false;
 }

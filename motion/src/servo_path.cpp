@@ -117,8 +117,10 @@ void ServoLoop::fill_window() noexcept {
       ++window_count_;
       window_length_ += seg.length;
       if (seg.max_acceleration > 0) {
-        stop_length_ = std::max(
-            stop_length_, seg.axis_velocity * seg.axis_velocity / (2.0 * seg.max_acceleration));
+        // Under a jerk limit the acceleration takes a / j to build up and to fall back.
+        const double v = seg.axis_velocity;
+        const double a = seg.max_acceleration;
+        stop_length_ = std::max(stop_length_, v * v / (2.0 * a) + (jerk_ > 0 ? v * a / jerk_ : 0));
       }
     }
     const std::uint64_t end = head_seq_ + static_cast<std::uint64_t>(window_count_);
@@ -182,6 +184,10 @@ bool ServoLoop::advance_path(double dt) noexcept {
         dt = done ? std::max(0.0, dt - left) : 0;
       }
       path_v_ = 0;
+      path_a_ = 0;
+    } else if (jerk_ > 0) {
+      scurve_step(dt);
+      break;
     } else {
       const std::size_t i = static_cast<std::size_t>(head_seq_ % kWindow);
       done = advance_profile(path_s_, path_v_, active.length, speed_limit(active),

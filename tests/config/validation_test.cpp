@@ -264,5 +264,41 @@ TEST_F(ValidationTest, AllProblemsAreCollected) {
   EXPECT_EQ(problems[5].substr(0, at(43).size()), at(43));
 }
 
+// [TRAJ] MAX_LINEAR_JERK asks for S-curve profiles; LinuxCNC's PLANNER_TYPE = 0 keeps
+// trapezoids and PLANNER_TYPE = 1 needs a jerk of at least 1, both with a warning otherwise.
+TEST_F(ValidationTest, JerkLimitAndPlannerType) {
+  auto load = [&](const std::string& lines) {
+    return load_machine_config(
+        write("m.ini", replace_line(minimal_ini(), 7, "LINEAR_UNITS = mm\n" + lines)));
+  };
+  auto plain = load("");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain.config->scurve);
+  auto jerk = load("MAX_LINEAR_JERK = 50000");
+  ASSERT_TRUE(jerk.ok());
+  EXPECT_TRUE(jerk.config->scurve);
+  EXPECT_EQ(jerk.config->max_linear_jerk, 50000);
+  EXPECT_TRUE(jerk.warnings.empty());
+  auto typed = load("PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 50000");
+  ASSERT_TRUE(typed.ok());
+  EXPECT_TRUE(typed.config->scurve);
+  auto off = load("PLANNER_TYPE = 0\nMAX_LINEAR_JERK = 50000");
+  ASSERT_TRUE(off.ok());
+  EXPECT_FALSE(off.config->scurve);
+  ASSERT_EQ(off.warnings.size(), 1u);
+  EXPECT_NE(strings(off.warnings)[0].find("MAX_LINEAR_JERK is not applied"), std::string::npos);
+  auto low = load("PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 0.5");
+  ASSERT_TRUE(low.ok());
+  EXPECT_FALSE(low.config->scurve);
+  ASSERT_EQ(low.warnings.size(), 1u);
+  EXPECT_EQ(strings(low.warnings)[0],
+            at(8) +
+                ": [TRAJ] PLANNER_TYPE: PLANNER_TYPE = 1 (S-curve) needs MAX_LINEAR_JERK >= 1 "
+                "(got 0.5): planning trapezoidal profiles");
+  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 7, "LINEAR_UNITS = mm\nPLANNER_TYPE = 2")),
+            std::vector<std::string>{at(8) + ": [TRAJ] PLANNER_TYPE: 2 is out of range: must be "
+                                             "between 0 and 1"});
+}
+
 }  // namespace
 }  // namespace cncd::config::test

@@ -120,6 +120,7 @@ Program random_program(std::mt19937& rng, int count) {
 struct Recorded {
   std::vector<AxisPose> points;
   std::vector<int> lines;
+  std::vector<double> speeds;  // the path speed the servo loop reports
 };
 
 // Queues the program and runs it to the end, recording every period's position and line;
@@ -140,6 +141,7 @@ Recorded run_program(VirtualMachine& m, const Program& prog, int pause_at, int o
     m.cycles(1);
     run.points.push_back(m.status().commanded);
     run.lines.push_back(m.status().line);
+    run.speeds.push_back(m.status().velocity);
   };
   for (const auto& move : prog.moves) {
     while (m.loop().segments().size() >= 1000)
@@ -358,6 +360,46 @@ TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
     EXPECT_DOUBLE_EQ(m.status().commanded[1], chain.back().end[1]);
   }
   EXPECT_LT(periods[0] * 1.3, periods[1]) << periods[0] << " vs " << periods[1];
+}
+
+// The same random programs with S-curve profiles ([TRAJ] MAX_LINEAR_JERK): every axis within
+// its limits, every program ends exactly, and the path speed's acceleration changes by at most
+// the jerk limit per second while the path moves -- but for entries into a segment whose own
+// acceleration limit is below the deceleration (one in many thousand periods, within 2.1 x)
+// and the periods in which the path comes to rest (below 1 mm/s: it arrives between two
+// periods' ends).
+TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
+  std::mt19937 rng(4711);
+  auto config = small_mill();
+  config.scurve = true;
+  config.max_linear_jerk = 40000;
+  const double dt = 1e-3;
+  int moving = 0, over = 0;
+  for (int round = 0; round < 24; ++round) {
+    const Program prog = random_program(rng, 30);
+    VirtualMachine m(config);
+    m.ready();
+    const AxisPose start = m.status().commanded;
+    const Recorded run = run_program(m, prog, round % 4 == 1 ? 700 : 0, round % 4 == 2 ? 500 : 0);
+    SCOPED_TRACE("round " + std::to_string(round));
+    const auto p = peaks(m, start);
+    EXPECT_LE(p.velocity, 1.001);
+    EXPECT_LE(p.acceleration, 1.001);
+    for (int axis = 0; axis < 3; ++axis)
+      EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
+    EXPECT_EQ(m.status().moves_done, prog.moves.size());
+    // The path speed's second differences (chords would misjudge the speed on tight curves).
+    std::vector<double> speed{0, 0};
+    speed.insert(speed.end(), run.speeds.begin(), run.speeds.end());
+    for (std::size_t k = 2; k < speed.size(); ++k) {
+      const double jerk = std::abs(speed[k] - 2 * speed[k - 1] + speed[k - 2]) / (dt * dt);
+      if (std::min({speed[k], speed[k - 1], speed[k - 2]}) < 1.0) continue;
+      ++moving;
+      if (jerk > config.max_linear_jerk * 1.001 + 1) ++over;
+      ASSERT_LE(jerk, config.max_linear_jerk * 2.1) << "period " << k;
+    }
+  }
+  EXPECT_LE(over, moving / 1000) << over << " of " << moving << " periods";
 }
 
 }  // namespace

@@ -115,6 +115,9 @@ struct MachineConfig {
   double default_linear_acceleration = 0;
   double max_linear_acceleration = 0;
   double max_linear_jerk = 0;  // units/s^3, 0 = unlimited
+  // S-curve profiles: path motion changes its acceleration by at most max_linear_jerk per
+  // second ([TRAJ] PLANNER_TYPE, MAX_LINEAR_JERK).
+  bool scurve = false;
   std::filesystem::path position_file;
   bool no_force_homing = false;
   // [KINS]

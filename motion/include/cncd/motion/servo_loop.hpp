@@ -107,6 +107,15 @@ class ServoLoop {
   // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
   void soft_limits_changed() noexcept;
   void finish_front() noexcept;  // the window's first segment is done
+  // S-curve profiles (servo_scurve.cpp): one period of path motion whose acceleration changes
+  // by at most jerk_ per second, through as many segments as it covers. Spends all of `dt`.
+  void scurve_step(double& dt) noexcept;
+  // The speed limits ahead of the path's position into limits_, as far as the path, `ds`
+  // further on at speed `v` and acceleration `a`, could need to slow down for them.
+  void gather_limits(double ds, double v, double a) noexcept;
+  // Whether speed `v` and acceleration `a`, `ds` further on, can still keep every limit
+  // gathered (the hard ones only when `soft` is false).
+  bool keeps_limits(double v, double a, double ds, bool soft) const noexcept;
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
@@ -159,6 +168,19 @@ class ServoLoop {
   int pulls_left_ = 0;
   double path_s_ = 0;
   double path_v_ = 0;
+  double path_a_ = 0;  // S-curve profiles only
+  // S-curve profiles: the path's jerk limit (0: trapezoidal profiles) and the limits ahead.
+  double jerk_ = 0;
+  struct SpeedLimit {
+    double distance;  // from the path's position
+    double soft;      // with the feed, the overrides and holds
+    double hard;      // of the axes alone
+    double accel;     // smallest path acceleration limit up to there
+  };
+  static constexpr int kMaxLimits = 64;
+  std::array<SpeedLimit, kMaxLimits> limits_{};
+  int limit_count_ = 0;
+  double cap_soft_ = 0, cap_hard_ = 0;  // the active segment's own speed limits
   double dwell_elapsed_s_ = 0;
   bool pause_requested_ = false;
   bool abort_requested_ = false;

@@ -1,0 +1,195 @@
+// S-curve path motion: each servo period picks the highest acceleration within a jerk step of
+// the last one from which every speed limit ahead can still be kept under the jerk limit.
+#include <algorithm>
+#include <cmath>
+
+#include "cncd/motion/servo_loop.hpp"
+#include "scurve.hpp"
+
+namespace cncd::motion {
+namespace {
+
+// The limits are checked against braking that uses this share of the jerk limit, so that the
+// period-by-period steps (which cannot switch the jerk within a period) have room to follow it.
+constexpr double kPlanJerkShare = 0.98;
+constexpr double kDistanceSlack = 1e-9;
+// Binary search steps over one period's range of accelerations.
+constexpr int kSearchSteps = 14;
+
+}  // namespace
+
+void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
+  limit_count_ = 0;
+  const Segment& head = window_at(head_seq_);
+  cap_hard_ = head.axis_velocity;
+  cap_soft_ = std::min(cap_hard_, speed_limit(head));
+  double distance = head.length - path_s_;
+  double accel = head.max_acceleration;
+  // Beyond the distance in which the fastest next state stops, no limit binds.
+  auto reach = [&] {
+    return ds + scurve::brake_distance(v, a, 0.0, accel, kPlanJerkShare * jerk_) + 1e-6;
+  };
+  double horizon = reach();
+  double min_soft = 1e300;
+  double min_hard = 1e300;
+  double kept_accel = accel;
+  for (int k = 0; k < window_count_; ++k) {
+    const std::uint64_t seq = head_seq_ + static_cast<std::uint64_t>(k);
+    const Segment& seg = window_at(seq);
+    double hard = 0;
+    double soft = 0;
+    if (k + 1 < window_count_) {
+      const Segment& next = window_at(seq + 1);
+      if (seg.continuous && seg.kind != Segment::Kind::dwell && next.kind != Segment::Kind::dwell) {
+        hard = std::min({seg.axis_velocity, next.axis_velocity, seg.junction_velocity});
+        soft = std::min({hard, speed_limit(seg), speed_limit(next)});
+        if (next.max_acceleration < accel) {
+          accel = next.max_acceleration;
+          horizon = reach();
+        }
+      }
+    }
+    // A limit no lower than one nearer (with no lower acceleration to slow down with) cannot
+    // be the one that binds.
+    if (soft < min_soft || hard < min_hard || accel < kept_accel) {
+      if (limit_count_ == kMaxLimits) {
+        // Out of room: the path stops at the last limit kept, a safe underestimate.
+        limits_[static_cast<std::size_t>(kMaxLimits - 1)].soft = 0;
+        limits_[static_cast<std::size_t>(kMaxLimits - 1)].hard = 0;
+        return;
+      }
+      limits_[static_cast<std::size_t>(limit_count_++)] = {distance, soft, hard, accel};
+      min_soft = std::min(min_soft, soft);
+      min_hard = std::min(min_hard, hard);
+      kept_accel = accel;
+    }
+    if (hard <= 0 || distance > horizon) return;
+    distance += window_at(seq + 1).length;
+  }
+}
+
+bool ServoLoop::keeps_limits(double v, double a, double ds, bool soft) const noexcept {
+  const double jerk = kPlanJerkShare * jerk_;
+  const double cap = soft ? cap_soft_ : cap_hard_;
+  if (scurve::settle_speed(v, std::max(a, 0.0), jerk) > cap * (1 + 1e-12) + 1e-12) return false;
+  for (int k = 0; k < limit_count_; ++k) {
+    const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
+    const double room = limit.distance - ds + kDistanceSlack;
+    if (room < 0) return false;
+    const double target = soft ? limit.soft : limit.hard;
+    if (scurve::brake_distance(v, a, target, limit.accel, jerk) > room) return false;
+    // An acceleration above what the segments there allow must be ramped off before them.
+    const double excess = std::abs(a) - limit.accel;
+    if (excess > 0) {
+      const double t = excess / jerk;
+      const double sign = a > 0 ? 1.0 : -1.0;
+      if (t * (v + t * (a / 2.0 - sign * jerk * t / 6.0)) > room) return false;
+    }
+  }
+  return true;
+}
+
+void ServoLoop::scurve_step(double& dt) noexcept {
+  const Segment& head = window_at(head_seq_);
+  const double accel = head.max_acceleration;
+  const double v = path_v_;
+  const double a = std::clamp(path_a_, -accel, accel);
+  const double hi = std::min(accel, a + jerk_ * dt);
+  // Far enough to hold every limit the next period's fastest state could need to slow for.
+  const scurve::Step fastest = scurve::integrate(v, a, hi, dt);
+  gather_limits(fastest.distance, fastest.velocity, hi);
+  const double lo = std::max(-accel, a - jerk_ * dt);
+
+  auto keeps = [&](double a_next, bool soft) {
+    const scurve::Step step = scurve::integrate(v, a, a_next, dt);
+    return keeps_limits(step.velocity, step.acceleration, step.distance, soft);
+  };
+  // The highest acceleration in [low, high] for which `ok` holds, given that it holds at low.
+  auto highest = [&](double low, double high, auto ok) {
+    for (int i = 0; i < kSearchSteps; ++i) {
+      const double mid = 0.5 * (low + high);
+      (ok(mid) ? low : high) = mid;
+    }
+    return low;
+  };
+  auto keeps_soft = [&](double x) { return keeps(x, true); };
+  auto keeps_hard = [&](double x) { return keeps(x, false); };
+  double a_next;
+  if (keeps_soft(hi)) {
+    a_next = hi;
+  } else if (keeps_soft(lo)) {
+    a_next = highest(lo, hi, keeps_soft);
+  } else {
+    // A lowered limit (override, hold, abort): slow down as hard as the jerk allows, easing
+    // off so as to settle on the active segment's limit rather than under it; the axes' own
+    // limits ahead still come first.
+    a_next = lo;
+    const auto settles_above = [&](double x) {
+      const scurve::Step step = scurve::integrate(v, a, x, dt);
+      return scurve::settle_speed(step.velocity, std::min(step.acceleration, 0.0), jerk_) >=
+             cap_soft_;
+    };
+    if (v > cap_soft_) {
+      // The lowest acceleration that still settles at or above the limit.
+      double low = lo;
+      double high = hi;
+      if (settles_above(lo)) {
+        high = lo;
+      } else if (settles_above(hi)) {
+        for (int i = 0; i < kSearchSteps; ++i) {
+          const double mid = 0.5 * (low + high);
+          (settles_above(mid) ? high : low) = mid;
+        }
+      }
+      a_next = high;
+    }
+    if (!keeps_hard(a_next)) a_next = keeps_hard(lo) ? highest(lo, a_next, keeps_hard) : lo;
+  }
+  scurve::Step step = scurve::integrate(v, a, a_next, dt);
+  dt = 0;
+
+  // A stop ahead is landed on exactly: when this step would pass it (the limits were lowered
+  // too late), or once the speed is down to what the last ramp of the acceleration to zero
+  // covers within a period (v = j t^2 / 2 over a distance j t^3 / 6, t <= dt).
+  const double last_ramp_v = jerk_ * period_s_ * period_s_ / 2;
+  const double last_ramp_s = last_ramp_v * period_s_ / 3;
+  for (int k = 0; k < limit_count_; ++k) {
+    const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
+    if (limit.hard > 0) continue;
+    const double gap = limit.distance - step.distance;
+    if (gap <= 0 || (gap <= last_ramp_s + 1e-9 && step.velocity <= last_ramp_v)) {
+      step = {limit.distance, 0.0, 0.0};
+    }
+    break;
+  }
+  if (step.velocity < 1e-12 && step.acceleration <= 0) step = {step.distance, 0.0, 0.0};
+  path_v_ = step.velocity;
+  path_a_ = step.acceleration;
+
+  // Along the segments the step covers.
+  double s = path_s_ + step.distance;
+  for (;;) {
+    const Segment& active = window_at(head_seq_);
+    if (s < active.length - 1e-12) break;
+    s = std::max(0.0, s - active.length);
+    axis_pose_ = active.end;
+    finish_front();
+    if (window_count_ == 0) {
+      path_v_ = path_a_ = 0;
+      s = 0;
+      break;
+    }
+    const Segment& next = window_at(head_seq_);
+    if (next.kind == Segment::Kind::dwell) {
+      path_v_ = path_a_ = 0;
+      s = 0;
+      break;  // the dwell starts with the next period
+    }
+    has_active_ = true;
+    if (!starts_here(next)) return;
+  }
+  path_s_ = s;
+  if (has_active_) axis_pose_ = window_at(head_seq_).point_at(path_s_);
+}
+
+}  // namespace cncd::motion
