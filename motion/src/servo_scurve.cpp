@@ -68,15 +68,24 @@ void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
   }
 }
 
-bool ServoLoop::keeps_limits(double v, double a, double ds, bool soft) const noexcept {
+bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double a, double ds,
+                             bool soft) const noexcept {
   const double jerk = kPlanJerkShare * jerk_;
   const double cap = soft ? cap_soft_ : cap_hard_;
   if (scurve::settle_speed(v, std::max(a, 0.0), jerk) > cap * (1 + 1e-12) + 1e-12) return false;
   for (int k = 0; k < limit_count_; ++k) {
     const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
     const double room = limit.distance - ds + kDistanceSlack;
-    if (room < 0) return false;
     const double target = soft ? limit.soft : limit.hard;
+    if (room < 0) {
+      // Passed within the step: the speed and the acceleration there lie between the step's
+      // two ends, and the segment after it must not be sped up past it.
+      if (std::max(v_before, scurve::settle_speed(v, std::max(a, 0.0), jerk)) >
+          target * (1 + 1e-12) + 1e-12)
+        return false;
+      if (std::max(std::abs(a_before), std::abs(a)) > limit.accel * (1 + 1e-12)) return false;
+      continue;
+    }
     if (scurve::brake_distance(v, a, target, limit.accel, jerk) > room) return false;
     // An acceleration above what the segments there allow must be ramped off before them.
     const double excess = std::abs(a) - limit.accel;
@@ -102,7 +111,7 @@ void ServoLoop::scurve_step(double& dt) noexcept {
 
   auto keeps = [&](double a_next, bool soft) {
     const scurve::Step step = scurve::integrate(v, a, a_next, dt);
-    return keeps_limits(step.velocity, step.acceleration, step.distance, soft);
+    return keeps_limits(v, a, step.velocity, step.acceleration, step.distance, soft);
   };
   // The highest acceleration in [low, high] for which `ok` holds, given that it holds at low.
   auto highest = [&](double low, double high, auto ok) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -167,6 +168,40 @@ TEST(SCurve, AbortAndHoldSlowDownAlongAnSCurve) {
       EXPECT_LE(path_peaks(m, start).jerk, 20000 * 1.001 + 1);
     }
   }
+}
+
+// A circle of 0.1 mm chords at 150 mm/s under G64: the servo loop passes several chords and
+// blend arcs a period, at full feed once up to speed, within every axis's limits and the jerk
+// limit, and the whole lap takes the feed-limited time plus the S-curve start and stop.
+TEST(SCurve, DenseChordsRunAtFullFeed) {
+  VirtualMachine m(jerk_mill(40000));
+  m.ready();
+  constexpr double kRadius = 30;
+  const int chords = static_cast<int>(std::round(2 * std::numbers::pi * kRadius / 0.1));
+  m.queue(line_to(Move::Kind::traverse, kRadius, 0, 0));
+  m.flush();
+  m.run_until_idle();
+  m.clear_trajectory();
+  const AxisPose at = m.status().commanded;
+  int periods = 0;
+  for (int i = 1; i <= chords; ++i) {
+    const double t = 2 * std::numbers::pi * i / chords;
+    Move move = line_to(Move::Kind::feed, kRadius * std::cos(t), kRadius * std::sin(t), 0, 150);
+    move.path_mode = Move::PathMode::blend;
+    for (; m.loop().segments().size() >= 1000; ++periods)
+      m.cycles(1);
+    m.queue(move);
+  }
+  periods += m.run_until_idle();
+  EXPECT_NEAR(m.status().commanded[0], kRadius, 1e-9);
+  EXPECT_NEAR(m.status().commanded[1], 0, 1e-9);
+  const auto p = peaks(m, at);
+  EXPECT_LE(p.velocity, 1.001);
+  EXPECT_LE(p.acceleration, 1.001);
+  EXPECT_LE(path_peaks(m, at).jerk, 40000 * 1.001 + 1);
+  // 188.5 mm at 150 mm/s, plus a start and a stop: v/a + a/j = 0.125 s.
+  const double bound = 2 * std::numbers::pi * kRadius / 150;
+  EXPECT_LT(periods * m.period_s(), bound + 0.125 + 0.01) << periods;
 }
 
 }  // namespace

@@ -113,9 +113,11 @@ class ServoLoop {
   // The speed limits ahead of the path's position into limits_, as far as the path, `ds`
   // further on at speed `v` and acceleration `a`, could need to slow down for them.
   void gather_limits(double ds, double v, double a) noexcept;
-  // Whether speed `v` and acceleration `a`, `ds` further on, can still keep every limit
-  // gathered (the hard ones only when `soft` is false).
-  bool keeps_limits(double v, double a, double ds, bool soft) const noexcept;
+  // Whether a step from `v_before`, `a_before` to speed `v` and acceleration `a`, `ds` further on,
+  // keeps every limit gathered (the hard ones only when `soft` is false): those it passes, and
+  // those ahead it can still slow down for.
+  bool keeps_limits(double v_before, double a_before, double v, double a, double ds,
+                    bool soft) const noexcept;
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
@@ -177,7 +179,7 @@ class ServoLoop {
     double hard;      // of the axes alone
     double accel;     // smallest path acceleration limit up to there
   };
-  static constexpr int kMaxLimits = 64;
+  static constexpr int kMaxLimits = 1024;
   std::array<SpeedLimit, kMaxLimits> limits_{};
   int limit_count_ = 0;
   double cap_soft_ = 0, cap_hard_ = 0;  // the active segment's own speed limits
