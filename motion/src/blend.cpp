@@ -168,6 +168,8 @@ void Planner::join(Segment& next, const Move& move) {
   }
   if (mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
       next.kind != Segment::Kind::line || !euclidean(prev) || !euclidean(next)) {
+    // fillet() emits the trimmed held segment and the fillet arc itself.
+    if (mode == Move::PathMode::blend && fillet(held, next)) return;
     if (mode == Move::PathMode::blend) kink(prev, held.reserved, next);
     output_.push_back(prev);
     return;
@@ -255,16 +257,17 @@ void Planner::kink(Segment& prev, bool prev_reserved, Segment& next) {
   v = std::min({v, prev.length / dt, next.length / dt});
   // A kink that must be crossed this slowly is a corner: it stops.
   if (!(v > 0.01 * std::min(prev.max_velocity, next.max_velocity))) return;
-  auto reserve = [](Segment& seg) {
-    seg.max_acceleration *= 1.0 - kKinkReserve;
-    if (seg.kind == Segment::Kind::arc) seg.axis_velocity *= std::sqrt(1.0 - kKinkReserve);
-    seg.max_velocity = std::min(seg.max_velocity, seg.axis_velocity);
-  };
-  if (!prev_reserved) reserve(prev);
-  reserve(next);
+  if (!prev_reserved) reserve_for_kink(prev);
+  reserve_for_kink(next);
   next_reserved_ = true;
   prev.continuous = true;
   prev.junction_velocity = v;
+}
+
+void Planner::reserve_for_kink(Segment& seg) {
+  seg.max_acceleration *= 1.0 - kKinkReserve;
+  if (seg.kind == Segment::Kind::arc) seg.axis_velocity *= std::sqrt(1.0 - kKinkReserve);
+  seg.max_velocity = std::min(seg.max_velocity, seg.axis_velocity);
 }
 
 void Planner::set_blend_limits(Segment& blend) const {

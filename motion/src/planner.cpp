@@ -22,34 +22,6 @@ double path_length(const AxisPose& delta) {
   return norm(3);
 }
 
-// The unit tangents at both ends, over every axis.
-void set_directions(Segment& seg) {
-  AxisPose start{}, end{};
-  for (int i = 0; i < kAxes; ++i)
-    start[i] = end[i] = seg.end[i] - seg.start[i];
-  if (seg.kind == Segment::Kind::arc) {
-    const double k = seg.radius * seg.sweep;  // d(in-plane position)/d(fraction of the sweep)
-    const double a0 = seg.start_angle;
-    const double a1 = seg.start_angle + seg.sweep;
-    start[seg.first_axis] = -k * std::sin(a0);
-    start[seg.second_axis] = k * std::cos(a0);
-    end[seg.first_axis] = -k * std::sin(a1);
-    end[seg.second_axis] = k * std::cos(a1);
-  }
-  auto normalize = [](AxisPose& d) {
-    double sum = 0;
-    for (double x : d)
-      sum += x * x;
-    const double n = std::sqrt(sum);
-    for (double& x : d)
-      x = n > kTiny ? x / n : 0.0;
-  };
-  normalize(start);
-  normalize(end);
-  seg.start_direction = start;
-  seg.end_direction = end;
-}
-
 }  // namespace
 
 AxisPose Segment::point_at(double s) const noexcept {
@@ -79,6 +51,33 @@ AxisPose Segment::point_at(double s) const noexcept {
 }
 
 Planner::Planner(const config::MachineConfig& config) : config_(config) {}
+
+void Planner::set_directions(Segment& seg) {
+  AxisPose start{}, end{};
+  for (int i = 0; i < kAxes; ++i)
+    start[i] = end[i] = seg.end[i] - seg.start[i];
+  if (seg.kind == Segment::Kind::arc) {
+    const double k = seg.radius * seg.sweep;  // d(in-plane position)/d(fraction of the sweep)
+    const double a0 = seg.start_angle;
+    const double a1 = seg.start_angle + seg.sweep;
+    start[seg.first_axis] = -k * std::sin(a0);
+    start[seg.second_axis] = k * std::cos(a0);
+    end[seg.first_axis] = -k * std::sin(a1);
+    end[seg.second_axis] = k * std::cos(a1);
+  }
+  auto normalize = [](AxisPose& d) {
+    double sum = 0;
+    for (double x : d)
+      sum += x * x;
+    const double n = std::sqrt(sum);
+    for (double& x : d)
+      x = n > kTiny ? x / n : 0.0;
+  };
+  normalize(start);
+  normalize(end);
+  seg.start_direction = start;
+  seg.end_direction = end;
+}
 
 void Planner::curve_limits(double fastest, double radius, double plane_a, double max_normal,
                            double& v, double& a) {
@@ -159,10 +158,6 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   for (int i = 0; i < kAxes; ++i)
     delta[i] = seg.end[i] - start[i];
 
-  // Direction cosines along the path, per axis: for a line constant, for an arc the in-plane
-  // axes reach 1 somewhere on a large enough sweep, so they are bounded by 1.
-  AxisPose direction{};
-  double centripetal_radius = 0;
   if (move.kind == Move::Kind::arc) {
     seg.kind = Segment::Kind::arc;
     seg.first_axis = static_cast<std::int8_t>(move.plane_axes[0]);
@@ -202,12 +197,6 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
       if (i != seg.first_axis && i != seg.second_axis) other += delta[i] * delta[i];
     }
     seg.length = std::sqrt(arc_length * arc_length + other);
-    for (int i = 0; i < kAxes; ++i) {
-      direction[i] = (i == seg.first_axis || i == seg.second_axis)
-                         ? arc_length / seg.length
-                         : std::abs(delta[i]) / seg.length;
-    }
-    centripetal_radius = seg.radius;
   } else {
     seg.kind = Segment::Kind::line;
     seg.length = path_length(delta);
@@ -218,12 +207,7 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
         sum += d * d;
       seg.length = std::sqrt(sum);
     }
-    if (seg.length <= kTiny) {
-      seg.length = 0;
-    } else {
-      for (int i = 0; i < kAxes; ++i)
-        direction[i] = std::abs(delta[i]) / seg.length;
-    }
+    if (seg.length <= kTiny) seg.length = 0;
   }
   if (check_limits && !within_limits(seg, error)) return std::nullopt;
   if (seg.length == 0) {
@@ -233,6 +217,21 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
     return seg;
   }
 
+  seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;
+  set_limits(seg);
+  return seg;
+}
+
+void Planner::set_limits(Segment& seg) const {
+  // Direction cosines along the path, per axis: for a line constant, for an arc the in-plane
+  // axes reach 1 somewhere on a large enough sweep, so they are bounded by 1.
+  AxisPose direction{};
+  const bool arc = seg.kind == Segment::Kind::arc;
+  const double arc_length = arc ? std::abs(seg.sweep) * seg.radius : 0.0;
+  for (int i = 0; i < kAxes; ++i) {
+    const bool in_plane = arc && (i == seg.first_axis || i == seg.second_axis);
+    direction[i] = (in_plane ? arc_length : std::abs(seg.end[i] - seg.start[i])) / seg.length;
+  }
   double v = 1e300;
   double a = 1e300;
   for (int i = 0; i < kAxes; ++i) {
@@ -244,28 +243,24 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   const bool linear_motion = direction[0] + direction[1] + direction[2] > kTiny;
   if (linear_motion && config_.max_linear_velocity > 0)
     v = std::min(v, config_.max_linear_velocity);
-  if (centripetal_radius > 0) {
+  if (arc) {
     // In the plane the acceleration is the tangential part (path acceleration x cos b, b the
     // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it.
     const double plane_a =
         std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
                  config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
     const double in_plane = direction[seg.first_axis];  // cos b
-    const double fastest =
-        move.kind == Move::Kind::traverse ? v : std::min(v, move.feed * config_.max_feed_override);
+    const double fastest = seg.feed > 0 ? std::min(v, seg.feed * config_.max_feed_override) : v;
     double v_plane = v * in_plane;
     double a_plane = 0;
-    curve_limits(fastest * in_plane, centripetal_radius, plane_a, kArcNormalShare, v_plane,
-                 a_plane);
+    curve_limits(fastest * in_plane, seg.radius, plane_a, kArcNormalShare, v_plane, a_plane);
     a = std::min(a, a_plane / in_plane);
     v = std::min(v, v_plane / in_plane);
   }
   set_directions(seg);
   seg.axis_velocity = v;
-  seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;
   seg.max_velocity = seg.feed > 0 ? std::min(v, seg.feed) : v;
   seg.max_acceleration = a;
-  return seg;
 }
 
 }  // namespace cncd::motion

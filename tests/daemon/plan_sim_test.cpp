@@ -69,7 +69,9 @@ TEST_F(PlanSimTest, RapidsRunAtTheFastestSpeedTheAxesAllowAlongThem) {
 TEST_F(PlanSimTest, ArcsAndDwellsAreFollowedAndEachMoveGetsItsStartTime) {
   std::vector<double> times;
   options_.on_sample = [&times](double t, const motion::AxisPose&) { times.push_back(t); };
-  const auto r = simulate("G21 G90\nG0 X20 Y0\nG2 X20 Y0 I-10 J0 F1200\nG4 P0.25\nG1 X30\nM2\n");
+  // G61: the traverse stops where the circle starts (under G64 a fillet would round it).
+  const auto r =
+      simulate("G21 G90 G61\nG0 X20 Y0\nG2 X20 Y0 I-10 J0 F1200\nG4 P0.25\nG1 X30\nM2\n");
   ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : "");
   ASSERT_EQ(r.moves, 4u);
   EXPECT_EQ(r.move_line, (std::vector<std::int32_t>{2, 3, 4, 5}));

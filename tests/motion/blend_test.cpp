@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "machine_fixture.hpp"
+#include "path_distance.hpp"
 
 namespace cncd::test {
 namespace {
@@ -20,44 +21,7 @@ using motion::Command;
 using motion::Move;
 
 double distance(const AxisPose& a, const AxisPose& b) {
-  double sum = 0;
-  for (int i = 0; i < 3; ++i)
-    sum += (a[i] - b[i]) * (a[i] - b[i]);
-  return std::sqrt(sum);
-}
-
-// Distance from `p` to the programmed move from `from` (a line, or an arc or helix in XY of
-// less than a turn).
-double distance_to_move(const AxisPose& p, const AxisPose& from, const Move& move) {
-  if (move.kind == Move::Kind::arc) {
-    const double cx = move.center_first, cy = move.center_second;
-    const double a0 = std::atan2(from[1] - cy, from[0] - cx);
-    const double a1 = std::atan2(move.end[1] - cy, move.end[0] - cx);
-    const double two_pi = 2 * std::numbers::pi;
-    double sweep = a1 - a0;
-    if (move.turns > 0 && sweep <= 0) sweep += two_pi;
-    if (move.turns < 0 && sweep >= 0) sweep -= two_pi;
-    double phi = std::atan2(p[1] - cy, p[0] - cx) - a0;
-    while (sweep > 0 && phi < 0)
-      phi += two_pi;
-    while (sweep < 0 && phi > 0)
-      phi -= two_pi;
-    const double f = std::clamp(phi / sweep, 0.0, 1.0);
-    const double r = std::hypot(from[0] - cx, from[1] - cy);
-    const AxisPose on{cx + r * std::cos(a0 + f * sweep), cy + r * std::sin(a0 + f * sweep),
-                      from[2] + (move.end[2] - from[2]) * f};
-    return std::min({distance(p, on), distance(p, from), distance(p, move.end)});
-  }
-  double len_sq = 0, t = 0;
-  for (int i = 0; i < 3; ++i) {
-    len_sq += (move.end[i] - from[i]) * (move.end[i] - from[i]);
-    t += (p[i] - from[i]) * (move.end[i] - from[i]);
-  }
-  t = len_sq > 0 ? std::clamp(t / len_sq, 0.0, 1.0) : 0.0;
-  AxisPose on{};
-  for (int i = 0; i < 3; ++i)
-    on[i] = from[i] + (move.end[i] - from[i]) * t;
-  return distance(p, on);
+  return xyz_distance(a, b);
 }
 
 struct Program {
@@ -67,7 +31,8 @@ struct Program {
 
 // Lines (feeds and traverses, some continuing straight on), arcs and helices tangent or not
 // to what comes before, and a few dwells, each move with its own path mode and tolerance.
-Program random_program(std::mt19937& rng, int count) {
+// `contour`: a G64 contour in XY of lines and arcs, most arcs entered at a corner.
+Program random_program(std::mt19937& rng, int count, bool contour = false) {
   std::uniform_real_distribution<double> unit(0, 1);
   Program prog;
   AxisPose at{};
@@ -76,14 +41,15 @@ Program random_program(std::mt19937& rng, int count) {
     Move move;
     move.line = k + 1;
     const double mode = unit(rng);
-    move.path_mode = mode < 0.1   ? Move::PathMode::exact_stop
+    move.path_mode = contour      ? Move::PathMode::blend
+                     : mode < 0.1 ? Move::PathMode::exact_stop
                      : mode < 0.3 ? Move::PathMode::exact_path
                                   : Move::PathMode::blend;
     move.tolerance = unit(rng) < 0.25 ? 0.0 : 0.005 + 0.5 * unit(rng) * unit(rng);
     move.feed = 10 + 240 * unit(rng);
     move.end = at;
     const double pick = unit(rng);
-    if (pick < 0.05 && k > 0) {
+    if (pick < 0.05 && k > 0 && !contour) {
       move.kind = Move::Kind::dwell;
       move.dwell_s = 0.005 + 0.03 * unit(rng);
     } else if (pick < 0.6) {
@@ -92,10 +58,11 @@ Program random_program(std::mt19937& rng, int count) {
       const double length = 0.05 + 20 * unit(rng) * unit(rng);
       move.end[0] += length * std::cos(heading);
       move.end[1] += length * std::sin(heading);
-      if (unit(rng) < 0.2) move.end[2] += (unit(rng) - 0.5) * 4;
+      if (unit(rng) < 0.2 && !contour) move.end[2] += (unit(rng) - 0.5) * 4;
     } else {
       move.kind = Move::Kind::arc;
-      if (unit(rng) < 0.3) heading += (unit(rng) - 0.5) * 2;  // a corner onto the arc
+      if (unit(rng) < (contour ? 0.8 : 0.3))
+        heading += (unit(rng) - 0.5) * 3;  // a corner onto the arc
       const double r = 0.5 + 15 * unit(rng);
       const double sweep = 0.1 + 4 * unit(rng);
       const double side = unit(rng) < 0.5 ? 1 : -1;
@@ -108,7 +75,7 @@ Program random_program(std::mt19937& rng, int count) {
       move.center_first = cx;
       move.center_second = cy;
       move.turns = side > 0 ? 1 : -1;
-      if (unit(rng) < 0.3) move.end[2] += (unit(rng) - 0.5) * 6;  // a helix
+      if (unit(rng) < 0.3 && !contour) move.end[2] += (unit(rng) - 0.5) * 6;  // a helix
     }
     prog.from.push_back(at);
     prog.moves.push_back(move);
@@ -156,16 +123,14 @@ Recorded run_program(VirtualMachine& m, const Program& prog, int pause_at, int o
   return run;
 }
 
-TEST(Blend, RandomProgramsStayWithinLimitsToleranceAndStops) {
-  std::mt19937 rng(2026);
-  const auto config = small_mill();
-  for (int round = 0; round < 16; ++round) {
-    const Program prog = random_program(rng, 40);
-    VirtualMachine m(config);
+// Runs the program (with a pause or an override change in some rounds) and checks the limits,
+// the tolerance, the stops, the dwells and the end.
+void check_program(const Program& prog, int round) {
+  {
+    VirtualMachine m(small_mill());
     m.ready();
     const AxisPose start = m.status().commanded;
     const Recorded run = run_program(m, prog, round % 4 == 1 ? 700 : 0, round % 4 == 2 ? 500 : 0);
-    SCOPED_TRACE("round " + std::to_string(round));
 
     const auto p = peaks(m, start);
     EXPECT_LE(p.velocity, 1.001);
@@ -218,6 +183,36 @@ TEST(Blend, RandomProgramsStayWithinLimitsToleranceAndStops) {
       }
     }
   }
+}
+
+TEST(Blend, RandomProgramsStayWithinLimitsToleranceAndStops) {
+  std::mt19937 rng(2026);
+  for (int round = 0; round < 16; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    check_program(random_program(rng, 40), round);
+  }
+}
+
+// G64 contours in XY where lines meet arcs and arcs meet arcs at corners: the corners get
+// fillets (counted from the planner's segments), and the same properties hold.
+TEST(Blend, RandomContoursWithLineArcAndArcArcCornersStayWithinLimitsAndTolerance) {
+  std::mt19937 rng(4);
+  const auto config = small_mill();
+  int fillets = 0;
+  for (int round = 0; round < 12; ++round) {
+    SCOPED_TRACE("contour round " + std::to_string(round));
+    const Program prog = random_program(rng, 40, true);
+    motion::Planner planner(config);
+    planner.reset(AxisPose{});
+    std::string error;
+    for (const auto& move : prog.moves)
+      ASSERT_TRUE(planner.push(move, true, error)) << error;
+    planner.flush();
+    for (const auto& seg : planner.output())
+      fillets += seg.fillet ? 1 : 0;
+    check_program(prog, round);
+  }
+  EXPECT_GE(fillets, 100);
 }
 
 // Lines at right angles (a staircase of 10 mm legs at F6000): in G64 P1 the corners are

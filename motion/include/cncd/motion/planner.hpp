@@ -5,8 +5,10 @@
 //
 // The stateful side (push/flush) looks one move ahead: it holds back the newest move until the
 // next one shows how the two join. Tangent junctions are marked for the servo loop to cross
-// at speed; under G64 a line-line corner gets a tangent blend arc within the P tolerance;
-// every other junction stops (docs/motion.md).
+// at speed; under G64 a line-line corner gets a tangent blend arc within the P tolerance, and
+// a corner where a programmed arc meets a line or another arc in its plane a tangent fillet
+// arc; every other junction stops, or is crossed slowly when it is a small kink
+// (docs/motion.md).
 #pragma once
 
 #include <deque>
@@ -63,6 +65,10 @@ class Planner {
                            double& v, double& a);
 
   bool within_limits(const Segment& segment, std::string& error) const;
+  // Path speed and acceleration limits of a line or an arc from its geometry and feed (0 for a
+  // traverse), and its unit tangents at both ends.
+  void set_limits(Segment& seg) const;
+  static void set_directions(Segment& seg);
   // Path speed and acceleration limits of a blend arc (blend_u, blend_v and radius set).
   void set_blend_limits(Segment& blend) const;
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
@@ -73,6 +79,8 @@ class Planner {
   // segments' accelerations reduced to leave room for it.
   void kink(Segment& prev, bool prev_reserved, Segment& next);
   static constexpr double kKinkReserve = 0.1;
+  // Gives up kKinkReserve of the segment's acceleration (and an arc's matching speed).
+  static void reserve_for_kink(Segment& seg);
   // Takes a planned segment (of `move`) into the look-ahead: joins it to the held one and
   // holds it, or emits it.
   void take(Segment seg, const Move& move);
@@ -100,6 +108,13 @@ class Planner {
     std::uint32_t moves = 0;
   };
   static constexpr std::size_t kMaxMerged = 256;
+
+  // G64 corners where a programmed arc meets a line or another arc, both in the arc's plane
+  // (no helix): a circular fillet tangent to both curves, within the held move's P of the
+  // corner (P 0: as large as the shares allow), taking at most half of each move; the arcs
+  // are trimmed by their start or end angle. False when no fillet fits; nothing changes then.
+  // arc_blend.cpp.
+  bool fillet(Held& held, Segment& next);
 
   const config::MachineConfig& config_;
   AxisPose end_{};

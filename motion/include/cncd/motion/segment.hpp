@@ -32,6 +32,14 @@ struct Segment {
   AxisPose blend_center{};
   AxisPose blend_u{};
   AxisPose blend_v{};
+  // Fillet (a blend where a programmed arc meets a line or another arc, in the plane
+  // first_axis/second_axis): the programmed corner it rounds, and the centre and radius of
+  // each side that is an arc (radius 0: that side is a line). Only for measuring the
+  // deviation from the programmed path; the servo loop follows blend_*.
+  bool fillet = false;
+  double corner_first = 0, corner_second = 0;
+  double in_center_first = 0, in_center_second = 0, in_radius = 0;
+  double out_center_first = 0, out_center_second = 0, out_radius = 0;
   std::int32_t line = 0;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
