@@ -64,6 +64,43 @@ double distance_to_path(const motion::Segment& segment, const motion::AxisPose& 
       nearest[i] = segment.start[i] + f * (segment.end[i] - segment.start[i]);
     return xyz_distance(nearest, point);
   }
+  if (segment.kind == Kind::blend && segment.fillet) {
+    // A fillet rounds a corner where an arc meets a line or another arc, in the plane of
+    // first_axis and second_axis: the programmed path is what it cut from each side, from
+    // where it leaves the first curve to the corner and from the corner to where it joins the
+    // second. An arc side's piece is less than half a turn.
+    const int a = segment.first_axis, b = segment.second_axis;
+    motion::AxisPose corner = segment.start;
+    corner[a] = segment.corner_first;
+    corner[b] = segment.corner_second;
+    auto piece = [&](const motion::AxisPose& from, const motion::AxisPose& to, double cx, double cy,
+                     double radius) {
+      motion::Segment s;
+      s.start = from;
+      s.end = to;
+      if (radius <= 0) {
+        s.kind = Kind::line;
+        s.length = xyz_distance(from, to);
+        return s;
+      }
+      s.kind = Kind::arc;
+      s.first_axis = segment.first_axis;
+      s.second_axis = segment.second_axis;
+      s.center_first = cx;
+      s.center_second = cy;
+      s.radius = radius;
+      s.start_angle = std::atan2(from[b] - cy, from[a] - cx);
+      s.sweep =
+          std::remainder(std::atan2(to[b] - cy, to[a] - cx) - s.start_angle, 2 * std::numbers::pi);
+      s.length = radius * std::abs(s.sweep);
+      return s;
+    };
+    const motion::Segment in = piece(segment.start, corner, segment.in_center_first,
+                                     segment.in_center_second, segment.in_radius);
+    const motion::Segment out = piece(corner, segment.end, segment.out_center_first,
+                                      segment.out_center_second, segment.out_radius);
+    return std::min(distance_to_path(in, point), distance_to_path(out, point));
+  }
   if (segment.kind == Kind::blend) {
     // The programmed path here is the corner the blend arc rounds: from where the arc leaves
     // the first line to the corner, and on to where it joins the second.

@@ -109,6 +109,26 @@ TEST_F(PlanSimTest, BlendedCornersKeepTheProgrammedBoundsAndOneStartTimePerMove)
     EXPECT_GT(r.move_start_s[i], r.move_start_s[i - 1]) << i;
 }
 
+TEST_F(PlanSimTest, FilletsWhereArcsMeetLinesAreMeasuredAgainstTheProgrammedCurves) {
+  // A barrel: two lines and two arcs meeting at 27 degree corners. Under G64 P0.05 each corner
+  // gets a fillet that passes P from it, measured against the programmed line and arc; G61
+  // stops at every corner.
+  const std::string profile = "G1 X40 F3000\nG3 X40 Y20 I-5 J10\nG1 X0\nG3 X0 Y0 I5 J-10\nM2\n";
+  const auto blended = simulate("G21 G90 G64 P0.05\n" + profile);
+  const auto exact = simulate("G21 G90 G61\n" + profile);
+  ASSERT_TRUE(blended.complete()) << (blended.error ? blended.error->to_string() : "");
+  ASSERT_TRUE(exact.complete()) << (exact.error ? exact.error->to_string() : "");
+  EXPECT_EQ(blended.moves, 4u);
+  EXPECT_LE(blended.max_deviation, 0.05 + 1e-6);
+  EXPECT_GE(blended.max_deviation, 0.03);
+  EXPECT_LT(exact.max_deviation, 1e-6);
+  EXPECT_LT(blended.cycle_time_s, exact.cycle_time_s - 0.05);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(blended.peak_velocity[axis], machine().axes[axis].max_velocity * 1.001);
+    EXPECT_LE(blended.peak_acceleration[axis], machine().axes[axis].max_acceleration * 1.001);
+  }
+}
+
 TEST_F(PlanSimTest, StartsWhereTheMachineStands) {
   options_.start_machine = interp::Pose{50, 60, 0};
   const auto r = simulate("G21 G91\nG1 X10 F600\nM2\n");
