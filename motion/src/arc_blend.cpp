@@ -156,12 +156,17 @@ std::optional<Fit> fit(const Side& in, const Side& out, double sigma, double r, 
   return best;
 }
 
-// The largest fillet radius that fits (grown by factors of 4, then bisected).
+// The largest fillet radius that fits (grown by factors of 4, then bisected), at most 1000
+// times the path length it may take from both moves. Where an arc curves back towards the
+// line it kinks away from, every radius fits and the fillet tends to a straight line: the cap
+// keeps its centre near enough for its points to be exact to far below a micrometre (and a
+// radius that large no longer limits the speed).
 std::optional<std::pair<double, Fit>> largest_fit(const Side& in, const Side& out, double sigma,
                                                   double tolerance) {
+  const double cap = 1e3 * (in.limit + out.limit);
   std::optional<std::pair<double, Fit>> best;
   double lo = 0, hi = 0;
-  for (double r = kMinFilletRadius; r < 1e12; r *= 4) {
+  for (double r = kMinFilletRadius; r <= cap; r = r < cap && 4 * r > cap ? cap : 4 * r) {
     const auto f = fit(in, out, sigma, r, tolerance);
     if (!f) {
       hi = r;

@@ -192,6 +192,30 @@ TEST(ArcBlend, CornerWhoseFilletNeedsMoreThanHalfAMoveStops) {
   EXPECT_LE(r.deviation, 1.0 + 1e-6);
 }
 
+// A line into an arc 1 mrad off its tangent that curves back the other way: fillets of any
+// radius fit, tending to a straight line; the radius stays bounded so that the fillet's
+// points, computed from its centre, are exact.
+TEST(ArcBlend, NearlyTangentArcCurvingBackGetsAnExactFillet) {
+  const double kink = 1e-3;
+  const double cx = 20 + 10 * std::sin(kink), cy = -10 * std::cos(kink);
+  const double end = std::numbers::pi / 2 + kink - 1;
+  std::vector<Move> moves{
+      line_to(Move::Kind::feed, 20, 0, 0, 100),
+      arc_to(cx + 10 * std::cos(end), cy + 10 * std::sin(end), cx, cy, -1, 100)};
+  const auto out = plan(moves, Move::PathMode::blend, 0.01);
+  ASSERT_EQ(out.size(), 3u);
+  const Segment& fillet = out[1];
+  ASSERT_TRUE(fillet.fillet);
+  EXPECT_LE(fillet.radius, 1e3 * (10 + 5) * (1 + 1e-12));
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(fillet.point_at(0)[i], fillet.start[i], 1e-9);
+    EXPECT_NEAR(fillet.point_at(fillet.length * (1 - 1e-12))[i], fillet.end[i], 1e-9);
+  }
+  const Measured r = run(moves, Move::PathMode::blend, 0.01, {20, 0, 0, 0, 0, 0, 0, 0, 0});
+  EXPECT_GT(r.corner_speed, 90.0);
+  EXPECT_LE(r.deviation, 0.01 + 1e-6);
+}
+
 TEST(ArcBlend, ExactPathAndExactStopNeverFillet) {
   for (const auto mode : {Move::PathMode::exact_path, Move::PathMode::exact_stop}) {
     const auto out = plan(line_into_quarter_arc(), mode, 0.2);
