@@ -228,6 +228,7 @@ class Simulation {
     const auto segment = planner_.plan(move, programmed_end_, false, error);
     if (!segment) return;  // push() reports it
     programmed_end_ = segment->end;
+    if (options_.on_move) options_.on_move(*segment);
     if (segment->kind == motion::Segment::Kind::dwell) {
       result_.feed_bound_s += segment->dwell_s;
       result_.exact_stop_bound_s += segment->dwell_s;

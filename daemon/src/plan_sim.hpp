@@ -17,6 +17,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "cncd/motion/segment.hpp"
 #include "cncd/motion/types.hpp"
 #include "program_check.hpp"
 
@@ -37,6 +38,9 @@ struct PlanSimOptions {
   // Called once per servo period with the time (s, from the program's start) and the
   // commanded axis positions (machine coordinates) at the end of that period.
   std::function<void(double, const motion::AxisPose&)> on_sample;
+  // Called with every programmed move, in order, as the planner plans it alone: the geometry
+  // the bounds use, before a blend or a merge shortens it.
+  std::function<void(const motion::Segment&)> on_move;
   // Set from another thread to stop the simulation early (PlanSimResult::stopped says so).
   const std::atomic<bool>* cancel = nullptr;
 };

@@ -94,8 +94,22 @@ TEST_F(PlanSimTest, ArcsAndDwellsAreFollowedAndEachMoveGetsItsStartTime) {
 
 TEST_F(PlanSimTest, BlendedCornersKeepTheProgrammedBoundsAndOneStartTimePerMove) {
   // A 20 mm square at 20 mm/s under G64 P0.1: the bounds are the programmed path's.
+  std::vector<motion::Segment> moves;
+  options_.on_move = [&moves](const motion::Segment& move) { moves.push_back(move); };
   const auto r = simulate("G21 G90 G64 P0.1\nG1 X20 F1200\nY20\nX0\nY0\nM2\n");
   ASSERT_TRUE(r.complete());
+  // Each move as programmed, corner to corner, whatever the blends made of it.
+  ASSERT_EQ(moves.size(), 4u);
+  const double corners[5][2] = {{0, 0}, {20, 0}, {20, 20}, {0, 20}, {0, 0}};
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    EXPECT_EQ(moves[i].line, static_cast<std::int32_t>(i + 2));
+    EXPECT_NEAR(moves[i].length, 20.0, 1e-9);
+    EXPECT_NEAR(moves[i].feed, 20.0, 1e-9);
+    EXPECT_NEAR(moves[i].start[0], corners[i][0], 1e-9);
+    EXPECT_NEAR(moves[i].start[1], corners[i][1], 1e-9);
+    EXPECT_NEAR(moves[i].end[0], corners[i + 1][0], 1e-9);
+    EXPECT_NEAR(moves[i].end[1], corners[i + 1][1], 1e-9);
+  }
   EXPECT_EQ(r.moves, 4u);
   EXPECT_NEAR(r.feed_bound_s, 4.0, 1e-9);
   EXPECT_NEAR(r.exact_stop_bound_s, 4.0 + 4 * 0.01, 1e-9);
