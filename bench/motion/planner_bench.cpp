@@ -4,12 +4,20 @@
 // same programs on the same limits (through /work/shared/tools/linuxcnc-bench/run.sh, in real
 // time, when it is there). Programs and INIs are generated (planner_programs.cpp).
 //
+// For a program with a dense blended path (the raster's rows, the circle's chords, the cut of
+// 3D_Chips) it also prints the path alone against its own feed-limited bound and the floors of
+// path_floor.hpp: the time from the start of its first move to the end of its last within the
+// whole program (from the simulation's per-move start times), and the path run alone from
+// rest where it starts (a program of its lines after G92), on cncd and LinuxCNC.
+//
 //   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH]
 //
 // A benchmark: it prints figures and never fails on them.
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -17,8 +25,10 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "path_floor.hpp"
 #include "plan_sim.hpp"
 #include "planner_programs.hpp"
 
@@ -69,6 +79,116 @@ double worst_ratio(const cncd::config::MachineConfig& machine, const cncd::motio
   }
   return worst;
 }
+
+struct Bench {
+  const cncd::config::MachineConfig& machine;
+  fs::path dir;
+  bool linuxcnc = false;
+  std::string run_sh;
+  fs::path lcnc_ini;
+
+  cncd::daemon::PlanSimResult simulate(const fs::path& program,
+                                       std::vector<cncd::motion::Segment>* path_moves = nullptr,
+                                       int first_line = 0, int last_line = 0) const {
+    cncd::daemon::PlanSimOptions options;
+    options.interp = cncd::daemon::interpreter_options(machine);
+    options.start_machine = cncd::interp::Pose{};
+    if (path_moves != nullptr)
+      options.on_move = [&](const cncd::motion::Segment& move) {
+        if (move.line >= first_line && move.line <= last_line) path_moves->push_back(move);
+      };
+    return cncd::daemon::simulate_plan(machine, program, options);
+  }
+
+  std::optional<LinuxcncRun> linuxcnc_run(const fs::path& program) const {
+    if (!linuxcnc) return std::nullopt;
+    std::fflush(stdout);
+    const fs::path log = dir / (program.stem().string() + ".linuxcnc.log");
+    return run_linuxcnc(run_sh, lcnc_ini, program, log);
+  }
+
+  void whole(const cncd::bench::BenchProgram& program, const cncd::daemon::PlanSimResult& r) const {
+    const double moves = static_cast<double>(r.moves);
+    std::printf("  whole program\n    cncd      cycle %.3f s  feed bound %.3f s  ratio %.4f",
+                r.cycle_time_s, r.feed_bound_s, r.cycle_time_s / r.feed_bound_s);
+    if (program.exact_stop)
+      std::printf("  exact-stop bound %.3f s  ratio %.4f", r.exact_stop_bound_s,
+                  r.cycle_time_s / r.exact_stop_bound_s);
+    std::printf(
+        "\n              peak v %.3f %%  peak a %.3f %% (worst axis, of its limit)  "
+        "X/Y/Z a %.1f/%.1f/%.1f %%  max deviation %.4f mm\n",
+        100 * worst_ratio(machine, r.peak_velocity, false),
+        100 * worst_ratio(machine, r.peak_acceleration, true),
+        100 * r.peak_acceleration[0] / machine.axes[0].max_acceleration,
+        100 * r.peak_acceleration[1] / machine.axes[1].max_acceleration,
+        100 * r.peak_acceleration[2] / machine.axes[2].max_acceleration, r.max_deviation);
+    std::printf(
+        "              %zu moves; CPU per move: planner %.3f us, servo loop %.3f us "
+        "(%.3f us per period); simulated in %.2f s\n",
+        r.moves, r.planner_cpu_s * 1e6 / moves, r.servo_cpu_s * 1e6 / moves,
+        r.servo_cpu_s * 1e6 / static_cast<double>(r.cycles), r.wall_s);
+    if (const auto l = linuxcnc_run(program.path)) {
+      std::printf("    LinuxCNC  run %.3f s (moving %.3f s)  ratio %.4f", l->run_s, l->moving_s,
+                  l->run_s / r.feed_bound_s);
+      if (program.exact_stop)
+        std::printf("  over exact-stop bound %.4f", l->run_s / r.exact_stop_bound_s);
+      std::printf("  cncd/LinuxCNC %.4f\n", r.cycle_time_s / l->run_s);
+    }
+  }
+
+  // The dense path: within the program (per-move start times) and alone, on both controllers.
+  void path(const cncd::bench::BenchProgram& program, const cncd::daemon::PlanSimResult& r,
+            const std::vector<cncd::motion::Segment>& moves) const {
+    std::size_t first = r.move_line.size();
+    std::size_t last = 0;
+    for (std::size_t i = 0; i < r.move_line.size(); ++i) {
+      if (r.move_line[i] == program.path_first_line && first == r.move_line.size()) first = i;
+      if (r.move_line[i] == program.path_last_line) last = i;
+    }
+    if (moves.empty() || first >= r.move_line.size() || last < first) {
+      std::printf("  path: lines %d..%d not found among the moves\n", program.path_first_line,
+                  program.path_last_line);
+      return;
+    }
+    const double end_s =
+        last + 1 < r.move_start_s.size() ? r.move_start_s[last + 1] : r.cycle_time_s;
+    const double in_program_s = end_s - r.move_start_s[first];
+    const auto floors = cncd::bench::path_floors(machine, moves);
+    std::printf(
+        "  blended path alone: lines %d..%d, %zu moves, %.1f mm\n"
+        "    feed bound %.3f s   start/stop floor %.3f s (%.4f x bound)   exact-path floor %.3f s "
+        "(%.4f x bound)\n",
+        program.path_first_line, program.path_last_line, moves.size(), floors.length,
+        floors.bound_s, floors.start_stop_s, floors.start_stop_s / floors.bound_s,
+        floors.exact_path_s, floors.exact_path_s / floors.bound_s);
+    const auto ratios = [&floors](const char* who, const char* how, double s) {
+      std::printf(
+          "    %-9s %-18s %.3f s  ratio %.4f  over start/stop floor %.4f  "
+          "over exact-path floor %.4f\n",
+          who, how, s, s / floors.bound_s, s / floors.start_stop_s, s / floors.exact_path_s);
+    };
+    ratios("cncd", "in the program", in_program_s);
+    const fs::path alone = cncd::bench::write_path_alone(program, dir, moves.front().start);
+    if (alone.empty()) {
+      std::printf("    (cannot write the path alone)\n");
+      return;
+    }
+    const auto a = simulate(alone);
+    if (!a.complete()) {
+      std::printf("    cncd alone: %s\n",
+                  (a.error ? a.error->to_string() : a.stopped->to_string()).c_str());
+      return;
+    }
+    ratios("cncd", "alone", a.cycle_time_s);
+    if (std::abs(a.feed_bound_s - floors.bound_s) > 1e-6 * floors.bound_s)
+      std::printf("    (the path alone's feed bound is %.3f s)\n", a.feed_bound_s);
+    if (const auto l = linuxcnc_run(alone)) {
+      ratios("LinuxCNC", "alone (moving)", l->moving_s);
+      std::printf("    cncd/LinuxCNC alone %.4f (LinuxCNC run, cycle start to idle, %.3f s)\n",
+                  a.cycle_time_s / l->moving_s, l->run_s);
+    }
+  }
+};
 
 }  // namespace
 
@@ -127,47 +247,19 @@ int main(int argc, char** argv) {
       "machine: X/Y 200 mm/s 2000 mm/s^2, Z 100 mm/s 1000 mm/s^2, 1 ms servo period (%s)\n"
       "files in %s\n\n",
       build, dir.c_str());
+  const Bench bench{machine, dir, linuxcnc, run_sh, lcnc_ini};
   for (const auto& program : programs) {
-    cncd::daemon::PlanSimOptions options;
-    options.interp = cncd::daemon::interpreter_options(machine);
-    options.start_machine = cncd::interp::Pose{};
-    const auto r = cncd::daemon::simulate_plan(machine, program.path, options);
     std::printf("%s  (%s)\n", program.name.c_str(), program.path.filename().c_str());
+    std::vector<cncd::motion::Segment> path_moves;
+    const auto r =
+        bench.simulate(program.path, &path_moves, program.path_first_line, program.path_last_line);
     if (!r.complete()) {
       std::printf("  cncd: %s\n\n",
                   (r.error ? r.error->to_string() : r.stopped->to_string()).c_str());
       continue;
     }
-    const double moves = static_cast<double>(r.moves);
-    std::printf("  cncd      cycle %.3f s  feed bound %.3f s  ratio %.4f", r.cycle_time_s,
-                r.feed_bound_s, r.cycle_time_s / r.feed_bound_s);
-    if (program.exact_stop)
-      std::printf("  exact-stop bound %.3f s  ratio %.4f", r.exact_stop_bound_s,
-                  r.cycle_time_s / r.exact_stop_bound_s);
-    std::printf(
-        "\n            peak v %.3f %%  peak a %.3f %% (worst axis, of its limit)  "
-        "X/Y/Z a %.1f/%.1f/%.1f %%  max deviation %.4f mm\n",
-        100 * worst_ratio(machine, r.peak_velocity, false),
-        100 * worst_ratio(machine, r.peak_acceleration, true),
-        100 * r.peak_acceleration[0] / machine.axes[0].max_acceleration,
-        100 * r.peak_acceleration[1] / machine.axes[1].max_acceleration,
-        100 * r.peak_acceleration[2] / machine.axes[2].max_acceleration, r.max_deviation);
-    std::printf(
-        "            %zu moves; CPU per move: planner %.3f us, servo loop %.3f us "
-        "(%.3f us per period); simulated in %.2f s\n",
-        r.moves, r.planner_cpu_s * 1e6 / moves, r.servo_cpu_s * 1e6 / moves,
-        r.servo_cpu_s * 1e6 / static_cast<double>(r.cycles), r.wall_s);
-    if (linuxcnc) {
-      std::fflush(stdout);
-      const fs::path log = dir / (program.path.stem().string() + ".linuxcnc.log");
-      if (const auto l = run_linuxcnc(run_sh, lcnc_ini, program.path, log)) {
-        std::printf("  LinuxCNC  run %.3f s (moving %.3f s)  ratio %.4f", l->run_s, l->moving_s,
-                    l->run_s / r.feed_bound_s);
-        if (program.exact_stop)
-          std::printf("  over exact-stop bound %.4f", l->run_s / r.exact_stop_bound_s);
-        std::printf("  cncd/LinuxCNC %.4f\n", r.cycle_time_s / l->run_s);
-      }
-    }
+    bench.whole(program, r);
+    if (program.path_first_line > 0) bench.path(program, r, path_moves);
     std::printf("\n");
     std::fflush(stdout);
   }

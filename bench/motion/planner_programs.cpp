@@ -1,5 +1,6 @@
 #include "planner_programs.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -42,58 +43,132 @@ std::string axis_section(char letter, bool joint, int index) {
   return out.str();
 }
 
-// Z over the surfacing raster: gentle enough that full feed stays within Z's limits.
+// Lines of a program, numbered as the interpreter numbers them (from 1).
+struct Program {
+  std::vector<std::string> lines;
+  int add(std::string line) {
+    lines.push_back(std::move(line));
+    return static_cast<int>(lines.size());
+  }
+  void write(const fs::path& path) const {
+    std::ofstream out(path);
+    for (const auto& line : lines)
+      out << line << "\n";
+  }
+};
+
+constexpr const char* kModes = "G21 G17 G40 G49 G80 G90 G94 G54";
+
+// Z over the surfacing raster, a gentle wave: z = -1 + 0.5 sin(2 pi x / 20) cos(2 pi y / 30).
+// Along a row at F6000 (100 mm/s) Z moves at most 0.5 (2 pi / 20) 100 = 15.7 mm/s (limit 100)
+// and accelerates at most 0.5 (2 pi / 20)^2 100^2 = 493 mm/s^2 (limit 1000); the path tilts at
+// most atan(0.157) = 8.9 degrees from X, where X allows 200 / cos(8.9) mm/s. The blend arcs
+// between the 0.1 mm chords have a radius of about 1 / curvature = 1 / 0.049 = 20 mm, whose
+// speed limit in the XZ plane, sqrt(0.95 1000 20) = 138 mm/s, is above the feed: the limits
+// allow the full feed all along the rows. At x = 0 and 100 z = -1 for every y: the step-overs
+// move Y alone.
 double surface_z(double x, double y) {
   return -1.0 +
          0.5 * std::sin(2 * std::numbers::pi * x / 20) * std::cos(2 * std::numbers::pi * y / 30);
 }
 
-// (a) rows of 0.1 mm G1 segments along X over a 40 x 10 mm patch, 0.5 mm step-over.
-void write_raster(const fs::path& path, int feed) {
-  std::ofstream out(path);
-  out << "(planner bench: 3D surfacing raster, 0.1 mm G1 segments, F" << feed << ", G64)\n"
-      << "G21 G17 G40 G49 G80 G90 G94 G54\nG64\nG0 Z5\nG0 X0 Y0\nG1 Z" << number(surface_z(0, 0))
-      << " F" << feed << "\n";
+// (a) 3D surfacing: 21 rows of 1000 G1 segments of 0.1 mm along X over a 100 x 10 mm patch,
+// 0.5 mm step-over, rows alternating in direction; the path is the rows and step-overs.
+BenchProgram write_raster(const fs::path& path, const std::string& name, int feed,
+                          const std::string& blend) {
   constexpr int kRows = 21;
-  constexpr int kSteps = 400;
+  constexpr int kSteps = 1000;
+  BenchProgram program{name, path};
+  Program p;
+  p.add("(planner bench: 3D surfacing raster, 100 x 10 mm, 21 rows of 0.1 mm G1 segments, F" +
+        std::to_string(feed) + ", " + blend + ")");
+  p.add(kModes);
+  program.prelude_lines = p.add(blend);
+  p.add("G0 Z5");
+  p.add("G0 X0 Y0");
+  p.add("G1 Z" + number(surface_z(0, 0)) + " F" + std::to_string(feed));
   for (int row = 0; row < kRows; ++row) {
     const double y = 0.5 * row;
-    if (row > 0) out << "Y" << number(y) << " Z" << number(surface_z(row % 2 ? 40 : 0, y)) << "\n";
+    if (row > 0) p.add("Y" + number(y) + " Z" + number(surface_z(row % 2 ? 100 : 0, y)));
     for (int k = 1; k <= kSteps; ++k) {
       const double x = 0.1 * (row % 2 ? kSteps - k : k);
-      out << "X" << number(x) << " Z" << number(surface_z(x, y)) << "\n";
+      const std::string move = "X" + number(x) + " Z" + number(surface_z(x, y));
+      const int line =
+          p.add(row == 0 && k == 1 ? "G1 " + move + " F" + std::to_string(feed) : move);
+      if (row == 0 && k == 1) program.path_first_line = line;
+      program.path_last_line = line;
     }
   }
-  out << "G0 Z5\nM2\n";
+  p.add("G0 Z5");
+  p.add("M2");
+  p.write(path);
+  return program;
 }
 
-// (b) a circle of 0.1 mm chords at F9000: radius 30 mm keeps the centripetal acceleration at
-// 150^2 / 30 = 750 mm/s^2, well within 2000.
-void write_circle(const fs::path& path) {
-  std::ofstream out(path);
+// (b) a circle of R30 mm in 0.1 mm chords at F9000, `laps` times round in one G1 chain, after
+// a 30 mm rapid and a 1 mm plunge: the centripetal acceleration 150^2 / 30 = 750 mm/s^2 is
+// well within 2000, so the limits allow the full feed all round.
+BenchProgram write_circle(const fs::path& path, const std::string& name, int laps) {
   constexpr double kRadius = 30;
   const int chords = static_cast<int>(std::round(2 * std::numbers::pi * kRadius / 0.1));
-  out << "(planner bench: circle R30 of " << chords << " chords of 0.1 mm, F9000, G64)\n"
-      << "G21 G17 G40 G49 G80 G90 G94 G54\nG64\nG0 Z1\nG0 X" << number(kRadius)
-      << " Y0\nG1 Z0 F9000\n";
-  for (int i = 1; i <= chords; ++i) {
-    const double t = 2 * std::numbers::pi * i / chords;
-    out << "X" << number(kRadius * std::cos(t)) << " Y" << number(kRadius * std::sin(t)) << "\n";
+  BenchProgram program{name, path};
+  Program p;
+  p.add("(planner bench: circle R30 of " + std::to_string(chords) + " chords of 0.1 mm, " +
+        std::to_string(laps) + (laps == 1 ? " lap" : " laps") + ", F9000, G64)");
+  p.add(kModes);
+  program.prelude_lines = p.add("G64");
+  p.add("G0 Z1");
+  p.add("G0 X" + number(kRadius) + " Y0");
+  p.add("G1 Z0 F9000");
+  for (int i = 1; i <= chords * laps; ++i) {
+    const double t = 2 * std::numbers::pi * (i % chords) / chords;
+    const std::string move =
+        "X" + number(kRadius * std::cos(t)) + " Y" + number(kRadius * std::sin(t));
+    const int line = p.add(i == 1 ? "G1 " + move + " F9000" : move);
+    if (i == 1) program.path_first_line = line;
+    program.path_last_line = line;
   }
-  out << "G0 Z1\nM2\n";
+  p.add("G0 Z1");
+  p.add("M2");
+  p.write(path);
+  return program;
 }
 
 // (c) a 6 x 5 grid: G81 rows (G99 and G98) and G83 peck rows.
 void write_drilling(const fs::path& path) {
   std::ofstream out(path);
   out << "(planner bench: drilling grid, G81 and G83)\n"
-      << "G21 G17 G40 G49 G80 G90 G94 G54\nG0 Z10\nG0 X0 Y0\n"
+      << kModes << "\nG0 Z10\nG0 X0 Y0\n"
       << "G99 G81 X0 Y0 Z-5 R2 F600\nX10\nX20\nX30\nX40\nX50\n"
       << "G98 G81 X50 Y10 Z-4 R1 F900\nX40\nX30\nX20\nX10\nX0\n"
       << "G99 G83 X0 Y20 Z-8 R2 Q2 F600\nX10\nX20\nX30\nX40\nX50\n"
       << "G98 G83 X50 Y30 Z-6 R2 Q1.5 F900\nX40\nX30\nX20\nX10\nX0\n"
       << "G99 G81 X0 Y40 Z-3 R1 F1200\nX10\nX20\nX30\nX40\nX50\n"
       << "G80 G0 Z10\nM2\n";
+}
+
+// (d) LinuxCNC's sample as it is; its dense path is the cut from N110 (after the plunge) to
+// N6901 (before the retract), and the lines before N50 (the tool change) set its modes.
+BenchProgram chips_program(const fs::path& chips_ngc) {
+  BenchProgram program{"(d) 3D_Chips.ngc", chips_ngc};
+  // The line's block number is `word` (N110, not N1100).
+  const auto numbered = [](const std::string& line, const std::string& word) {
+    return line.rfind(word, 0) == 0 &&
+           (line.size() == word.size() ||
+            !std::isdigit(static_cast<unsigned char>(line[word.size()])));
+  };
+  std::ifstream in(chips_ngc);
+  int count = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++count;
+    if (numbered(line, "N50") && program.prelude_lines == 0) program.prelude_lines = count - 1;
+    if (numbered(line, "N110")) program.path_first_line = count;
+    if (numbered(line, "N6901")) program.path_last_line = count;
+  }
+  if (program.prelude_lines == 0 || program.path_first_line == 0 ||
+      program.path_last_line < program.path_first_line)
+    program.path_first_line = program.path_last_line = 0;
+  return program;
 }
 
 }  // namespace
@@ -168,17 +243,41 @@ fs::path write_linuxcnc_ini(const fs::path& dir, const fs::path& axis_mm_ini, st
 
 std::vector<BenchProgram> write_programs(const fs::path& dir, const fs::path& chips_ngc) {
   std::vector<BenchProgram> programs;
-  programs.push_back({"(a) raster F3000", dir / "raster_f3000.ngc"});
-  write_raster(programs.back().path, 3000);
-  programs.push_back({"(a) raster F6000", dir / "raster_f6000.ngc"});
-  write_raster(programs.back().path, 6000);
-  programs.push_back({"(b) circle F9000", dir / "circle_f9000.ngc"});
-  write_circle(programs.back().path);
+  programs.push_back(write_raster(dir / "raster_f3000.ngc", "(a) raster F3000", 3000, "G64"));
+  programs.push_back(write_raster(dir / "raster_f6000.ngc", "(a) raster F6000", 6000, "G64"));
+  programs.push_back(write_raster(dir / "raster_f6000_p005.ngc", "(a) raster F6000 under G64 P0.05",
+                                  6000, "G64 P0.05"));
+  programs.push_back(write_circle(dir / "circle_f9000.ngc", "(b) circle F9000, 10 laps", 10));
+  programs.push_back(write_circle(dir / "circle_f9000_1lap.ngc", "(b) circle F9000, 1 lap", 1));
   programs.push_back({"(c) G81/G83 grid", dir / "drill_grid.ngc", true});
   write_drilling(programs.back().path);
   std::error_code ec;
-  if (fs::exists(chips_ngc, ec)) programs.push_back({"(d) 3D_Chips.ngc", chips_ngc});
+  if (fs::exists(chips_ngc, ec)) programs.push_back(chips_program(chips_ngc));
   return programs;
+}
+
+fs::path write_path_alone(const BenchProgram& program, const fs::path& dir,
+                          const motion::AxisPose& start) {
+  std::ifstream in(program.path);
+  const fs::path path = dir / (program.path.stem().string() + "_path.ngc");
+  std::ofstream out(path);
+  out << "(planner bench: the dense path of " << program.path.filename().string()
+      << " alone, from rest where it starts)\n";
+  int count = 0;
+  bool ended = false;
+  for (std::string line; std::getline(in, line);) {
+    ++count;
+    if (count == program.prelude_lines + 1)
+      out << "G92 X" << number(start[0]) << " Y" << number(start[1]) << " Z" << number(start[2])
+          << "\n";
+    if (count <= program.prelude_lines ||
+        (count >= program.path_first_line && count <= program.path_last_line))
+      out << line << "\n";
+    ended = count >= program.path_last_line;
+  }
+  out << "G92.1\nM2\n";
+  if (!ended || !out) return {};
+  return path;
 }
 
 }  // namespace cncd::bench

@@ -8,12 +8,20 @@
 #include <string>
 #include <vector>
 
+#include "cncd/motion/types.hpp"
+
 namespace cncd::bench {
 
 struct BenchProgram {
   std::string name;
   std::filesystem::path path;
   bool exact_stop = false;  // canned cycles: judge against the exact-stop bound
+  // The dense blended path: the program's lines path_first_line to path_last_line (0: none);
+  // the first of them names its motion mode and feed, and the program's first prelude_lines
+  // lines set the modes it runs in.
+  int path_first_line = 0;
+  int path_last_line = 0;
+  int prelude_lines = 0;
 };
 
 // Writes the cncd INI (sim drives) into `dir`; returns its path.
@@ -26,5 +34,11 @@ std::filesystem::path write_linuxcnc_ini(const std::filesystem::path& dir,
 // Writes the generated programs into `dir` and lists them with 3D_Chips.ngc (when found).
 std::vector<BenchProgram> write_programs(const std::filesystem::path& dir,
                                          const std::filesystem::path& chips_ngc);
+// Writes `program`'s dense path alone into `dir` (<stem>_path.ngc): its prelude, G92 making
+// `start` (where the path starts, program units) the current position wherever the machine
+// stands, the path's lines, G92.1 and M2. Returns its path, empty when it cannot.
+std::filesystem::path write_path_alone(const BenchProgram& program,
+                                       const std::filesystem::path& dir,
+                                       const motion::AxisPose& start);
 
 }  // namespace cncd::bench
