@@ -10,7 +10,10 @@
 // whole program (from the simulation's per-move start times), and the path run alone from
 // rest where it starts (a program of its lines after G92), on cncd and LinuxCNC.
 //
-//   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH]
+//   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] [--jerk J]
+//
+// --jerk J runs cncd with S-curve profiles ([TRAJ] MAX_LINEAR_JERK = J mm/s^3) and without
+// LinuxCNC, whose 2.9 planner has none (the floors stay those of trapezoids).
 //
 // A benchmark: it prints figures and never fails on them.
 #include <sys/wait.h>
@@ -195,6 +198,7 @@ struct Bench {
 int main(int argc, char** argv) {
   bool linuxcnc = true;
   bool keep = false;
+  double jerk = 0;
   std::string run_sh = kRunSh;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -204,8 +208,13 @@ int main(int argc, char** argv) {
       keep = true;
     } else if (arg == "--run-sh" && i + 1 < argc) {
       run_sh = argv[++i];
+    } else if (arg == "--jerk" && i + 1 < argc && std::atof(argv[i + 1]) >= 1) {
+      jerk = std::atof(argv[++i]);
+      linuxcnc = false;
     } else {
-      std::fprintf(stderr, "usage: cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH]\n");
+      std::fprintf(stderr,
+                   "usage: cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] "
+                   "[--jerk J (>= 1 mm/s^3)]\n");
       return 64;
     }
   }
@@ -222,7 +231,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s\n", problem.to_string().c_str());
     return 1;
   }
-  const auto& machine = *loaded.config;
+  auto machine = *loaded.config;
+  if (jerk > 0) {
+    machine.max_linear_jerk = jerk;
+    machine.scurve = true;
+  }
   const auto programs = cncd::bench::write_programs(dir, kChips);
   std::error_code ec;
   std::string lcnc_error;
@@ -244,8 +257,12 @@ int main(int argc, char** argv) {
   const char* build = "debug build: CPU figures are pessimistic";
 #endif
   std::printf(
-      "machine: X/Y 200 mm/s 2000 mm/s^2, Z 100 mm/s 1000 mm/s^2, 1 ms servo period (%s)\n"
+      "machine: X/Y 200 mm/s 2000 mm/s^2, Z 100 mm/s 1000 mm/s^2, 1 ms servo period, %s (%s)\n"
       "files in %s\n\n",
+      jerk > 0
+          ? ("S-curve profiles, path jerk " + std::to_string(static_cast<long>(jerk)) + " mm/s^3")
+                .c_str()
+          : "trapezoidal profiles",
       build, dir.c_str());
   const Bench bench{machine, dir, linuxcnc, run_sh, lcnc_ini};
   for (const auto& program : programs) {
