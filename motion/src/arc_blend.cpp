@@ -156,11 +156,11 @@ std::optional<Fit> fit(const Side& in, const Side& out, double sigma, double r, 
   return best;
 }
 
-// The largest fillet radius that fits (grown by factors of 4, then bisected), at most 1000
-// times the path length it may take from both moves. Where an arc curves back towards the
-// line it kinks away from, every radius fits and the fillet tends to a straight line: the cap
-// keeps its centre near enough for its points to be exact to far below a micrometre (and a
-// radius that large no longer limits the speed).
+// The largest fillet radius that fits (grown by factors of 4, then bisected to a millionth),
+// at most 1000 times the path length it may take from both moves. Where an arc curves back
+// towards the line it kinks away from, every radius fits and the fillet tends to a straight
+// line: the cap keeps its centre near enough for its points to be exact to far below a
+// micrometre (and a radius that large no longer limits the speed).
 std::optional<std::pair<double, Fit>> largest_fit(const Side& in, const Side& out, double sigma,
                                                   double tolerance) {
   const double cap = 1e3 * (in.limit + out.limit);
@@ -176,7 +176,7 @@ std::optional<std::pair<double, Fit>> largest_fit(const Side& in, const Side& ou
     best = {r, *f};
   }
   if (!best || hi == 0) return best;
-  for (int k = 0; k < 60 && hi - lo > 1e-10 * hi; ++k) {
+  for (int k = 0; k < 60 && hi - lo > 1e-6 * hi; ++k) {
     const double mid = 0.5 * (lo + hi);
     if (const auto f = fit(in, out, sigma, mid, tolerance)) {
       lo = mid;
