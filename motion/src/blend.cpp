@@ -1,7 +1,9 @@
 // The planner's look-ahead: holding the newest move back until the next one shows how the two
 // join, marking tangent junctions and rounding G64 line-line corners with a blend arc.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
 
 #include "cncd/motion/planner.hpp"
 
@@ -271,26 +273,66 @@ void Planner::reserve_for_kink(Segment& seg) {
 }
 
 void Planner::set_blend_limits(Segment& blend) const {
-  // Per axis the arc's velocity and acceleration are at most their in-plane size times
-  // w = |(u_i, v_i)|, the axis's share of the plane.
+  // Along the arc, axis i's share of the unit tangent is T_i = w cos(phi + alpha) and of the
+  // unit normal (towards the centre) N_i = -w sin(phi + alpha), w = |(u_i, v_i)| its share of
+  // the plane. Two bounds hold for its acceleration a_t T_i + a_n N_i: the orthogonal one,
+  // sqrt(a_t^2 + a_n^2) w, and the sum of the parts' largest sizes over the sweep,
+  // a_t max|T_i| + a_n max|N_i|, which on a short arc is far below the first when the
+  // tangent and the normal lie along different axes (a slope's blend: the tangent along X,
+  // the normal along Z). The sum bound is taken where it is the better of the two.
   double v = 1e300;
-  double plane_a = 1e300;
+  double plane_a = 1e300;   // orthogonal bound: the plane's acceleration limit
+  double normal_a = 1e300;  // the centripetal acceleration every axis allows alone
+  std::array<double, kAxes> max_t{}, max_n{};
   bool linear = false;
+  const double sweep = std::abs(blend.sweep);
+  // Largest |cos| over [x, x + sweep].
+  auto max_cos = [sweep](double x) {
+    const double pi = std::numbers::pi;
+    const double first_peak = std::ceil(x / pi) * pi;  // the first multiple of pi from x on
+    if (first_peak <= x + sweep) return 1.0;
+    return std::max(std::abs(std::cos(x)), std::abs(std::cos(x + sweep)));
+  };
   for (int i = 0; i < kAxes; ++i) {
     const double w = std::hypot(blend.blend_u[i], blend.blend_v[i]);
     if (w <= 1e-12) continue;
     const auto& axis = config_.axes[static_cast<std::size_t>(i)];
-    v = std::min(v, axis.max_velocity / w);
+    const double alpha = std::atan2(blend.blend_u[i], blend.blend_v[i]);
+    const auto k = static_cast<std::size_t>(i);
+    max_t[k] = w * max_cos(alpha);
+    max_n[k] = w * max_cos(alpha - std::numbers::pi / 2);
+    if (max_t[k] > 1e-12) v = std::min(v, axis.max_velocity / max_t[k]);
+    if (max_n[k] > 1e-12) normal_a = std::min(normal_a, axis.max_acceleration / max_n[k]);
     plane_a = std::min(plane_a, axis.max_acceleration / w);
     linear = linear || i < 3;
   }
   if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
   const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
-  double a = 0;
-  curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v, a);
-  blend.axis_velocity = v;
-  blend.max_velocity = blend.feed > 0 ? std::min(v, blend.feed) : v;
-  blend.max_acceleration = a;
+  double v_orthogonal = v;
+  double a_orthogonal = 0;
+  curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v_orthogonal, a_orthogonal);
+  // The sum bound: the centripetal part takes what the fastest speed needs (at most the share
+  // of what every axis allows), the tangential part what each axis has left.
+  double v_sum = v;
+  double centripetal = fastest * fastest / blend.radius;
+  if (centripetal >= kBlendNormalShare * normal_a) {
+    centripetal = kBlendNormalShare * normal_a;
+    v_sum = std::min(v_sum, std::sqrt(centripetal * blend.radius));
+  }
+  double a_sum = 1e300;
+  for (int i = 0; i < kAxes; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (max_t[k] <= 1e-12) continue;
+    const double left = config_.axes[k].max_acceleration - centripetal * max_n[k];
+    a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
+  }
+  // Only where it allows both as much speed and more acceleration: a blend left with little
+  // tangential acceleration would slow everything that has to brake through it.
+  const bool sum_better = v_sum >= v_orthogonal * (1 - 1e-12) && a_sum > a_orthogonal;
+  blend.axis_velocity = sum_better ? v_sum : v_orthogonal;
+  blend.max_velocity =
+      blend.feed > 0 ? std::min(blend.axis_velocity, blend.feed) : blend.axis_velocity;
+  blend.max_acceleration = sum_better ? a_sum : a_orthogonal;
 }
 
 }  // namespace cncd::motion

@@ -93,5 +93,36 @@ TEST(BlendGeometry, StraightOnIsTangentAndReversalsStop) {
   EXPECT_FALSE(out[0].continuous);
 }
 
+// A blend between two lines along X that bend slightly in Z (a sloped surface): the arc's
+// tangent lies along X and its normal along Z, so the tangential acceleration is X's (2000),
+// not the plane's weakest axis (Z, 1000), while every axis stays within its limit with the
+// centripetal part included; a blend in XY, where both axes carry both parts, keeps the
+// orthogonal split.
+TEST(BlendGeometry, ASlopeBlendKeepsTheTangentAxisAcceleration) {
+  const auto config = small_mill();
+  const auto slope = corner(AxisPose{10, 0, 0.2}, AxisPose{20, 0, 0}, 0.01);
+  ASSERT_EQ(slope.size(), 3u);
+  const Segment& arc = slope[1];
+  ASSERT_EQ(arc.kind, Segment::Kind::blend);
+  EXPECT_GT(arc.max_acceleration, 1900);
+  // The worst case over the sweep: tangential along X at most 2000, and Z's share of the
+  // tangential plus the centripetal part at the arc's speed limit within Z's 1000.
+  const double speed = std::min(arc.axis_velocity, 100.0 * config.max_feed_override);
+  const double a_n = speed * speed / arc.radius;
+  for (double f = 0; f <= 1.0; f += 0.125) {
+    const double phi = arc.sweep * f;
+    for (int i = 0; i < 3; ++i) {
+      const double t = -std::sin(phi) * arc.blend_u[i] + std::cos(phi) * arc.blend_v[i];
+      const double n = -(std::cos(phi) * arc.blend_u[i] + std::sin(phi) * arc.blend_v[i]);
+      EXPECT_LE(std::abs(arc.max_acceleration * t) + std::abs(a_n * n),
+                config.axes[static_cast<std::size_t>(i)].max_acceleration * (1 + 1e-9))
+          << "axis " << i << " at " << f;
+    }
+  }
+  const auto flat = corner(AxisPose{10, 0, 0}, AxisPose{20, 10, 0}, 0.5);
+  ASSERT_EQ(flat.size(), 3u);
+  EXPECT_LE(flat[1].max_acceleration, 2000);
+}
+
 }  // namespace
 }  // namespace cncd::test
