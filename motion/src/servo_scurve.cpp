@@ -98,6 +98,19 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
   return true;
 }
 
+bool ServoLoop::eases_in_time(double v, double a, double ds) const noexcept {
+  const double jerk = kPlanJerkShare * jerk_;
+  for (int k = 0; k < limit_count_; ++k) {
+    const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
+    const double excess = -a - limit.accel;
+    if (excess <= 0) continue;
+    const double room = limit.distance - ds + kDistanceSlack;
+    const double t = excess / jerk;
+    if (room < 0 || t * (v + t * (a / 2.0 + jerk * t / 6.0)) > room) return false;
+  }
+  return true;
+}
+
 void ServoLoop::scurve_step(double& dt) noexcept {
   const Segment& head = window_at(head_seq_);
   const double accel = head.max_acceleration;
@@ -153,6 +166,24 @@ void ServoLoop::scurve_step(double& dt) noexcept {
       a_next = high;
     }
     if (!keeps_hard(a_next)) a_next = keeps_hard(lo) ? highest(lo, a_next, keeps_hard) : lo;
+    // Never brake harder than a segment ahead allows by the time it is reached (dropping the
+    // deceleration at a segment's start is a jump), unless easing off would break an axis
+    // limit.
+    const auto eases = [&](double x) {
+      const scurve::Step step = scurve::integrate(v, a, x, dt);
+      return eases_in_time(step.velocity, step.acceleration, step.distance);
+    };
+    if (!eases(a_next)) {
+      double low = a_next;
+      double high = hi;
+      if (eases(hi)) {
+        for (int i = 0; i < kSearchSteps; ++i) {
+          const double mid = 0.5 * (low + high);
+          (eases(mid) ? high : low) = mid;
+        }
+      }
+      if (keeps_hard(high) || !keeps_hard(a_next)) a_next = high;
+    }
   }
   scurve::Step step = scurve::integrate(v, a, a_next, dt);
   dt = 0;

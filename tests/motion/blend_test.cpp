@@ -357,21 +357,20 @@ TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
   EXPECT_LT(periods[0] * 1.3, periods[1]) << periods[0] << " vs " << periods[1];
 }
 
-// The same random programs with S-curve profiles ([TRAJ] MAX_LINEAR_JERK): every axis within
-// its limits, every program ends exactly, and the path speed's acceleration changes by at most
-// the jerk limit per second while the path moves -- but for entries into a segment whose own
-// acceleration limit is below the deceleration (one in many thousand periods, within 2.1 x)
-// and the periods in which the path comes to rest (below 1 mm/s: it arrives between two
-// periods' ends).
+// The same random programs, and random contours of lines and arcs meeting at corners, with
+// S-curve profiles ([TRAJ] MAX_LINEAR_JERK): every axis within its limits, every program ends
+// exactly, and the path speed's acceleration changes by at most the jerk limit per second
+// while the path moves (not in the periods in which it comes to rest, below 1 mm/s: it
+// arrives between two periods' ends).
 TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
   std::mt19937 rng(4711);
   auto config = small_mill();
   config.scurve = true;
   config.max_linear_jerk = 40000;
   const double dt = 1e-3;
-  int moving = 0, over = 0;
-  for (int round = 0; round < 24; ++round) {
-    const Program prog = random_program(rng, 30);
+  int moving = 0;
+  for (int round = 0; round < 30; ++round) {
+    const Program prog = random_program(rng, 30, round % 2 == 1);
     VirtualMachine m(config);
     m.ready();
     const AxisPose start = m.status().commanded;
@@ -390,11 +389,10 @@ TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
       const double jerk = std::abs(speed[k] - 2 * speed[k - 1] + speed[k - 2]) / (dt * dt);
       if (std::min({speed[k], speed[k - 1], speed[k - 2]}) < 1.0) continue;
       ++moving;
-      if (jerk > config.max_linear_jerk * 1.001 + 1) ++over;
-      ASSERT_LE(jerk, config.max_linear_jerk * 2.1) << "period " << k;
+      ASSERT_LE(jerk, config.max_linear_jerk * 1.001 + 1) << "period " << k;
     }
   }
-  EXPECT_LE(over, moving / 1000) << over << " of " << moving << " periods";
+  EXPECT_GT(moving, 100000);
 }
 
 }  // namespace

@@ -118,6 +118,9 @@ class ServoLoop {
   // those ahead it can still slow down for.
   bool keeps_limits(double v_before, double a_before, double v, double a, double ds,
                     bool soft) const noexcept;
+  // Whether a deceleration `a` at speed `v`, `ds` further on, can ease off to every coming
+  // segment's own acceleration limit before reaching it.
+  bool eases_in_time(double v, double a, double ds) const noexcept;
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
