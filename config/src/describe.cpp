@@ -63,7 +63,9 @@ std::string describe(const MachineConfig& c) {
   line(out, "Trajectory:   max velocity " + num(c.max_linear_velocity) + " " + lu +
                 "/s, max acceleration " + num(c.max_linear_acceleration) + " " + lu +
                 "/s^2, default velocity " + num(c.default_linear_velocity) + " " + lu + "/s" +
-                (c.scurve ? ", S-curve with max jerk " + num(c.max_linear_jerk) + " " + lu + "/s^3"
+                (c.scurve ? ", S-curve with max jerk " + num(c.max_linear_jerk) + " " + lu +
+                                "/s^3 (trapezoids when an axis reaches its acceleration in "
+                                "under 20 servo periods)"
                           : ", trapezoidal profiles"));
   line(out, "Homing:       " + std::string(c.no_force_homing ? "not required before programs"
                                                              : "required before programs"));

@@ -33,7 +33,17 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config) {
   joint_axis_.fill(-1);
-  if (config.scurve) jerk_ = config.max_linear_jerk;
+  if (config.scurve) {
+    // The acceleration must take at least kMinRampPeriods servo periods to build up on every
+    // axis: steeper S-curves, which the period-by-period steps cannot follow within the axis
+    // limits, are planned as trapezoids (cncd --check-config says so).
+    double accel = 1e300;
+    for (const auto& axis : config.axes) {
+      if (axis.present && axis.max_acceleration > 0) accel = std::min(accel, axis.max_acceleration);
+    }
+    if (config.max_linear_jerk * period_s_ * kMinRampPeriods <= accel)
+      jerk_ = config.max_linear_jerk;
+  }
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
         config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);

@@ -176,6 +176,7 @@ class ServoLoop {
   double path_a_ = 0;  // S-curve profiles only
   // S-curve profiles: the path's jerk limit (0: trapezoidal profiles) and the limits ahead.
   double jerk_ = 0;
+  static constexpr double kMinRampPeriods = 20;
   struct SpeedLimit {
     double distance;  // from the path's position
     double soft;      // with the feed, the overrides and holds
