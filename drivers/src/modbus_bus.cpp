@@ -196,8 +196,10 @@ void ModbusBus::loop() {
     const bool connected = ctx_ != nullptr || connect();
     for (std::size_t i = 0; i < drives_.size(); ++i) {
       DriveState& s = state_[i];
-      Setpoint setpoint{};
-      setpoints_[i].try_load(setpoint);
+      // While the servo thread is storing, keep the setpoint of the last update: an empty one
+      // would disable the drive, send it to zero and pass for a reset request.
+      setpoints_[i].try_load(s.setpoint);
+      const Setpoint& setpoint = s.setpoint;
       if (setpoint.reset_request != s.reset_ack) {
         // An explicit reset (the servo turned the drives on again): forget the latched fault,
         // ask the drive to clear its own, and let setpoints through again.

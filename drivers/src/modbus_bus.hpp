@@ -94,6 +94,7 @@ class ModbusBus {
     bool latched = false;
     bool pulse_reset = false;
     std::uint32_t reset_ack = 0;
+    Setpoint setpoint{};  // the latest one loaded
     Readback last{};
   };
   void loop();

@@ -1,5 +1,6 @@
 // The modbus driver end to end over loopback TCP (and RTU on a pseudo-terminal pair) against
 // real libmodbus servers: the simulated drives of cncd-drive-sim, run in-process.
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <thread>
@@ -138,6 +139,67 @@ TEST_F(ModbusDriverTest, DriveFaultBitLatchesAndIsResetThroughTheControlWord) {
   servo(40, 0, 0, true);
   EXPECT_FALSE(feedback_[1].fault) << reason();
   EXPECT_EQ(sim_->status(11) & 4u, 0u);
+}
+
+// A servo thread that stores setpoints without pause: the bus thread often finds a store in
+// progress, and must then send the previous setpoint, never an empty one (target 0, drive
+// disabled) nor take it for a reset request.
+class BusyServo {
+ public:
+  BusyServo(ModbusDriver& driver, double x, double y)
+      : thread_([&driver, x, y, this] {
+          const JointCommand c[2] = {{x, 0, true}, {y, 0, true}};
+          while (!done_.load(std::memory_order_relaxed))
+            driver.write(c, 2);
+        }) {}
+  ~BusyServo() {
+    done_ = true;
+    thread_.join();
+  }
+  BusyServo(const BusyServo&) = delete;
+  BusyServo& operator=(const BusyServo&) = delete;
+
+ private:
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+TEST_F(ModbusDriverTest, SetpointsStoredWithoutPauseReachTheDriveWhole) {
+  start_sim();
+  start_driver();
+  servo(30, 1.234, -0.5, true);
+  ASSERT_EQ(sim_->target(10), 1234) << reason();
+  BusyServo busy(driver_, 1.234, -0.5);
+  const std::uint64_t writes = sim_->target_writes(10);
+  int wrong = 0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
+  while (std::chrono::steady_clock::now() < until) {
+    if (sim_->target(10) != 1234 || sim_->target(11) != -500 || (sim_->control(10) & 1u) == 0 ||
+        (sim_->control(11) & 1u) == 0) {
+      ++wrong;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+  EXPECT_GT(sim_->target_writes(10), writes + 20) << "the bus kept updating";
+  EXPECT_EQ(wrong, 0) << "the drives saw another target or lost their enable";
+  EXPECT_EQ(reason(), "");
+}
+
+TEST_F(ModbusDriverTest, ALatchedFaultStaysLatchedWhileSetpointsKeepComing) {
+  start_sim();
+  start_driver();
+  servo(30, 0.1, 0.2, true);
+  sim_->set_fault(11, true);
+  ASSERT_TRUE(servo_until([&] { return feedback_[1].fault; }, 2000, 0.1, 0.2, true));
+  sim_->set_fault(11, false);  // the drive could be reset now, but nobody asked
+  BusyServo busy(driver_, 0.1, 0.2);
+  const std::uint64_t writes = sim_->target_writes(11);
+  const std::uint64_t running = sim_->target_writes(10);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  EXPECT_GT(sim_->target_writes(10), running + 20) << "the other drive kept its updates";
+  EXPECT_EQ(sim_->target_writes(11), writes) << "no setpoints while the fault is latched";
+  EXPECT_EQ(sim_->control(11) & 3u, 0u) << "neither enabled nor reset";
+  EXPECT_NE(reason().find("slave 11"), std::string::npos) << reason();
 }
 
 TEST_F(ModbusDriverTest, ExceptionRepliesAndSilenceFault) {
