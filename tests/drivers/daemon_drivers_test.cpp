@@ -118,7 +118,7 @@ json run_example(const TempDir& dir, const std::string& ini) {
   result(client.call("program.run"));
   wait_until([](const json& s) { return s["exec"] == "idle"; });
   // Let the drives settle onto the last command.
-  return wait_until([](const json& s) {
+  json settled = wait_until([](const json& s) {
     const auto& a = s["position"]["actual"];
     const auto& c = s["position"]["commanded"];
     for (const char* axis : {"x", "y", "z"}) {
@@ -126,6 +126,9 @@ json run_example(const TempDir& dir, const std::string& ini) {
     }
     return true;
   });
+  // A clean stop, so that the drivers close what they write (a recording's last transitions).
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
+  return settled;
 }
 
 // The example INI with its files redirected into `dir`.

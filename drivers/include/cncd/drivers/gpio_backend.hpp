@@ -70,7 +70,7 @@ class VcdBackend final : public GpioBackend {
     std::uint32_t output;
     std::uint32_t level;
   };
-  static constexpr std::size_t kRingSize = 1u << 16;
+  static constexpr std::size_t kRingSize = 1u << 18;
   bool pop(Transition& out) noexcept;
   void drain();
   void writer_loop();
