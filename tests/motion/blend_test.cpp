@@ -123,6 +123,18 @@ Recorded run_program(VirtualMachine& m, const Program& prog, int pause_at, int o
   return run;
 }
 
+// Every axis stayed within its limits and the program ended where it was written, every move
+// done.
+void expect_limits_and_exact_end(const VirtualMachine& m, const AxisPose& start,
+                                 const Program& prog) {
+  const auto p = peaks(m, start);
+  EXPECT_LE(p.velocity, 1.001);
+  EXPECT_LE(p.acceleration, 1.001);
+  for (int axis = 0; axis < 3; ++axis)
+    EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
+  EXPECT_EQ(m.status().moves_done, prog.moves.size());
+}
+
 // Runs the program (with a pause or an override change in some rounds) and checks the limits,
 // the tolerance, the stops, the dwells and the end.
 void check_program(const Program& prog, int round) {
@@ -132,12 +144,7 @@ void check_program(const Program& prog, int round) {
     const AxisPose start = m.status().commanded;
     const Recorded run = run_program(m, prog, round % 4 == 1 ? 700 : 0, round % 4 == 2 ? 500 : 0);
 
-    const auto p = peaks(m, start);
-    EXPECT_LE(p.velocity, 1.001);
-    EXPECT_LE(p.acceleration, 1.001);
-    for (int axis = 0; axis < 3; ++axis)
-      EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
-    EXPECT_EQ(m.status().moves_done, prog.moves.size());
+    expect_limits_and_exact_end(m, start, prog);
 
     // Within P of the programmed path: a period's position lies on its line's move, or on a
     // blend into it from the move before.
@@ -376,12 +383,7 @@ TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
     const AxisPose start = m.status().commanded;
     const Recorded run = run_program(m, prog, round % 4 == 1 ? 700 : 0, round % 4 == 2 ? 500 : 0);
     SCOPED_TRACE("round " + std::to_string(round));
-    const auto p = peaks(m, start);
-    EXPECT_LE(p.velocity, 1.001);
-    EXPECT_LE(p.acceleration, 1.001);
-    for (int axis = 0; axis < 3; ++axis)
-      EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
-    EXPECT_EQ(m.status().moves_done, prog.moves.size());
+    expect_limits_and_exact_end(m, start, prog);
     // The path speed's second differences (chords would misjudge the speed on tight curves).
     std::vector<double> speed{0, 0};
     speed.insert(speed.end(), run.speeds.begin(), run.speeds.end());
