@@ -18,6 +18,14 @@ std::uint32_t home_switch_joints(const std::vector<DriverBinding>& drivers) {
   return mask;
 }
 
+// Enough cycles of commands to reach back as far as any driver's feedback may answer.
+std::size_t history_depth(const std::vector<DriverBinding>& drivers, std::int64_t period_ns) {
+  std::int64_t deadline_ns = 0;
+  for (const auto& binding : drivers)
+    deadline_ns = std::max(deadline_ns, binding.driver->feedback_deadline_ns());
+  return CommandHistory::depth_for(deadline_ns, period_ns);
+}
+
 template <std::size_t N>
 void copy_name(char (&out)[N], const char* name) {
   std::snprintf(out, N, "%s", name);
@@ -31,7 +39,8 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
       joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
       homing_(config, period_s_, home_switch_joints(drivers_)),
-      jog_(config) {
+      jog_(config),
+      history_(joint_count_, history_depth(drivers_, config.servo_period_ns)) {
   joint_axis_.fill(-1);
   if (config.scurve) {
     // The acceleration must take at least kMinRampPeriods servo periods to build up on every
@@ -264,102 +273,8 @@ void ServoLoop::update_stats(std::int64_t wake_error_ns) noexcept {
   status_.rt.wake_error_max_ns = histogram_.max_ns();
 }
 
-void ServoLoop::read_drivers() noexcept {
-  drivers::MachineInputs inputs;
-  for (auto& binding : drivers_) {
-    drivers::JointFeedback block[kJoints];
-    const int n = static_cast<int>(binding.joints.size());
-    binding.driver->read(block, n);
-    binding.driver->read_inputs(inputs);
-    for (int k = 0; k < n; ++k)
-      feedback_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])] = block[k];
-  }
-  for (int j = 0; j < joint_count_; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    joints_.feedback[k] = feedback_[k].position - joints_.motor_offset[k];
-    joints_.home_switch[k] = feedback_[k].home_switch;
-  }
-  if (inputs.estop && status_.machine != MachineState::estop) {
-    stop_now(MachineState::estop, nullptr);
-    latch_fault("estop input asserted");
-  }
-}
-
-void ServoLoop::check_joints() noexcept {
-  // Feedback counts once the drives have been sent the enable: a fault latched while they were
-  // off is cleared by that enable edge, so judging it in the cycle that turns the machine on
-  // would trip over the old fault again.
-  if (status_.machine != MachineState::on || !drives_enabled_) return;
-  for (int j = 0; j < joint_count_; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    const auto& fb = feedback_[k];
-    char text[200];  // latch_fault() keeps what fits in Status::fault_reason
-    if (!std::isfinite(fb.position)) {
-      status_.joint_fault[k] = true;
-      std::snprintf(text, sizeof text, "joint %d: feedback position is not a number", j);
-      latch_fault(text);
-      return;
-    }
-    if (fb.fault || fb.stale) {
-      status_.joint_fault[k] = true;
-      // The driver may know more (which drive, register or line).
-      char detail[96] = {};
-      if (fb.fault && joint_driver_[k] != nullptr) {
-        joint_driver_[k]->fault_reason(detail, sizeof detail);
-      }
-      std::snprintf(text, sizeof text, "joint %d: %s%s%s", j,
-                    fb.fault ? "drive fault" : "feedback is stale", detail[0] ? ": " : "", detail);
-      latch_fault(text);
-      return;
-    }
-    // A tripped limit switch stops everything, except while homing a joint configured to
-    // ignore its limits (its home switch shares the limit input).
-    if ((fb.min_limit || fb.max_limit) && !homing_.ignores_limits(j)) {
-      status_.joint_fault[k] = true;
-      std::snprintf(text, sizeof text, "joint %d: %s limit switch tripped", j,
-                    fb.min_limit ? "minimum" : "maximum");
-      latch_fault(text);
-      return;
-    }
-    // LinuxCNC's limit: FERROR at full speed, scaled down with speed, never below MIN_FERROR.
-    const auto& joint = config_.joints[k];
-    const double speed = std::abs(commands_out_[k].velocity);
-    const double limit =
-        std::max(joint.min_ferror, joint.ferror * speed / std::max(joint.max_velocity, 1e-9));
-    const double error = std::abs(last_motor_cmd_[k] - fb.position);
-    if (error > limit) {
-      status_.joint_fault[k] = true;
-      // Clamped: printing a huge number with %f would need a large buffer.
-      std::snprintf(text, sizeof text, "joint %d: following error %.4f exceeds %.4f", j,
-                    std::min(error, 1e9), std::min(limit, 1e9));
-      latch_fault(text);
-      return;
-    }
-  }
-}
-
-void ServoLoop::write_drivers() noexcept {
-  const bool enable = status_.machine == MachineState::on;
-  drives_enabled_ = enable;
-  for (int j = 0; j < joint_count_; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    const double motor = joints_.command[k] + joints_.motor_offset[k];
-    commands_out_[k].velocity = (motor - last_motor_cmd_[k]) / period_s_;
-    commands_out_[k].position = motor;
-    commands_out_[k].enable = enable;
-    last_motor_cmd_[k] = motor;
-  }
-  for (auto& binding : drivers_) {
-    drivers::JointCommand block[kJoints];
-    const int n = static_cast<int>(binding.joints.size());
-    for (int k = 0; k < n; ++k)
-      block[k] =
-          commands_out_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])];
-    binding.driver->write(block, n);
-  }
-}
-
 void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
+  ++cycle_;
   update_stats(wake_error_ns);
   Command command;
   // Feedback first: a command (homing) may redefine joint positions from it.

@@ -45,13 +45,14 @@ void RecordingDriver::write(const drivers::JointCommand* commands, int count) no
   inner_.write(commands, count);
 }
 
-VirtualMachine::VirtualMachine(const config::MachineConfig& config, std::uint32_t capabilities)
+VirtualMachine::VirtualMachine(const config::MachineConfig& config, std::uint32_t capabilities,
+                               drivers::Driver* drive)
     : config_(config), sim_(std::make_unique<drivers::SimDriver>()), planner_(config_) {
   std::vector<int> joints;
   for (std::size_t j = 0; j < config_.joints.size(); ++j)
     joints.push_back(static_cast<int>(j));
   EXPECT_EQ(sim_->configure(config_, joints), "");
-  recorder_ = std::make_unique<RecordingDriver>(*sim_, capabilities);
+  recorder_ = std::make_unique<RecordingDriver>(drive != nullptr ? *drive : *sim_, capabilities);
   loop_ = std::make_unique<motion::ServoLoop>(
       config_, std::vector<motion::DriverBinding>{{recorder_.get(), joints}});
 }

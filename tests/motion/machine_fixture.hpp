@@ -33,6 +33,9 @@ class RecordingDriver final : public drivers::Driver {
   bool fault_reason(char* out, std::size_t size) const noexcept override {
     return inner_.fault_reason(out, size);
   }
+  std::int64_t feedback_deadline_ns() const noexcept override {
+    return inner_.feedback_deadline_ns();
+  }
   std::uint32_t capabilities() const noexcept override { return capabilities_; }
   const char* name() const noexcept override { return "recording"; }
   const std::vector<motion::JointArray>& written() const { return written_; }
@@ -49,11 +52,14 @@ class RecordingDriver final : public drivers::Driver {
 
 class VirtualMachine {
  public:
-  // `capabilities`: what the loop is told the driver can do (the sim's by default).
+  // `capabilities`: what the loop is told the driver can do (the sim's by default). `drive`:
+  // the driver behind the recording one, already configured and outliving the machine (the
+  // simulated driver by default).
   explicit VirtualMachine(const config::MachineConfig& config,
                           std::uint32_t capabilities = drivers::kCapHomeSwitch |
                                                        drivers::kCapLimitSwitches |
-                                                       drivers::kCapEstopInput);
+                                                       drivers::kCapEstopInput,
+                          drivers::Driver* drive = nullptr);
   // Machine on and homed.
   void ready();
   // Plans and queues through the look-ahead planner (which may hold the move back until the

@@ -21,6 +21,10 @@ struct JointCommand {
   double position = 0;  // joint units (mm, inch or degrees)
   double velocity = 0;  // joint units/s, feed-forward
   bool enable = false;
+  // The servo cycle that computed this command: 1 for the first, one more each period. A
+  // driver whose feedback comes back later than the next period hands it back in
+  // JointFeedback::command_cycle.
+  std::uint64_t cycle = 0;
 };
 
 // What a driver reports each period.
@@ -31,6 +35,12 @@ struct JointFeedback {
   bool max_limit = false;
   bool fault = false;  // drive reports a fault
   bool stale = false;  // no fresh feedback within the driver's deadline
+  // Which command `position` answers: the cycle (JointCommand::cycle) of the latest command
+  // the drive had been given when the position was measured. The following error compares
+  // the position with that command, not with the latest one, so that a drive whose feedback
+  // arrives late (Modbus: up to an update period plus a round trip) is not charged with the
+  // distance its command travelled meanwhile. 0: the latest command written (sim, gpio).
+  std::uint64_t command_cycle = 0;
 };
 
 struct MachineInputs {
@@ -71,6 +81,10 @@ class Driver {
     if (size > 0) out[0] = '\0';
     return false;
   }
+  // Non-RT, after configure(): how long ago (ns) the command that feedback not yet stale
+  // answers may have been written; 0 when feedback always answers the latest command. The
+  // servo loop keeps that many periods of commands to compare late feedback with.
+  virtual std::int64_t feedback_deadline_ns() const noexcept { return 0; }
   virtual std::uint32_t capabilities() const noexcept = 0;
   virtual const char* name() const noexcept = 0;
 };

@@ -9,6 +9,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/motion/command_history.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
 #include "cncd/motion/rt_stats.hpp"
@@ -126,7 +127,10 @@ class ServoLoop {
   void advance_jog() noexcept;
   bool axis_homed(int axis) const noexcept;
   void read_drivers() noexcept;
-  void check_joints() noexcept;
+  void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
+  // The command joint `k`'s feedback answers (motor coordinates): the latest one written, or
+  // the one of the cycle the driver names.
+  drivers::JointCommand answered_command(std::size_t k) const noexcept;
   void write_drivers() noexcept;
   void update_stats(std::int64_t wake_error_ns) noexcept;
   void latch_fault(const char* reason) noexcept;
@@ -194,6 +198,10 @@ class ServoLoop {
   JointIo joints_{};
   Homing homing_;
   Jog jog_;
+  // Servo cycles counted from 1 (drivers::JointCommand::cycle), and every joint's motor
+  // commands of the last cycles, for feedback that answers an older one.
+  std::uint64_t cycle_ = 0;
+  CommandHistory history_;
   JointArray last_motor_cmd_{};  // what the drivers were told last period (motor coordinates)
   std::array<drivers::JointCommand, kJoints> commands_out_{};
   std::array<drivers::JointFeedback, kJoints> feedback_{};  // motor coordinates
