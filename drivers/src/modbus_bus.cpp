@@ -156,10 +156,12 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
     out[width] = control;
     ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width + 1, out); });
     if (!ok) fail(index, "writing holding registers", d.target_register, width + 1, true);
+    if (ok) s.written_cycle = setpoint.cycle;
   } else {
     if (!s.latched) {
       ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width, out); });
       if (!ok) fail(index, "writing holding registers", d.target_register, width, true);
+      if (ok) s.written_cycle = setpoint.cycle;
     }
     if (ok) {
       ok = attempt([&] { return modbus_write_register(ctx, d.control_register, control); });
@@ -180,6 +182,7 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
   }
   if (!ok) return false;
   s.last.counts = decode(in, d);
+  s.last.command_cycle = s.written_cycle;
   s.last.status = in[width];
   s.last.time_ns = monotonic_ns();
   if ((s.last.status & kStatusFault) != 0 && !s.latched) {

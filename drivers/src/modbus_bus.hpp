@@ -46,12 +46,16 @@ struct Setpoint {
   std::int64_t counts = 0;
   std::uint32_t reset_request = 0;  // bumped on every rising edge of enable
   bool enable = false;
+  std::uint64_t cycle = 0;  // the servo cycle that computed it (JointCommand::cycle)
 };
 
 // I/O thread -> servo thread.
 struct Readback {
   std::int64_t counts = 0;
   std::int64_t time_ns = 0;  // CLOCK_MONOTONIC of the last good read; 0 = never
+  // The cycle of the setpoint written in the exchange that read `counts` (just before the
+  // read): the command the position answers. 0 before any setpoint was written.
+  std::uint64_t command_cycle = 0;
   std::uint32_t reset_ack = 0;
   std::uint16_t status = 0;
   bool fault = false;  // latched until a reset request is acknowledged
@@ -94,7 +98,8 @@ class ModbusBus {
     bool latched = false;
     bool pulse_reset = false;
     std::uint32_t reset_ack = 0;
-    Setpoint setpoint{};  // the latest one loaded
+    Setpoint setpoint{};              // the latest one loaded
+    std::uint64_t written_cycle = 0;  // cycle of the last setpoint the drive received
     Readback last{};
   };
   void loop();

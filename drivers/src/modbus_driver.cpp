@@ -92,12 +92,16 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
   }
   if (!ini.error().empty()) return ini.error();
   buses_.clear();
+  deadline_ns_ = 0;
   for (auto& [number, members] : by_bus) {
     BusSettings settings = read_bus(ini, number);
     if (!ini.error().empty()) return ini.error();
     // Feedback older than a few update periods plus one slow reply is stale.
     const std::int64_t stale_ns =
         (5LL * settings.update_period_ms + 2LL * settings.timeout_ms) * 1'000'000;
+    // The setpoint a fresh readback answers waited up to an update period in its mailbox.
+    deadline_ns_ =
+        std::max(deadline_ns_, stale_ns + std::int64_t{settings.update_period_ms} * 1'000'000);
     std::vector<DriveSettings> drives;
     for (const auto& member : members)
       drives.push_back(member.second);
@@ -140,7 +144,8 @@ void ModbusDriver::write(const JointCommand* commands, int count) noexcept {
                                      double{std::numeric_limits<std::int32_t>::min()},
                                      double{std::numeric_limits<std::int32_t>::max()});
     slot.bus->put_setpoint(
-        slot.drive, Setpoint{static_cast<std::int64_t>(counts), slot.reset_request, slot.enabled});
+        slot.drive, Setpoint{static_cast<std::int64_t>(counts), slot.reset_request, slot.enabled,
+                             commands[i].cycle});
   }
 }
 
@@ -155,10 +160,12 @@ void ModbusDriver::read(JointFeedback* feedback, int count) noexcept {
       slot.time_ns = rb.time_ns;
       slot.reset_ack = rb.reset_ack;
       slot.fault = rb.fault;
+      slot.command_cycle = rb.command_cycle;
     }
     JointFeedback& fb = feedback[i];
     fb = JointFeedback{};
     fb.position = static_cast<double>(slot.counts) / slot.scale;
+    fb.command_cycle = slot.command_cycle;
     // A fault from before the latest reset request is history until the bus has seen it.
     fb.fault = slot.fault && slot.reset_ack == slot.reset_request;
     fb.stale = slot.time_ns == 0 || now - slot.time_ns > slot.stale_ns;

@@ -1,5 +1,6 @@
 // The modbus driver end to end over loopback TCP (and RTU on a pseudo-terminal pair) against
 // real libmodbus servers: the simulated drives of cncd-drive-sim, run in-process.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <memory>
@@ -93,6 +94,41 @@ TEST_F(ModbusDriverTest, SetpointsArriveAsRegisterCountsAndPositionsComeBack) {
   EXPECT_EQ(reason(), "");
   servo(20, 1.234, -0.5, false);
   EXPECT_EQ(sim_->control(10) & 1u, 0u);
+}
+
+TEST_F(ModbusDriverTest, AReadbackNamesTheCycleOfTheSetpointItAnswers) {
+  start_sim();  // no lag: a drive stands on its target by the time it is read back
+  start_driver();
+  int answered = 0;
+  std::uint64_t most_late = 0;
+  std::uint64_t last[2] = {0, 0};
+  for (std::uint64_t cycle = 1; cycle <= 300; ++cycle) {
+    driver_.read(feedback_, 2);
+    for (int j = 0; j < 2; ++j) {
+      const std::uint64_t named = feedback_[j].command_cycle;
+      if (named == 0) continue;  // no setpoint has gone out yet
+      EXPECT_LT(named, cycle) << "a command not written yet";
+      EXPECT_GE(named, last[j]);
+      last[j] = named;
+      most_late = std::max(most_late, cycle - 1 - named);
+      // Every setpoint is its own cycle in counts (negated for joint 1): the position read
+      // back is the one of the setpoint the readback names.
+      const double sign = j == 0 ? 1.0 : -1.0;
+      EXPECT_DOUBLE_EQ(feedback_[j].position, sign * static_cast<double>(named) / 1000)
+          << "joint " << j << " at cycle " << cycle;
+      ++answered;
+    }
+    const double counts = static_cast<double>(cycle);
+    const JointCommand c[2] = {{counts / 1000, 0, true, cycle}, {-counts / 1000, 0, true, cycle}};
+    driver_.write(c, 2);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_GT(answered, 400);
+  // Updated every 5 ms, the readbacks answer setpoints several servo periods old.
+  EXPECT_GE(most_late, 3u);
+  EXPECT_FALSE(faulted(0) || faulted(1)) << reason();
+  // Stale feedback older than 5 x 5 + 2 x 40 ms, answering setpoints up to 5 ms older.
+  EXPECT_EQ(driver_.feedback_deadline_ns(), 110'000'000);
 }
 
 TEST_F(ModbusDriverTest, KilledDriveLatchesAFaultAndWorksAgainOnlyAfterReset) {

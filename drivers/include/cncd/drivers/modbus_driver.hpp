@@ -32,6 +32,8 @@ class ModbusDriver final : public Driver {
   void write(const JointCommand* commands, int count) noexcept override;
   void read(JointFeedback* feedback, int count) noexcept override;
   bool fault_reason(char* out, std::size_t size) const noexcept override;
+  // The stale deadline of the slowest bus plus its update period.
+  std::int64_t feedback_deadline_ns() const noexcept override { return deadline_ns_; }
   std::uint32_t capabilities() const noexcept override { return kCapPositionFeedback; }
   const char* name() const noexcept override { return "modbus"; }
 
@@ -50,9 +52,11 @@ class ModbusDriver final : public Driver {
     std::int64_t time_ns = 0;
     std::uint32_t reset_ack = 0;
     bool fault = false;
+    std::uint64_t command_cycle = 0;  // of the last readback
   };
   std::vector<std::unique_ptr<ModbusBus>> buses_;
   std::vector<Slot> slots_;
+  std::int64_t deadline_ns_ = 0;
 };
 
 }  // namespace cncd::drivers
