@@ -200,6 +200,8 @@ class BusyServo {
   std::thread thread_;
 };
 
+constexpr std::uint64_t kBusyUpdates = 100;
+
 TEST_F(ModbusDriverTest, SetpointsStoredWithoutPauseReachTheDriveWhole) {
   start_sim();
   start_driver();
@@ -208,15 +210,17 @@ TEST_F(ModbusDriverTest, SetpointsStoredWithoutPauseReachTheDriveWhole) {
   BusyServo busy(driver_, 1.234, -0.5);
   const std::uint64_t writes = sim_->target_writes(10);
   int wrong = 0;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
-  while (std::chrono::steady_clock::now() < until) {
+  // A hundred updates (half a second, longer on a loaded machine).
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (sim_->target_writes(10) < writes + kBusyUpdates &&
+         std::chrono::steady_clock::now() < until) {
     if (sim_->target(10) != 1234 || sim_->target(11) != -500 || (sim_->control(10) & 1u) == 0 ||
         (sim_->control(11) & 1u) == 0) {
       ++wrong;
     }
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
-  EXPECT_GT(sim_->target_writes(10), writes + 20) << "the bus kept updating";
+  EXPECT_GE(sim_->target_writes(10), writes + kBusyUpdates) << "the bus kept updating";
   EXPECT_EQ(wrong, 0) << "the drives saw another target or lost their enable";
   EXPECT_EQ(reason(), "");
 }
@@ -231,8 +235,12 @@ TEST_F(ModbusDriverTest, ALatchedFaultStaysLatchedWhileSetpointsKeepComing) {
   BusyServo busy(driver_, 0.1, 0.2);
   const std::uint64_t writes = sim_->target_writes(11);
   const std::uint64_t running = sim_->target_writes(10);
-  std::this_thread::sleep_for(std::chrono::milliseconds(600));
-  EXPECT_GT(sim_->target_writes(10), running + 20) << "the other drive kept its updates";
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (sim_->target_writes(10) < running + kBusyUpdates &&
+         std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_GE(sim_->target_writes(10), running + kBusyUpdates) << "the other drive kept its updates";
   EXPECT_EQ(sim_->target_writes(11), writes) << "no setpoints while the fault is latched";
   EXPECT_EQ(sim_->control(11) & 3u, 0u) << "neither enabled nor reset";
   EXPECT_NE(reason().find("slave 11"), std::string::npos) << reason();
