@@ -4,6 +4,7 @@
 #include <sys/socket.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -133,6 +134,13 @@ void ModbusBus::fail(std::size_t index, const char* what, int first, int count, 
   if (drop_link) link_failed_ = true;
 }
 
+void ModbusBus::remember_write(DriveState& s, std::uint64_t cycle) {
+  // The same setpoint again: the drive has had it since it first came.
+  if (s.written[0].time_ns != 0 && s.written[0].cycle == cycle) return;
+  std::move_backward(s.written.begin(), s.written.end() - 1, s.written.end());
+  s.written[0] = DriveState::Written{cycle, monotonic_ns()};
+}
+
 bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
   const DriveSettings& d = drives_[index];
   DriveState& s = state_[index];
@@ -156,12 +164,12 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
     out[width] = control;
     ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width + 1, out); });
     if (!ok) fail(index, "writing holding registers", d.target_register, width + 1, true);
-    if (ok) s.written_cycle = setpoint.cycle;
+    if (ok) remember_write(s, setpoint.cycle);
   } else {
     if (!s.latched) {
       ok = attempt([&] { return modbus_write_registers(ctx, d.target_register, width, out); });
       if (!ok) fail(index, "writing holding registers", d.target_register, width, true);
-      if (ok) s.written_cycle = setpoint.cycle;
+      if (ok) remember_write(s, setpoint.cycle);
     }
     if (ok) {
       ok = attempt([&] { return modbus_write_register(ctx, d.control_register, control); });
@@ -182,9 +190,17 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
   }
   if (!ok) return false;
   s.last.counts = decode(in, d);
-  s.last.command_cycle = s.written_cycle;
   s.last.status = in[width];
   s.last.time_ns = monotonic_ns();
+  s.last.command_cycle = s.written[0].cycle;
+  // The drive has hardly begun to follow a setpoint it was just given: the one it has had a
+  // whole update period to follow bounds the position from the other side.
+  const std::int64_t hold_ns = std::int64_t{bus_.update_period_ms} * 1'000'000;
+  for (const auto& w : s.written) {
+    if (w.time_ns == 0) break;
+    s.last.previous_cycle = w.cycle;
+    if (s.last.time_ns - w.time_ns >= hold_ns) break;
+  }
   if ((s.last.status & kStatusFault) != 0 && !s.latched) {
     fail(index, "drive reports a fault (status bit 2)", -1, 0, false);
   }

@@ -3,6 +3,7 @@
 // servo thread only through seqlock mailboxes. No libmodbus call happens anywhere else.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -53,9 +54,12 @@ struct Setpoint {
 struct Readback {
   std::int64_t counts = 0;
   std::int64_t time_ns = 0;  // CLOCK_MONOTONIC of the last good read; 0 = never
-  // The cycle of the setpoint written in the exchange that read `counts` (just before the
-  // read): the command the position answers. 0 before any setpoint was written.
+  // The commands the position answers (JointFeedback): the cycle of the setpoint written in
+  // the exchange that read `counts` (just before the read), and of the newest one the drive
+  // had been given an update period or more before the read (the oldest remembered when none
+  // was). 0 before any setpoint was written.
   std::uint64_t command_cycle = 0;
+  std::uint64_t previous_cycle = 0;
   std::uint32_t reset_ack = 0;
   std::uint16_t status = 0;
   bool fault = false;  // latched until a reset request is acknowledged
@@ -98,14 +102,21 @@ class ModbusBus {
     bool latched = false;
     bool pulse_reset = false;
     std::uint32_t reset_ack = 0;
-    Setpoint setpoint{};              // the latest one loaded
-    std::uint64_t written_cycle = 0;  // cycle of the last setpoint the drive received
+    Setpoint setpoint{};  // the latest one loaded
+    // The last setpoints the drive received, newest first: their cycle and when it first got
+    // each (time 0: none).
+    struct Written {
+      std::uint64_t cycle = 0;
+      std::int64_t time_ns = 0;
+    };
+    std::array<Written, 8> written{};
     Readback last{};
   };
   void loop();
   bool connect();
   void disconnect();
   bool exchange(std::size_t index, const Setpoint& setpoint);
+  static void remember_write(DriveState& s, std::uint64_t cycle);
   void fail(std::size_t index, const char* what, int first, int count, bool drop_link);
 
   BusSettings bus_;

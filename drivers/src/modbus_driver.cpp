@@ -161,11 +161,13 @@ void ModbusDriver::read(JointFeedback* feedback, int count) noexcept {
       slot.reset_ack = rb.reset_ack;
       slot.fault = rb.fault;
       slot.command_cycle = rb.command_cycle;
+      slot.previous_cycle = rb.previous_cycle;
     }
     JointFeedback& fb = feedback[i];
     fb = JointFeedback{};
     fb.position = static_cast<double>(slot.counts) / slot.scale;
     fb.command_cycle = slot.command_cycle;
+    fb.previous_cycle = slot.previous_cycle;
     // A fault from before the latest reset request is history until the bus has seen it.
     fb.fault = slot.fault && slot.reset_ack == slot.reset_request;
     fb.stale = slot.time_ns == 0 || now - slot.time_ns > slot.stale_ns;

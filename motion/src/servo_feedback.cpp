@@ -67,25 +67,38 @@ void ServoLoop::check_joints() noexcept {
       return;
     }
     // LinuxCNC's limit: FERROR at full speed, scaled down with speed, never below MIN_FERROR;
-    // measured against the command the feedback answers, at that command's speed.
-    const drivers::JointCommand answered = answered_command(k);
+    // measured from the commands the feedback answers, at their speed.
+    const drivers::JointCommand newer = answered_command(k, fb.command_cycle);
     // Feedback answering a command sent while the drives were off: the drive followed nothing.
-    if (!answered.enable) continue;
+    if (!newer.enable) continue;
+    drivers::JointCommand older = newer;
+    // An older command sent with the drives off still counts: it followed the drive.
+    if (fb.previous_cycle != 0 && fb.previous_cycle < newer.cycle)
+      older = answered_command(k, fb.previous_cycle);
     const auto& joint = config_.joints[k];
-    const double speed = std::abs(answered.velocity);
+    const double speed = std::max(std::abs(older.velocity), std::abs(newer.velocity));
     const double limit =
         std::max(joint.min_ferror, joint.ferror * speed / std::max(joint.max_velocity, 1e-9));
-    const double error = std::abs(answered.position - fb.position);
+    const double low = std::min(older.position, newer.position);
+    const double high = std::max(older.position, newer.position);
+    const double error = std::max({low - fb.position, fb.position - high, 0.0});
     if (error > limit) {
       status_.joint_fault[k] = true;
       // Clamped: printing a huge number with %f would need a large buffer.
       const int n = std::snprintf(text, sizeof text, "joint %d: following error %.4f exceeds %.4f",
                                   j, std::min(error, 1e9), std::min(limit, 1e9));
-      const std::uint64_t late = cycle_ - 1 > answered.cycle ? cycle_ - 1 - answered.cycle : 0;
-      if (late > 0 && n > 0 && static_cast<std::size_t>(n) < sizeof text) {
-        std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n),
-                      " (against the command of %llu periods ago)",
-                      static_cast<unsigned long long>(late));
+      const auto ago = [this](std::uint64_t cycle) {
+        return static_cast<unsigned long long>(cycle_ - 1 > cycle ? cycle_ - 1 - cycle : 0);
+      };
+      if (n > 0 && static_cast<std::size_t>(n) < sizeof text && ago(older.cycle) > 0) {
+        const auto rest = sizeof text - static_cast<std::size_t>(n);
+        if (older.cycle == newer.cycle) {
+          std::snprintf(text + n, rest, " (against the command of %llu periods ago)",
+                        ago(newer.cycle));
+        } else {
+          std::snprintf(text + n, rest, " (against the commands of %llu to %llu periods ago)",
+                        ago(older.cycle), ago(newer.cycle));
+        }
       }
       latch_fault(text);
       return;
@@ -93,8 +106,8 @@ void ServoLoop::check_joints() noexcept {
   }
 }
 
-drivers::JointCommand ServoLoop::answered_command(std::size_t k) const noexcept {
-  const std::uint64_t cycle = feedback_[k].command_cycle;
+drivers::JointCommand ServoLoop::answered_command(std::size_t k,
+                                                  std::uint64_t cycle) const noexcept {
   if (cycle != 0 && cycle < cycle_) {
     if (const auto* command = history_.find(static_cast<int>(k), cycle)) return *command;
   }

@@ -102,13 +102,30 @@ TEST_F(ModbusDriverTest, AReadbackNamesTheCycleOfTheSetpointItAnswers) {
   int answered = 0;
   std::uint64_t most_late = 0;
   std::uint64_t last[2] = {0, 0};
+  std::uint64_t before_last[2] = {0, 0};
+  std::uint64_t last_previous[2] = {0, 0};
+  int seen_previous = 0;
   for (std::uint64_t cycle = 1; cycle <= 300; ++cycle) {
     driver_.read(feedback_, 2);
     for (int j = 0; j < 2; ++j) {
       const std::uint64_t named = feedback_[j].command_cycle;
-      if (named == 0) continue;  // no setpoint has gone out yet
+      // No setpoint has gone out yet, or a fault (a write that timed out may still have
+      // reached the drive).
+      if (named == 0 || faulted(j)) continue;
       EXPECT_LT(named, cycle) << "a command not written yet";
       EXPECT_GE(named, last[j]);
+      // The setpoint the drive had an update period before: an older one, or the same one
+      // when this loop was held up for longer than that (a loaded machine).
+      const std::uint64_t previous = feedback_[j].previous_cycle;
+      EXPECT_LE(previous, named);
+      EXPECT_GE(previous, last_previous[j]);
+      last_previous[j] = previous;
+      // Exchanges every 5 ms: mostly the one of the exchange before (or the one before that,
+      // when this exchange woke up a little earlier than the last).
+      if (named != last[j]) {
+        seen_previous += previous != 0 && (previous == last[j] || previous == before_last[j]);
+        before_last[j] = last[j];
+      }
       last[j] = named;
       most_late = std::max(most_late, cycle - 1 - named);
       // Every setpoint is its own cycle in counts (negated for joint 1): the position read
@@ -124,6 +141,7 @@ TEST_F(ModbusDriverTest, AReadbackNamesTheCycleOfTheSetpointItAnswers) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_GT(answered, 400);
+  EXPECT_GT(seen_previous, 20);  // about 2 x 60 updates
   // Updated every 5 ms, the readbacks answer setpoints several servo periods old.
   EXPECT_GE(most_late, 3u);
   EXPECT_FALSE(faulted(0) || faulted(1)) << reason();

@@ -70,6 +70,56 @@ class LateDriver final : public drivers::Driver {
   std::array<double, drivers::kMaxJoints> position_{};
 };
 
+// A drive given the latest command only every `update` periods, as a Modbus bus does, and read
+// right after each: it follows its target through a first-order lag of `lag_s`, and its
+// feedback, refreshed at each update, names the command just written and, when
+// `names_previous`, the one before, which it had the whole update to follow.
+class SlowBusDriver final : public drivers::Driver {
+ public:
+  SlowBusDriver(int update, double period_s, double lag_s, bool names_previous)
+      : update_(update),
+        alpha_(lag_s > 0 ? 1.0 - std::exp(-period_s / lag_s) : 1.0),
+        names_previous_(names_previous) {}
+  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
+    return "";
+  }
+  void enable() override {}
+  void disable() override {}
+  void write(const JointCommand* commands, int count) noexcept override {
+    std::copy_n(commands, std::min(count, drivers::kMaxJoints), latest_.begin());
+  }
+  void read(drivers::JointFeedback* feedback, int count) noexcept override {
+    const bool exchange = ++periods_ % update_ == 0;
+    for (int i = 0; i < count && i < drivers::kMaxJoints; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (target_[k].enable) position_[k] += (target_[k].position - position_[k]) * alpha_;
+      if (exchange) {
+        previous_[k] = target_[k].cycle;
+        target_[k] = latest_[k];
+        read_back_[k] = position_[k];
+      }
+      feedback[i] = drivers::JointFeedback{};
+      feedback[i].position = read_back_[k];
+      feedback[i].command_cycle = target_[k].cycle;
+      feedback[i].previous_cycle = names_previous_ ? previous_[k] : 0;
+    }
+  }
+  std::int64_t feedback_deadline_ns() const noexcept override { return 2LL * update_ * 1'000'000; }
+  std::uint32_t capabilities() const noexcept override { return drivers::kCapPositionFeedback; }
+  const char* name() const noexcept override { return "slow bus"; }
+
+ private:
+  int update_;
+  double alpha_;
+  bool names_previous_;
+  int periods_ = 0;
+  std::array<JointCommand, drivers::kMaxJoints> latest_{};
+  std::array<JointCommand, drivers::kMaxJoints> target_{};
+  std::array<std::uint64_t, drivers::kMaxJoints> previous_{};
+  std::array<double, drivers::kMaxJoints> position_{};
+  std::array<double, drivers::kMaxJoints> read_back_{};
+};
+
 constexpr int kDelay = 15;  // periods: 3 mm at X's 200 mm/s, three times its FERROR of 1 mm
 
 struct LateMachine {
@@ -177,6 +227,40 @@ TEST(LateFeedback, OffAndOnAgainMidMoveDoesNotFault) {
   EXPECT_EQ(m.machine.status().machine, MachineState::on);
   m.fast_move();
   EXPECT_EQ(m.fault(), "");
+}
+
+// A bus held up for 40 periods between updates: the drive gets targets 8 mm apart at X's
+// 200 mm/s and is read back right after each, still standing on the one before.
+struct SlowBusMachine {
+  SlowBusMachine(double lag_s, bool names_previous)
+      : drive(40, 1e-3, lag_s, names_previous), machine(small_mill(), 0, &drive) {
+    machine.cycles(80);  // a first update or two, before anything moves
+    machine.ready();
+    machine.queue(line_to(Move::Kind::traverse, 300, 0, 0));
+    machine.run_until_idle(5000);
+    machine.cycles(100);
+  }
+  std::string fault() const { return machine.status().fault_reason; }
+  SlowBusDriver drive;
+  VirtualMachine machine;
+};
+
+TEST(LateFeedback, ADriveUpdatedRarelyIsJudgedBetweenItsLastTwoTargets) {
+  SlowBusMachine m(0.002, true);
+  EXPECT_EQ(m.fault(), "");
+  EXPECT_NEAR(m.machine.status().actual[0], 300, 1e-6);
+}
+
+TEST(LateFeedback, AgainstItsNewestTargetAloneTheSameDriveFaults) {
+  SlowBusMachine m(0.002, false);
+  EXPECT_NE(m.fault().find("joint 0: following error"), std::string::npos) << m.fault();
+}
+
+TEST(LateFeedback, ADriveUpdatedRarelyThatLagsItsTargetsFaults) {
+  // 20 ms behind its targets: 4 mm at full speed, past the older target by more than FERROR.
+  SlowBusMachine m(0.02, true);
+  EXPECT_NE(m.fault().find("joint 0: following error"), std::string::npos) << m.fault();
+  EXPECT_NE(m.fault().find("(against the commands of"), std::string::npos) << m.fault();
 }
 
 JointCommand at(double position, std::uint64_t cycle) {

@@ -35,12 +35,17 @@ struct JointFeedback {
   bool max_limit = false;
   bool fault = false;  // drive reports a fault
   bool stale = false;  // no fresh feedback within the driver's deadline
-  // Which command `position` answers: the cycle (JointCommand::cycle) of the latest command
-  // the drive had been given when the position was measured. The following error compares
-  // the position with that command, not with the latest one, so that a drive whose feedback
-  // arrives late (Modbus: up to an update period plus a round trip) is not charged with the
-  // distance its command travelled meanwhile. 0: the latest command written (sim, gpio).
+  // Which commands `position` answers, by their cycle (JointCommand::cycle). command_cycle is
+  // the latest command the drive had been given when the position was measured; 0 means the
+  // latest command written (sim, gpio). previous_cycle is the newest command it had been given
+  // long enough before to have followed it (Modbus: an update period; 0: the same as
+  // command_cycle): a drive given a new target only now and then, and read right after, has
+  // hardly begun to follow the newest. The following error is the distance from `position` to
+  // the nearest point between those two commands, not to the latest command, so that a drive
+  // whose feedback is late, or whose targets come late, is not charged with the distance its
+  // command travelled meanwhile.
   std::uint64_t command_cycle = 0;
+  std::uint64_t previous_cycle = 0;
 };
 
 struct MachineInputs {

@@ -53,6 +53,7 @@ class ModbusDriver final : public Driver {
     std::uint32_t reset_ack = 0;
     bool fault = false;
     std::uint64_t command_cycle = 0;  // of the last readback
+    std::uint64_t previous_cycle = 0;
   };
   std::vector<std::unique_ptr<ModbusBus>> buses_;
   std::vector<Slot> slots_;

@@ -128,9 +128,9 @@ class ServoLoop {
   bool axis_homed(int axis) const noexcept;
   void read_drivers() noexcept;
   void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
-  // The command joint `k`'s feedback answers (motor coordinates): the latest one written, or
-  // the one of the cycle the driver names.
-  drivers::JointCommand answered_command(std::size_t k) const noexcept;
+  // Joint `k`'s command of `cycle` (motor coordinates) as feedback names it: 0 or a cycle not
+  // written yet is the latest one written, one that fell out of the history its oldest.
+  drivers::JointCommand answered_command(std::size_t k, std::uint64_t cycle) const noexcept;
   void write_drivers() noexcept;
   void update_stats(std::int64_t wake_error_ns) noexcept;
   void latch_fault(const char* reason) noexcept;
