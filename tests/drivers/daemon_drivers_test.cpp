@@ -146,15 +146,13 @@ std::string adapt(const TempDir& dir, const std::string& name,
   return dir.write(name, text).string();
 }
 
-// The Modbus example pointed at the drive simulator on `port`. The simulator is an ordinary
-// process on a machine shared with other tests: starved of the CPU, its replies can come tens
-// of milliseconds late, which the example's following-error limits (meant for drives that
-// answer in time) would take for a drive that cannot follow. These tests are about the
-// program's end and the fault handling, so the limits are widened.
+// The Modbus example pointed at the drive simulator on `port`, with the example's own
+// following-error limits. The simulator is an ordinary process on a machine shared with other
+// tests, and the bus thread is no real-time thread: their replies can come tens of
+// milliseconds late. The servo loop compares each readback with the setpoint it answers
+// (JointFeedback::command_cycle), so that latency is not taken for a drive that cannot follow.
 std::vector<std::pair<std::string, std::string>> modbus_changes(int port) {
-  return {{"PORT = 1502", "PORT = " + std::to_string(port)},
-          {"FERROR = 2\n", "FERROR = 20\n"},
-          {"MIN_FERROR = 0.5\n", "MIN_FERROR = 5\n"}};
+  return {{"PORT = 1502", "PORT = " + std::to_string(port)}};
 }
 
 void expect_end(const json& s, const char* driver) {
@@ -174,14 +172,13 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
   {
     TempDir dir;
     const std::string vcd = (dir.path() / "steps.vcd").string();
-    const json s = run_example(
-        dir,
-        adapt(dir, "gpio_vcd_mill.ini",
-              {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
-               // As for the Modbus drives below: a base thread stalled by a busy shared machine
-               // catches up afterwards, which the example's tight limits would call a fault.
-               {"FERROR = 1\n", "FERROR = 10\n"},
-               {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
+    const json s =
+        run_example(dir, adapt(dir, "gpio_vcd_mill.ini",
+                               {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
+                                // A base thread stalled by a busy shared machine catches up
+                                // afterwards, which the example's tight limits would call a fault.
+                                {"FERROR = 1\n", "FERROR = 10\n"},
+                                {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
     expect_end(s, "gpio");
     // cncd has stopped and flushed the recording: the pulses add up to the end position.
     const auto changes = read_vcd(vcd);
