@@ -1,6 +1,8 @@
 #include "modbus_bus.hpp"
 
 #include <modbus/modbus.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/socket.h>
 #include <time.h>
 
@@ -208,6 +210,15 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
 }
 
 void ModbusBus::loop() {
+  if (bus_.rt_priority > 0) {
+    // Just below the servo thread: kept waiting for the CPU by ordinary work, the bus would
+    // deliver setpoints late (the drives fall behind) and readbacks late (stale feedback).
+    // Refused without privileges, and then it runs at normal priority (the daemon already
+    // warns about real-time scheduling).
+    sched_param param{};
+    param.sched_priority = bus_.rt_priority;
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  }
   const std::int64_t period_ns = static_cast<std::int64_t>(bus_.update_period_ms) * 1'000'000;
   std::int64_t next_ns = monotonic_ns();
   while (running_.load(std::memory_order_relaxed)) {

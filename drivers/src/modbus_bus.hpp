@@ -29,6 +29,7 @@ struct BusSettings {
   int timeout_ms = 50;
   int update_period_ms = 10;
   int retries = 1;
+  int rt_priority = 0;  // SCHED_FIFO priority of the I/O thread; 0: an ordinary thread
 };
 
 struct DriveSettings {

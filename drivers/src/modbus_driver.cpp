@@ -96,6 +96,7 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
   for (auto& [number, members] : by_bus) {
     BusSettings settings = read_bus(ini, number);
     if (!ini.error().empty()) return ini.error();
+    settings.rt_priority = std::max(1, machine.cncd.rt_priority - 1);
     // Feedback older than a few update periods plus one slow reply is stale.
     const std::int64_t stale_ns =
         (5LL * settings.update_period_ms + 2LL * settings.timeout_ms) * 1'000'000;
