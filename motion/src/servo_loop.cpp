@@ -129,6 +129,7 @@ void ServoLoop::flush_queue() noexcept {
   }
   window_length_ = 0;
   stop_length_ = 0;
+  floor_first_ = floor_end_ = 0;
   pass_active_ = false;
   while (segments_.pop(dropped)) {
     ++status_.segments_done;

@@ -116,6 +116,13 @@ void ServoLoop::fill_window() noexcept {
       exit_soft_[static_cast<std::size_t>(seq % kWindow)] = 0;
       ++window_count_;
       window_length_ += seg.length;
+      if (seg.kind != Segment::Kind::dwell) {
+        while (floor_end_ > floor_first_ &&
+               window_at(floor_seq_[(floor_end_ - 1) % kWindow]).max_acceleration >=
+                   seg.max_acceleration)
+          --floor_end_;
+        floor_seq_[floor_end_++ % kWindow] = seq;
+      }
       if (seg.max_acceleration > 0) {
         // Under a jerk limit the acceleration takes a / j to build up and to fall back.
         const double v = seg.axis_velocity;
@@ -142,9 +149,15 @@ void ServoLoop::finish_front() noexcept {
   ++status_.segments_done;
   status_.moves_done += done.moves;
   window_length_ = std::max(0.0, window_length_ - done.length);
+  if (floor_end_ > floor_first_ && floor_seq_[floor_first_ % kWindow] == head_seq_) ++floor_first_;
   ++head_seq_;
   --window_count_;
   has_active_ = false;
+}
+
+double ServoLoop::window_floor_accel() noexcept {
+  return floor_end_ > floor_first_ ? window_at(floor_seq_[floor_first_ % kWindow]).max_acceleration
+                                   : 0.0;
 }
 
 bool ServoLoop::advance_path(double dt) noexcept {

@@ -25,11 +25,11 @@ void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
   cap_soft_ = std::min(cap_hard_, speed_limit(head));
   double distance = head.length - path_s_;
   double accel = head.max_acceleration;
-  // Beyond the distance in which the fastest next state stops, no limit binds.
-  auto reach = [&] {
-    return ds + scurve::brake_distance(v, a, 0.0, accel, kPlanJerkShare * jerk_) + 1e-6;
-  };
-  double horizon = reach();
+  // Beyond the distance in which the fastest next state stops with the smallest acceleration
+  // limit in the window, no limit binds (the smallest limit met so far is not enough: a lower
+  // one further on would come into reach too late to slow down for).
+  const double horizon =
+      ds + scurve::brake_distance(v, a, 0.0, window_floor_accel(), kPlanJerkShare * jerk_) + 1e-6;
   double min_soft = 1e300;
   double min_hard = 1e300;
   double kept_accel = accel;
@@ -43,10 +43,7 @@ void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
       if (seg.continuous && seg.kind != Segment::Kind::dwell && next.kind != Segment::Kind::dwell) {
         hard = std::min({seg.axis_velocity, next.axis_velocity, seg.junction_velocity});
         soft = std::min({hard, speed_limit(seg), speed_limit(next)});
-        if (next.max_acceleration < accel) {
-          accel = next.max_acceleration;
-          horizon = reach();
-        }
+        accel = std::min(accel, next.max_acceleration);
       }
     }
     // A limit no lower than one nearer (with no lower acceleration to slow down with) cannot

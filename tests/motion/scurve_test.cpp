@@ -204,5 +204,34 @@ TEST(SCurve, DenseChordsRunAtFullFeed) {
   EXPECT_LT(periods * m.period_s(), bound + 0.125 + 0.01) << periods;
 }
 
+// 0.1 mm chords of a circle at 150 mm/s under G64, then a retract along Z blended in: the blend
+// arc into the retract is tiny and of low tangential acceleration (312 mm/s^2), so the path
+// must slow down for it well before the chords' own limits would ask. Found only once it came
+// within stopping distance at the chords' acceleration, it was passed at 33 mm/s, 17
+// times Z's acceleration limit.
+TEST(SCurve, ALowAccelerationBlendFarAheadIsSlowedDownForInTime) {
+  VirtualMachine m(jerk_mill(40000));
+  m.ready();
+  m.queue(line_to(Move::Kind::traverse, 30, 0, 0));
+  m.flush();
+  m.run_until_idle();
+  m.clear_trajectory();
+  const AxisPose start = m.status().commanded;
+  for (int i = 1; i <= 95; ++i) {
+    const double t = 0.1 * i / 30;
+    Move chord = line_to(Move::Kind::feed, 30 * std::cos(t), 30 * std::sin(t), 0, 150);
+    chord.path_mode = Move::PathMode::blend;
+    m.queue(chord);
+  }
+  Move retract = line_to(Move::Kind::traverse, 30 * std::cos(9.5 / 30), 30 * std::sin(9.5 / 30), 1);
+  retract.path_mode = Move::PathMode::blend;
+  m.queue(retract);
+  m.run_until_idle();
+  EXPECT_DOUBLE_EQ(m.status().commanded[2], 1);
+  const auto p = peaks(m, start);
+  EXPECT_LE(p.velocity, 1.001);
+  EXPECT_LE(p.acceleration, 1.001);
+}
+
 }  // namespace
 }  // namespace cncd::test

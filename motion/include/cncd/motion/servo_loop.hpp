@@ -107,7 +107,8 @@ class ServoLoop {
   void run_pass() noexcept;
   // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
   void soft_limits_changed() noexcept;
-  void finish_front() noexcept;  // the window's first segment is done
+  void finish_front() noexcept;          // the window's first segment is done
+  double window_floor_accel() noexcept;  // the smallest acceleration limit in the window
   // S-curve profiles (servo_scurve.cpp): one period of path motion whose acceleration changes
   // by at most jerk_ per second, through as many segments as it covers. Spends all of `dt`.
   void scurve_step(double& dt) noexcept;
@@ -170,6 +171,12 @@ class ServoLoop {
   int window_count_ = 0;
   double window_length_ = 0;  // path length of the window's segments
   double stop_length_ = 0;    // longest stopping distance of the window's segments
+  // The window's segments (dwells aside) whose acceleration limit is below that of every later
+  // one, oldest first, in a ring indexed by the two counters: the first has the window's
+  // smallest limit (S-curve profiles: how far ahead a limit can bind).
+  std::array<std::uint64_t, kWindow> floor_seq_{};
+  std::uint64_t floor_first_ = 0;
+  std::uint64_t floor_end_ = 0;
   bool pass_active_ = false;
   std::uint64_t pass_seq_ = 0;    // next segment whose exit speeds the pass recomputes
   std::uint64_t pass_floor_ = 0;  // the pass goes at least this far back
