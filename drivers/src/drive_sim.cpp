@@ -5,6 +5,8 @@
 #include <modbus/modbus.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/select.h>
 #include <unistd.h>
 
@@ -75,6 +77,8 @@ std::string DriveSim::start() {
     running_ = true;
     relay_thread_ = std::thread([this] { relay(); });
     thread_ = std::thread([this] { serve_rtu(); });
+    raise_priority(relay_thread_);
+    raise_priority(thread_);
     return "";
   }
   ctx_ = modbus_new_tcp(options_.address.c_str(), options_.port);
@@ -90,6 +94,7 @@ std::string DriveSim::start() {
   port_ = ntohs(bound.sin_port);
   running_ = true;
   thread_ = std::thread([this] { serve_tcp(); });
+  raise_priority(thread_);
   return "";
 }
 
@@ -157,6 +162,21 @@ int DriveSim::handle(void* ctx, const std::uint8_t* query, int length) {
     d->control.store(m->tab_registers[2]);
   }
   return rc;
+}
+
+void DriveSim::raise_priority(std::thread& thread) noexcept {
+  if (options_.rt_priority <= 0) return;
+  sched_param param{};
+  param.sched_priority = options_.rt_priority;
+  const int error = pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
+  if (error != 0) priority_error_ = error;
+}
+
+std::string DriveSim::warning() const {
+  const int error = priority_error_;
+  if (error == 0) return "";
+  return "real-time priority " + std::to_string(options_.rt_priority) + " refused (" +
+         std::strerror(error) + "): serving at ordinary priority";
 }
 
 void DriveSim::serve_tcp() {

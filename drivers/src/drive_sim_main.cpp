@@ -31,6 +31,7 @@ void usage() {
   std::puts(
       "usage: cncd-drive-sim [--port N] [--address A] [--rtu] [--drives N] [--slave ID]\n"
       "                      [--lag SECONDS] [--fault-after SECONDS] [--exception]\n"
+      "                      [--rt-priority N]\n"
       "  --port N          Modbus TCP port (default 1502; 0 = any free port, printed)\n"
       "  --address A       address to listen on (default 127.0.0.1)\n"
       "  --rtu             serve Modbus RTU on a new pseudo-terminal (its path is printed)\n"
@@ -39,6 +40,8 @@ void usage() {
       "  --lag SECONDS     following time constant (default 0.01)\n"
       "  --fault-after S   set the fault bit of every drive after S seconds\n"
       "  --exception       answer every request with an exception\n"
+      "  --rt-priority N   serve from SCHED_FIFO threads of priority N (1-99), as a drive\n"
+      "                    with a processor of its own; default 0: ordinary threads\n"
       "signals: SIGUSR1 toggles a fault on every drive, SIGUSR2 toggles silence");
 }
 
@@ -73,6 +76,15 @@ int main(int argc, char** argv) {
       options.lag_s = std::atof(value());
     } else if (arg == "--fault-after") {
       fault_after_s = std::atof(value());
+    } else if (arg == "--rt-priority") {
+      const char* text = value();
+      char* end = nullptr;
+      const long priority = std::strtol(text, &end, 10);
+      if (end == text || *end != '\0' || priority < 0 || priority > 99) {
+        std::fprintf(stderr, "cncd-drive-sim: --rt-priority wants 0 to 99, not '%s'\n", text);
+        return 64;
+      }
+      options.rt_priority = static_cast<int>(priority);
     } else if (arg == "--exception") {
       exception = true;
     } else if (arg == "--help" || arg == "-h") {
@@ -102,6 +114,8 @@ int main(int argc, char** argv) {
                 options.address.c_str(), sim.port());
   }
   std::fflush(stdout);
+  if (const auto warning = sim.warning(); !warning.empty())
+    std::fprintf(stderr, "cncd-drive-sim: warning: %s\n", warning.c_str());
   sim.set_exception(exception);
   int faults_seen = 0;
   int silences_seen = 0;

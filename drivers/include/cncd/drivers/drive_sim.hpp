@@ -24,6 +24,10 @@ struct DriveSimOptions {
   int drives = 1;       // unit ids first_slave .. first_slave + drives - 1 (tcp; rtu serves one)
   double lag_s = 0.01;  // following time constant; 0 = the actual position is the target
   std::int32_t in_position_counts = 2;
+  // SCHED_FIFO priority of the serving threads, as a drive has a processor of its own and is
+  // not kept waiting by the host's other work; 0: ordinary threads. Where the system refuses,
+  // start() still serves and warning() says so.
+  int rt_priority = 0;
 };
 
 inline constexpr int kDriveSimMaxDrives = 16;
@@ -42,6 +46,8 @@ class DriveSim {
   int port() const { return port_; }
   // rtu: the terminal a client opens (DEVICE = ...).
   const std::string& device() const { return device_; }
+  // Why the threads run at ordinary priority although rt_priority asked otherwise; "" if not.
+  std::string warning() const;
 
   // Any thread. Fault injection: the drive sets its fault bit (and disables) until cleared
   // here and reset by the master; silent: requests get no reply (timeouts); exception: every
@@ -76,6 +82,7 @@ class DriveSim {
   void serve_rtu();
   void relay();
   void advance(double dt) noexcept;
+  void raise_priority(std::thread& thread) noexcept;
   int handle(void* ctx, const std::uint8_t* query, int length);
 
   DriveSimOptions options_;
@@ -84,6 +91,7 @@ class DriveSim {
   std::atomic<bool> silent_{false};
   std::atomic<bool> exception_{false};
   std::atomic<bool> running_{false};
+  int priority_error_ = 0;  // errno of the last refused SCHED_FIFO request (start())
   void* ctx_ = nullptr;
   void* mapping_ = nullptr;
   int listen_fd_ = -1;
