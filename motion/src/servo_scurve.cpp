@@ -2,6 +2,7 @@
 // the last one from which every speed limit ahead can still be kept under the jerk limit.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "cncd/motion/servo_loop.hpp"
 #include "scurve.hpp"
@@ -12,56 +13,83 @@ namespace {
 // The limits are checked against braking that uses this share of the jerk limit, so that the
 // period-by-period steps (which cannot switch the jerk within a period) have room to follow it.
 constexpr double kPlanJerkShare = 0.98;
+// Likewise the braking holds this share of the acceleration limit, so that a step whose linear
+// change in acceleration lags a braking that reaches its limit within the period can brake
+// harder and catch up.
+constexpr double kPlanAccelShare = 0.98;
 constexpr double kDistanceSlack = 1e-9;
 // Binary search steps over one period's range of accelerations.
 constexpr int kSearchSteps = 14;
 
 }  // namespace
 
+// Which limits bind, and with what braking. Every period picks a state from which every limit
+// ahead can still be kept; that choice only exists next period if the set of such states does
+// not shrink as the path advances or the window grows:
+// - A limit at the end of segment m is kept by braking over the segments between the path and
+//   it, so it brakes with `accel`, the smallest tangential limit of the segments from the
+//   active one to m. The segment after m takes no part: `entry` (its own limit) is what an
+//   acceleration must be ramped off to before it, and a braking to the limit's speed ends
+//   with no acceleration there. As the path advances segments leave that minimum, which can
+//   only rise; segments arriving in the window come after m. An earlier version took the
+//   smallest limit up to the segment after m for both, so that one short tight blend slowed
+//   every braking beyond it.
+// - A limit m is implied (not "on") by a nearer limit j with w_j <= w_m: a step that passes j
+//   leaves the path at most at w_j with its acceleration ramped to zero within w_j
+//   (settle_speed), from where no braking is needed for m, and until then j comes first.
+//   Whether it is depends on the two speeds alone, never on where the path stands; once j
+//   is passed, m is on again from a state that meets it with nothing to brake.
 void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
   limit_count_ = 0;
+  const double jerk = kPlanJerkShare * jerk_;
   const Segment& head = window_at(head_seq_);
   cap_hard_ = head.axis_velocity;
   cap_soft_ = std::min(cap_hard_, speed_limit(head));
   double distance = head.length - path_s_;
-  double accel = head.max_acceleration;
-  // Beyond the distance in which the fastest next state stops with the smallest acceleration
-  // limit in the window, no limit binds (the smallest limit met so far is not enough: a lower
-  // one further on would come into reach too late to slow down for).
+  // No limit beyond the distance in which the fastest next state stops with the smallest
+  // acceleration limit in the window can bind (a limit brakes with no less).
+  double brake = head.max_acceleration;  // the smallest limit up to the limit at hand
   const double horizon =
-      ds + scurve::brake_distance(v, a, 0.0, window_floor_accel(), kPlanJerkShare * jerk_) + 1e-6;
+      ds + scurve::brake_distance(v, a, 0.0, kPlanAccelShare * window_floor_accel(), jerk) + 1e-6;
   double min_soft = 1e300;
   double min_hard = 1e300;
-  double kept_accel = accel;
+  double min_entry = 1e300;
+  // A limit no faster than one nearer is implied by it (see above).
+  auto implied = [&](double target, bool soft) { return target >= (soft ? min_soft : min_hard); };
   for (int k = 0; k < window_count_; ++k) {
     const std::uint64_t seq = head_seq_ + static_cast<std::uint64_t>(k);
     const Segment& seg = window_at(seq);
     double hard = 0;
     double soft = 0;
+    double entry = 1e300;
     if (k + 1 < window_count_) {
       const Segment& next = window_at(seq + 1);
       if (seg.continuous && seg.kind != Segment::Kind::dwell && next.kind != Segment::Kind::dwell) {
         hard = std::min({seg.axis_velocity, next.axis_velocity, seg.junction_velocity});
         soft = std::min({hard, speed_limit(seg), speed_limit(next)});
-        accel = std::min(accel, next.max_acceleration);
+        entry = next.max_acceleration;
       }
     }
-    // A limit no lower than one nearer (with no lower acceleration to slow down with) cannot
-    // be the one that binds.
-    if (soft < min_soft || hard < min_hard || accel < kept_accel) {
+    const bool soft_on = !implied(soft, true);
+    const bool hard_on = !implied(hard, false);
+    if (soft_on || hard_on || entry < min_entry) {
       if (limit_count_ == kMaxLimits) {
         // Out of room: the path stops at the last limit kept, a safe underestimate.
-        limits_[static_cast<std::size_t>(kMaxLimits - 1)].soft = 0;
-        limits_[static_cast<std::size_t>(kMaxLimits - 1)].hard = 0;
+        SpeedLimit& last = limits_[static_cast<std::size_t>(kMaxLimits - 1)];
+        last.soft = last.hard = 0;
+        last.soft_on = last.hard_on = true;
         return;
       }
-      limits_[static_cast<std::size_t>(limit_count_++)] = {distance, soft, hard, accel};
-      min_soft = std::min(min_soft, soft);
-      min_hard = std::min(min_hard, hard);
-      kept_accel = accel;
+      limits_[static_cast<std::size_t>(limit_count_++)] = {distance, soft,    hard,   brake,
+                                                           entry,    soft_on, hard_on};
     }
+    min_soft = std::min(min_soft, soft);
+    min_hard = std::min(min_hard, hard);
+    min_entry = std::min(min_entry, entry);
     if (hard <= 0 || distance > horizon) return;
-    distance += window_at(seq + 1).length;
+    const Segment& next = window_at(seq + 1);
+    distance += next.length;
+    brake = std::min(brake, next.max_acceleration);
   }
 }
 
@@ -74,18 +102,24 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
     const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
     const double room = limit.distance - ds + kDistanceSlack;
     const double target = soft ? limit.soft : limit.hard;
+    const bool on = soft ? limit.soft_on : limit.hard_on;
     if (room < 0) {
       // Passed within the step: the speed and the acceleration there lie between the step's
       // two ends, and the segment after it must not be sped up past it.
-      if (std::max(v_before, scurve::settle_speed(v, std::max(a, 0.0), jerk)) >
-          target * (1 + 1e-12) + 1e-12)
+      if (on && std::max(v_before, scurve::settle_speed(v, std::max(a, 0.0), jerk)) >
+                    target * (1 + 1e-12) + 1e-12)
         return false;
-      if (std::max(std::abs(a_before), std::abs(a)) > limit.accel * (1 + 1e-12)) return false;
+      if (std::max(std::abs(a_before), std::abs(a)) > limit.entry * (1 + 1e-12)) return false;
       continue;
     }
-    if (scurve::brake_distance(v, a, target, limit.accel, jerk) > room) return false;
-    // An acceleration above what the segments there allow must be ramped off before them.
-    const double excess = std::abs(a) - limit.accel;
+    if (on && scurve::brake_distance(v, a, target, kPlanAccelShare * limit.accel, jerk) > room)
+      return false;
+    // Where the speed must come down to the limit's, the braking ends with no acceleration
+    // there, and it was planned with at most `accel`: a harder deceleration must be eased to
+    // that in time. Elsewhere an acceleration above what the segment after the limit allows
+    // must be ramped off before it.
+    const bool brakes = on && scurve::settle_speed(v, std::max(a, -limit.accel), jerk) > target;
+    const double excess = std::abs(a) - (brakes ? limit.accel : limit.entry);
     if (excess > 0) {
       const double t = excess / jerk;
       const double sign = a > 0 ? 1.0 : -1.0;
@@ -99,7 +133,7 @@ bool ServoLoop::eases_in_time(double v, double a, double ds) const noexcept {
   const double jerk = kPlanJerkShare * jerk_;
   for (int k = 0; k < limit_count_; ++k) {
     const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
-    const double excess = -a - limit.accel;
+    const double excess = -a - limit.entry;
     if (excess <= 0) continue;
     const double room = limit.distance - ds + kDistanceSlack;
     const double t = excess / jerk;

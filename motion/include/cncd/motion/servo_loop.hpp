@@ -192,7 +192,10 @@ class ServoLoop {
     double distance;  // from the path's position
     double soft;      // with the feed, the overrides and holds
     double hard;      // of the axes alone
-    double accel;     // smallest path acceleration limit up to there
+    double accel;     // smallest path acceleration limit of the segments up to there
+    double entry;     // the acceleration limit of the segment that starts there
+    bool soft_on;     // whether the soft (hard) speed binds: no nearer limit is as low
+    bool hard_on;
   };
   static constexpr int kMaxLimits = 1024;
   std::array<SpeedLimit, kMaxLimits> limits_{};
