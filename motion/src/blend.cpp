@@ -315,10 +315,8 @@ void Planner::set_blend_limits(Segment& blend) const {
   // of what every axis allows), the tangential part what each axis has left.
   double v_sum = v;
   double centripetal = fastest * fastest / blend.radius;
-  if (centripetal >= kBlendNormalShare * normal_a) {
-    centripetal = kBlendNormalShare * normal_a;
-    v_sum = std::min(v_sum, std::sqrt(centripetal * blend.radius));
-  }
+  if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
+  v_sum = std::min(v_sum, std::sqrt(centripetal * blend.radius));
   double a_sum = 1e300;
   for (int i = 0; i < kAxes; ++i) {
     const auto k = static_cast<std::size_t>(i);

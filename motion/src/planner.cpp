@@ -84,10 +84,13 @@ void Planner::curve_limits(double fastest, double radius, double plane_a, double
   // The tangential and centripetal parts are at right angles: shares t and n of the in-plane
   // limit with t^2 + n^2 = 1 keep their sum, and so every axis of the plane, within it. The
   // centripetal part gets what the fastest speed needs (the rest speeds up and slows down),
-  // at most `max_normal`; beyond, the curve limits the speed.
+  // at most `max_normal`; beyond, the curve limits the speed. Either way the speed is limited
+  // to what that share allows (the fastest speed asked for, when it fits): a path that does not
+  // slow down to its feed in time (S-curve profiles under a lowered override) is still held to
+  // what the axes allow on the curve.
   const double needed = fastest * fastest / (radius * plane_a);
   const double normal = std::min(needed, max_normal);
-  if (needed >= max_normal) v = std::min(v, std::sqrt(max_normal * plane_a * radius));
+  v = std::min(v, std::sqrt(normal * plane_a * radius));
   a = std::sqrt(1.0 - normal * normal) * plane_a;
 }
 

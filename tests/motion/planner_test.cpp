@@ -125,6 +125,44 @@ TEST(Planner, ArcsStayOnTheirCircleWithinLimits) {
   }
 }
 
+// A slow arc and a slow corner's blend arc: their acceleration is split between speeding up and
+// turning for the fastest speed the feed can ask for (at MAX_FEED_OVERRIDE), so their speed
+// limit of the axes alone is that speed too. A path that does not slow to the feed in time
+// (S-curve profiles after the override drops) is then still held within the axis limits.
+TEST(Planner, SlowCurvesAreLimitedToTheSpeedTheirAccelerationSplitAllows) {
+  auto config = small_mill();
+  config.max_feed_override = 1.5;
+  motion::Planner planner(config);
+  planner.reset(motion::AxisPose{});
+  std::string error;
+  Move arc;
+  arc.kind = Move::Kind::arc;
+  arc.center_first = -2;
+  arc.center_second = 0;
+  arc.end = {-2, 2, 0, 0, 0, 0, 0, 0, 0};
+  arc.turns = 1;
+  arc.feed = 10;
+  const auto seg = planner.plan(arc, motion::AxisPose{}, true, error);
+  ASSERT_TRUE(seg.has_value()) << error;
+  EXPECT_NEAR(seg->axis_velocity, 15, 1e-9);
+  const double turning = seg->axis_velocity * seg->axis_velocity / 2;
+  EXPECT_LE(std::hypot(turning, seg->max_acceleration), 2000 * (1 + 1e-9));
+  Move first = line_to(Move::Kind::feed, 10, 0, 0, 10);
+  first.path_mode = Move::PathMode::blend;
+  Move second = line_to(Move::Kind::feed, 10, 10, 0, 10);
+  second.path_mode = Move::PathMode::blend;
+  ASSERT_TRUE(planner.push(first, true, error)) << error;
+  ASSERT_TRUE(planner.push(second, true, error)) << error;
+  planner.flush();
+  int blends = 0;
+  for (const auto& out : planner.output()) {
+    if (out.kind != motion::Segment::Kind::blend) continue;
+    ++blends;
+    EXPECT_LE(out.axis_velocity, 15 * (1 + 1e-9));
+  }
+  EXPECT_EQ(blends, 1);
+}
+
 TEST(Planner, ExactStopTimeMatchesTheTrapezoid) {
   VirtualMachine m(small_mill());
   m.ready();
