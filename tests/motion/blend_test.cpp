@@ -3,6 +3,7 @@
 // differences of the positions of every period), stay within P of the programmed path, stop
 // where they must, hold every dwell and end exactly at the programmed end.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -370,13 +371,17 @@ TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
 // while the path moves (not in the periods in which it comes to rest, below 1 mm/s: it
 // arrives between two periods' ends).
 TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
-  std::mt19937 rng(4711);
   auto config = small_mill();
   config.scurve = true;
   config.max_linear_jerk = 40000;
   const double dt = 1e-3;
   int moving = 0;
-  for (int round = 0; round < 30; ++round) {
+  // Thirty rounds from each of three seeds (18 and 23 ran into a low-acceleration blend seen
+  // too late by an earlier search for the limits ahead).
+  constexpr std::array<unsigned, 3> kSeeds{4711u, 18u, 23u};
+  std::mt19937 rng;
+  for (int round = 0; round < 90; ++round) {
+    if (round % 30 == 0) rng.seed(kSeeds[static_cast<std::size_t>(round / 30)]);
     const Program prog = random_program(rng, 30, round % 2 == 1);
     VirtualMachine m(config);
     m.ready();
@@ -394,7 +399,7 @@ TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
       ASSERT_LE(jerk, config.max_linear_jerk * 1.001 + 1) << "period " << k;
     }
   }
-  EXPECT_GT(moving, 100000);
+  EXPECT_GT(moving, 300000);
 }
 
 }  // namespace
