@@ -98,6 +98,9 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
   const double jerk = kPlanJerkShare * jerk_;
   const double cap = soft ? cap_soft_ : cap_hard_;
   if (scurve::settle_speed(v, std::max(a, 0.0), jerk) > cap * (1 + 1e-12) + 1e-12) return false;
+  // Whether a nearer limit already brakes the path to its speed: that braking ends with no
+  // acceleration at it, so the accelerations of the segments beyond it are met there.
+  bool braked = false;
   for (int k = 0; k < limit_count_; ++k) {
     const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
     const double room = limit.distance - ds + kDistanceSlack;
@@ -120,11 +123,12 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
     // must be ramped off before it.
     const bool brakes = on && scurve::settle_speed(v, std::max(a, -limit.accel), jerk) > target;
     const double excess = std::abs(a) - (brakes ? limit.accel : limit.entry);
-    if (excess > 0) {
+    if (excess > 0 && !braked) {
       const double t = excess / jerk;
       const double sign = a > 0 ? 1.0 : -1.0;
       if (t * (v + t * (a / 2.0 - sign * jerk * t / 6.0)) > room) return false;
     }
+    braked = braked || brakes;
   }
   return true;
 }

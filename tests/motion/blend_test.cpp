@@ -376,11 +376,12 @@ TEST(Blend, SCurveRandomProgramsKeepTheJerkLimit) {
   config.max_linear_jerk = 40000;
   const double dt = 1e-3;
   int moving = 0;
-  // Thirty rounds from each of three seeds (18 and 23 ran into a low-acceleration blend seen
-  // too late by an earlier search for the limits ahead).
-  constexpr std::array<unsigned, 3> kSeeds{4711u, 18u, 23u};
+  // Thirty rounds from each of four seeds (18 and 23 ran into a low-acceleration blend seen
+  // too late by an earlier search for the limits ahead; in round 92 a braking for a reversal
+  // gave up and took its tiny blend arc at 21 times Y's acceleration limit).
+  constexpr std::array<unsigned, 4> kSeeds{4711u, 18u, 23u, 217u};
   std::mt19937 rng;
-  for (int round = 0; round < 90; ++round) {
+  for (int round = 0; round < 120; ++round) {
     if (round % 30 == 0) rng.seed(kSeeds[static_cast<std::size_t>(round / 30)]);
     const Program prog = random_program(rng, 30, round % 2 == 1);
     VirtualMachine m(config);
