@@ -94,7 +94,7 @@ void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
 }
 
 bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double a, double ds,
-                             bool soft) const noexcept {
+                             bool soft, bool speeds_only) const noexcept {
   const double jerk = kPlanJerkShare * jerk_;
   const double cap = soft ? cap_soft_ : cap_hard_;
   if (scurve::settle_speed(v, std::max(a, 0.0), jerk) > cap * (1 + 1e-12) + 1e-12) return false;
@@ -112,7 +112,8 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
       if (on && std::max(v_before, scurve::settle_speed(v, std::max(a, 0.0), jerk)) >
                     target * (1 + 1e-12) + 1e-12)
         return false;
-      if (std::max(std::abs(a_before), std::abs(a)) > limit.entry * (1 + 1e-12)) return false;
+      if (!speeds_only && std::max(std::abs(a_before), std::abs(a)) > limit.entry * (1 + 1e-12))
+        return false;
       continue;
     }
     if (on && scurve::brake_distance(v, a, target, kPlanAccelShare * limit.accel, jerk) > room)
@@ -123,7 +124,7 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
     // must be ramped off before it.
     const bool brakes = on && scurve::settle_speed(v, std::max(a, -limit.accel), jerk) > target;
     const double excess = std::abs(a) - (brakes ? limit.accel : limit.entry);
-    if (excess > 0 && !braked) {
+    if (excess > 0 && !braked && !(speeds_only && !brakes)) {
       const double t = excess / jerk;
       const double sign = a > 0 ? 1.0 : -1.0;
       if (t * (v + t * (a / 2.0 - sign * jerk * t / 6.0)) > room) return false;
@@ -157,9 +158,9 @@ void ServoLoop::scurve_step(double& dt) noexcept {
   gather_limits(fastest.distance, fastest.velocity, hi);
   const double lo = std::max(-accel, a - jerk_ * dt);
 
-  auto keeps = [&](double a_next, bool soft) {
+  auto keeps = [&](double a_next, bool soft, bool speeds_only = false) {
     const scurve::Step step = scurve::integrate(v, a, a_next, dt);
-    return keeps_limits(v, a, step.velocity, step.acceleration, step.distance, soft);
+    return keeps_limits(v, a, step.velocity, step.acceleration, step.distance, soft, speeds_only);
   };
   // The highest acceleration in [low, high] for which `ok` holds, given that it holds at low.
   auto highest = [&](double low, double high, auto ok) {
@@ -203,7 +204,9 @@ void ServoLoop::scurve_step(double& dt) noexcept {
     if (!keeps_hard(a_next)) a_next = keeps_hard(lo) ? highest(lo, a_next, keeps_hard) : lo;
     // Never brake harder than a segment ahead allows by the time it is reached (dropping the
     // deceleration at a segment's start is a jump), unless easing off would break an axis
-    // limit.
+    // limit. Where no choice keeps them all, easing off wins only if it still keeps every
+    // speed limit: too fast into a tight arc costs v^2/r, far more than a brief excess of
+    // tangential acceleration at a segment's start.
     const auto eases = [&](double x) {
       const scurve::Step step = scurve::integrate(v, a, x, dt);
       return eases_in_time(step.velocity, step.acceleration, step.distance);
@@ -217,7 +220,7 @@ void ServoLoop::scurve_step(double& dt) noexcept {
           (eases(mid) ? high : low) = mid;
         }
       }
-      if (keeps_hard(high) || !keeps_hard(a_next)) a_next = high;
+      if (keeps_hard(high) || (!keeps_hard(a_next) && keeps(high, false, true))) a_next = high;
     }
   }
   scurve::Step step = scurve::integrate(v, a, a_next, dt);

@@ -117,9 +117,10 @@ class ServoLoop {
   void gather_limits(double ds, double v, double a) noexcept;
   // Whether a step from `v_before`, `a_before` to speed `v` and acceleration `a`, `ds` further on,
   // keeps every limit gathered (the hard ones only when `soft` is false): those it passes, and
-  // those ahead it can still slow down for.
-  bool keeps_limits(double v_before, double a_before, double v, double a, double ds,
-                    bool soft) const noexcept;
+  // those ahead it can still slow down for; with `speeds_only`, the speeds alone and not the
+  // coming segments' acceleration limits.
+  bool keeps_limits(double v_before, double a_before, double v, double a, double ds, bool soft,
+                    bool speeds_only = false) const noexcept;
   // Whether a deceleration `a` at speed `v`, `ds` further on, can ease off to every coming
   // segment's own acceleration limit before reaching it.
   bool eases_in_time(double v, double a, double ds) const noexcept;
