@@ -204,9 +204,9 @@ void ServoLoop::scurve_step(double& dt) noexcept {
     if (!keeps_hard(a_next)) a_next = keeps_hard(lo) ? highest(lo, a_next, keeps_hard) : lo;
     // Never brake harder than a segment ahead allows by the time it is reached (dropping the
     // deceleration at a segment's start is a jump), unless easing off would break an axis
-    // limit. Where no choice keeps them all, easing off wins only if it still keeps every
-    // speed limit: too fast into a tight arc costs v^2/r, far more than a brief excess of
-    // tangential acceleration at a segment's start.
+    // limit. Where no choice keeps them all, braking wins only where it keeps every speed
+    // limit and easing off does not: too fast into a tight arc costs v^2/r, far more than a
+    // brief excess of tangential acceleration at a segment's start.
     const auto eases = [&](double x) {
       const scurve::Step step = scurve::integrate(v, a, x, dt);
       return eases_in_time(step.velocity, step.acceleration, step.distance);
@@ -220,7 +220,8 @@ void ServoLoop::scurve_step(double& dt) noexcept {
           (eases(mid) ? high : low) = mid;
         }
       }
-      if (keeps_hard(high) || (!keeps_hard(a_next) && keeps(high, false, true))) a_next = high;
+      const bool brakes_safer = keeps(a_next, false, true) && !keeps(high, false, true);
+      if (keeps_hard(high) || (!keeps_hard(a_next) && !brakes_safer)) a_next = high;
     }
   }
   scurve::Step step = scurve::integrate(v, a, a_next, dt);
