@@ -86,7 +86,7 @@ SessionFiles files_next_to(const std::filesystem::path& program) {
   const auto dir = program.parent_path();
   if (std::filesystem::exists(dir / "tool.tbl")) {
     files.tool_table = dir / "tool.tbl";
-  } else if (std::filesystem::exists(kRs274DefaultToolTable)) {
+  } else {
     files.tool_table = kRs274DefaultToolTable;
   }
   if (std::filesystem::exists(dir / "params.var")) files.parameter_file = dir / "params.var";

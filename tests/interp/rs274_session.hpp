@@ -19,9 +19,10 @@ struct SessionFiles {
   std::filesystem::path parameter_file;  // empty = none
 };
 
-// The table rs274 reads when given none.
-inline constexpr const char* kRs274DefaultToolTable =
-    "/usr/share/doc/linuxcnc/examples/sample-configs/common/tool.tbl";
+// A copy of the table rs274 reads when given none (LinuxCNC's sample-configs/common/tool.tbl),
+// committed so that the goldens made with it need no LinuxCNC installed. Both interpreters are
+// handed this file, never LinuxCNC's.
+inline constexpr const char* kRs274DefaultToolTable = CNCD_RS274_DEFAULT_TOOL_TABLE;
 
 // Looks for tool.tbl and params.var next to the program; without tool.tbl, rs274's default.
 SessionFiles files_next_to(const std::filesystem::path& program);
