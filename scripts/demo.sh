@@ -12,12 +12,14 @@ example=${CNCD_DEMO_INI:-config/examples/sim_mm.ini}
 program=${CNCD_DEMO_PROGRAM:-examples/g81_example1.ngc}
 rundir=$(mktemp -d)
 sock=$rundir/cncd.sock
-# The machine runs from a copy, so the parameter and position files it writes stay out of
-# the source tree.
-cp "${example%.ini}".* "$rundir"/
-ini=$rundir/$(basename "$example")
+# The machine runs from the example INI as it is; its parameter, tool and position files go to
+# a state directory of the demo's own (a machine's usual one is $XDG_STATE_HOME/cncd/<name>,
+# docs/service.md), so that every demo starts from the example's shipped state and nothing is
+# written into the source tree.
+state=$rundir/state
+ini=$example
 
-"$bin/cncd" --ini "$ini" --socket "$sock" 2>"$rundir/cncd.log" &
+"$bin/cncd" --ini "$ini" --state-dir "$state" --socket "$sock" 2>"$rundir/cncd.log" &
 pid=$!
 cleanup() {
   if kill -0 "$pid" 2>/dev/null; then

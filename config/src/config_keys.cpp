@@ -63,6 +63,9 @@ constexpr std::array kKeys{
           "Highest spindle override an operator may set; 1.2 = 120 %"},
   KeySpec{"CNCD", "SOCKET", path, "/run/cncd/cncd.sock", 0, 0, false, "", "",
           "Unix socket that clients connect to"},
+  KeySpec{"CNCD", "STATE_DIR", path, "", 0, 0, false, "", "",
+          "Directory of the parameter, tool and position files given as relative paths; "
+          "default $STATE_DIRECTORY under systemd, else $XDG_STATE_HOME/cncd/<INI name>"},
   KeySpec{"CNCD", "READ_GROUP", text, "", 0, 0, false, "", "",
           "Group whose members may read status; empty: only root and CONTROL_GROUP"},
   KeySpec{"CNCD", "CONTROL_GROUP", text, "", 0, 0, false, "", "",

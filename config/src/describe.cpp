@@ -72,9 +72,15 @@ std::string describe(const MachineConfig& c) {
   line(out, "Feed override: up to " + num(c.max_feed_override * 100) + " %");
   line(out, "Spindle override: " + num(c.min_spindle_override * 100) + " to " +
                 num(c.max_spindle_override * 100) + " %");
-  line(out, "Parameters:   " + or_none(c.parameter_file));
-  line(out, "Tool table:   " + or_none(c.tool_table));
-  line(out, "Positions:    " + or_none(c.position_file));
+  line(out, "State files:  " + (c.cncd.state_dir.empty() ? std::string("none")
+                                                         : c.cncd.state_dir.string() + " (" +
+                                                               c.cncd.state_dir_origin + ")"));
+  auto state_file = [&](const std::filesystem::path& file, const std::filesystem::path& seed) {
+    return or_none(file) + (seed.empty() ? "" : " (first copied from " + seed.string() + ")");
+  };
+  line(out, "Parameters:   " + state_file(c.parameter_file, c.parameter_file_seed));
+  line(out, "Tool table:   " + state_file(c.tool_table, c.tool_table_seed));
+  line(out, "Positions:    " + state_file(c.position_file, c.position_file_seed));
   if (!c.startup_code.empty()) line(out, "Startup code: " + c.startup_code);
   for (const auto& dir : c.subroutine_path)
     line(out, "Subroutines:  " + dir.string());

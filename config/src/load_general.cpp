@@ -149,10 +149,8 @@ void load_general(TypedReader& r, MachineConfig& c) {
   load_extra_joints(r, c);
   if (const auto v = r.real("TASK", "CYCLE_TIME")) c.task_cycle_time_s = *v;
 
-  c.parameter_file = r.path("RS274NGC", "PARAMETER_FILE").value_or("");
   c.startup_code = r.text("RS274NGC", "RS274NGC_STARTUP_CODE").value_or("");
   c.subroutine_path = r.path_list("RS274NGC", "SUBROUTINE_PATH");
-  c.tool_table = r.path("EMCIO", "TOOL_TABLE").value_or("");
 
   load_coordinates(r, c);
   load_linear_units(r, c);
@@ -164,7 +162,6 @@ void load_general(TypedReader& r, MachineConfig& c) {
   c.max_linear_acceleration = r.real("TRAJ", "MAX_LINEAR_ACCELERATION").value_or(0);
   c.max_linear_jerk = r.real("TRAJ", "MAX_LINEAR_JERK").value_or(0);
   load_planner_type(r, c);
-  c.position_file = r.path("TRAJ", "POSITION_FILE").value_or("");
   c.no_force_homing = r.boolean("TRAJ", "NO_FORCE_HOMING").value_or(false);
 
   if (const auto v = r.real("DISPLAY", "MAX_FEED_OVERRIDE")) c.max_feed_override = *v;

@@ -9,6 +9,8 @@ namespace cncd::config {
 
 // [EMC] [EMCMOT] [TASK] [RS274NGC] [EMCIO] [TRAJ] [DISPLAY] [CNCD]
 void load_general(TypedReader& reader, MachineConfig& config);
+// [CNCD] STATE_DIR and where the parameter, tool and position files live.
+void load_state_files(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
 // [KINS], the joint map, [AXIS_L] and [JOINT_n]; fills the [TRAJ] limits left unset.
 void load_motion(TypedReader& reader, MachineConfig& config);
 // Cross-checks between keys and sections.

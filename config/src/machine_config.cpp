@@ -40,7 +40,7 @@ void sort_by_place(std::vector<Problem>& problems) {
   });
 }
 
-LoadResult load(const std::filesystem::path& ini_path) {
+LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& options) {
   LoadResult result;
   auto ini = std::make_shared<IniFile>(IniFile::read(ini_path, result.problems, result.warnings));
   if (ini->sections().empty() && ini->entries().empty()) {
@@ -56,6 +56,7 @@ LoadResult load(const std::filesystem::path& ini_path) {
   MachineConfig config;
   config.path = ini_path;
   load_general(reader, config);
+  load_state_files(reader, config, options);
   if (check_sections(reader)) {
     load_motion(reader, config);
     validate(reader, config);
@@ -69,11 +70,11 @@ LoadResult load(const std::filesystem::path& ini_path) {
 
 }  // namespace
 
-LoadResult load_machine_config(const std::filesystem::path& ini_path) {
+LoadResult load_machine_config(const std::filesystem::path& ini_path, const LoadOptions& options) {
   // Bad input never throws here; what remains is running out of memory or a filesystem
   // error, which must still reach the operator as a problem rather than terminate the daemon.
   try {
-    return load(ini_path);
+    return load(ini_path, options);
   } catch (const std::exception& e) {
     LoadResult failed;
     failed.problems.push_back(

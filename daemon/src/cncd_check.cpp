@@ -36,11 +36,15 @@ constexpr int kExitUsage = 2;
 int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "cncd-check: " << why << '\n';
   std::cerr
-      << "usage: cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch]\n"
+      << "usage: cncd-check [--ini FILE [--state-dir DIR]] [--canon] [--inch]\n"
+         "                  [--tool-units mm|inch]\n"
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
          "               start-up code and the axis soft limits from the machine's INI\n"
+         "  --state-dir DIR  where the machine's parameter file and tool table live\n"
+         "               (default as for cncd: [CNCD] STATE_DIR, $STATE_DIRECTORY,\n"
+         "               $XDG_STATE_HOME/cncd/<INI name>); read only, never written\n"
          "  --canon      print the canonical commands as LinuxCNC's rs274 does\n"
          "  --inch       machine units are inches (without --ini)\n"
          "  --tool-units units the tool table is written in (default: the machine's)\n"
@@ -144,6 +148,7 @@ int main(int argc, char** argv) {
   bool json = false;
   std::string trajectory;
   std::string ini;
+  config::LoadOptions load_options;
   std::string program;
   double max_seconds = 600;
   for (int i = 1; i < argc; ++i) {
@@ -158,11 +163,13 @@ int main(int argc, char** argv) {
     } else if (arg == "--inch") {
       inch = true;
     } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
-               arg == "--max-seconds" || arg == "--trajectory") {
+               arg == "--max-seconds" || arg == "--trajectory" || arg == "--state-dir") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
         ini = value;
+      } else if (arg == "--state-dir") {
+        load_options.state_dir = value;
       } else if (arg == "--trajectory") {
         trajectory = value;
       } else if (arg == "--max-seconds") {
@@ -187,6 +194,7 @@ int main(int argc, char** argv) {
   }
   if (program.empty()) return usage("no program given");
   if (plan && ini.empty()) return usage("--plan needs --ini: the machine's limits");
+  if (ini.empty() && !load_options.state_dir.empty()) return usage("--state-dir goes with --ini");
   if (plan && canon) return usage("--plan and --canon exclude each other");
   if (!plan && (json || !trajectory.empty()))
     return usage("--json and --trajectory go with --plan");
@@ -195,7 +203,7 @@ int main(int argc, char** argv) {
   options.max_seconds = max_seconds;
   std::optional<config::LoadResult> loaded;
   if (!ini.empty()) {
-    loaded = config::load_machine_config(ini);
+    loaded = config::load_machine_config(ini, load_options);
     if (!loaded->ok()) {
       for (const auto& problem : loaded->problems)
         std::cerr << problem.to_string() << '\n';
@@ -205,12 +213,24 @@ int main(int argc, char** argv) {
     }
     options.machine = &*loaded->config;
     options.interp = daemon::interpreter_options(*loaded->config);
+    // Where the daemon would read them: the state directory's copies, else the seeds beside
+    // the INI that it would start from. Only read; cncd-check never writes them.
+    const auto& machine = *loaded->config;
+    options.interp.parameter_file =
+        config::state_file_to_read(machine.parameter_file, machine.parameter_file_seed);
+    options.interp.tool_table =
+        config::state_file_to_read(machine.tool_table, machine.tool_table_seed);
   } else if (inch) {
     options.interp.machine_units = interp::Units::inches;
   }
   if (!overrides.tool_table.empty()) options.interp.tool_table = overrides.tool_table;
   if (!overrides.parameter_file.empty()) options.interp.parameter_file = overrides.parameter_file;
   if (overrides.tool_table_units) options.interp.tool_table_units = overrides.tool_table_units;
+  // A parameter file or tool table not there yet is no reason to refuse: the daemon starts
+  // from the defaults too, and writes the file later.
+  const interp::Interpreter loader(options.interp);
+  for (const auto& warning : loader.load_warnings())
+    std::cerr << "cncd-check: warning: " << warning << '\n';
 
   std::ios::sync_with_stdio(false);
   if (plan) {

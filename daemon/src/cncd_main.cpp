@@ -18,6 +18,7 @@
 #include "logging.hpp"
 #include "methods.hpp"
 #include "server.hpp"
+#include "state_files.hpp"
 #include "task.hpp"
 #include "version.hpp"
 #include "watchdog_gate.hpp"
@@ -29,13 +30,16 @@ constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE
 
 void print_usage(std::FILE* out) {
   std::fprintf(out,
-               "usage: cncd --ini FILE [--socket PATH] [--log-level LEVEL]\n"
-               "       cncd --check-config FILE\n"
+               "usage: cncd --ini FILE [--socket PATH] [--state-dir DIR] [--log-level LEVEL]\n"
+               "       cncd --check-config FILE [--state-dir DIR]\n"
                "       cncd --version\n"
                "\n"
                "  --ini FILE           machine configuration (LinuxCNC-style INI)\n"
                "  --socket PATH        control socket (default: [CNCD] SOCKET, else "
                "/run/cncd/cncd.sock)\n"
+               "  --state-dir DIR      where the parameter, tool and position files live\n"
+               "                       (default: [CNCD] STATE_DIR, else $STATE_DIRECTORY, else\n"
+               "                       $XDG_STATE_HOME/cncd/<INI name>)\n"
                "  --log-level LEVEL    trace, debug, info, warn, error, critical or off\n"
                "                       (default: [CNCD] LOG_LEVEL, else info)\n"
                "  --check-config FILE  validate FILE, print a summary of the machine, exit 0;\n"
@@ -46,6 +50,7 @@ struct Options {
   std::string ini;
   std::string socket;
   std::string log_level;
+  std::string state_dir;
   bool check_only = false;
 };
 
@@ -76,6 +81,9 @@ std::optional<int> parse_args(int argc, char** argv, Options& options) {
     } else if (arg == "--socket") {
       if (!(v = value("--socket"))) return kExitUsage;
       options.socket = *v;
+    } else if (arg == "--state-dir") {
+      if (!(v = value("--state-dir"))) return kExitUsage;
+      options.state_dir = *v;
     } else if (arg == "--log-level") {
       if (!(v = value("--log-level"))) return kExitUsage;
       options.log_level = *v;
@@ -116,6 +124,22 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
     return kExitUnavailable;
   }
 
+  std::vector<StateNote> notes;
+  if (const auto error = prepare_state_files(config, notes); !error.empty()) {
+    spdlog::critical("{}", error);
+    return cncd::config::kExitConfig;
+  }
+  if (!config.cncd.state_dir.empty()) {
+    spdlog::info("state files in {} ({})", config.cncd.state_dir.string(),
+                 config.cncd.state_dir_origin);
+  }
+  for (const auto& note : notes) {
+    if (note.warning) {
+      spdlog::warn("{}", note.text);
+    } else {
+      spdlog::info("{}", note.text);
+    }
+  }
   EventLog events;
   Completions completions;
   Task task(config, events, completions);
@@ -185,7 +209,9 @@ int main(int argc, char** argv) {
   Options options;
   if (const auto status = parse_args(argc, argv, options)) return *status;
 
-  const auto loaded = cncd::config::load_machine_config(options.ini);
+  cncd::config::LoadOptions load_options;
+  load_options.state_dir = options.state_dir;
+  const auto loaded = cncd::config::load_machine_config(options.ini, load_options);
   if (!loaded.ok()) {
     for (const auto& problem : loaded.problems) {
       std::fprintf(stderr, "%s\n", problem.to_string().c_str());

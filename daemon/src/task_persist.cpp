@@ -9,7 +9,7 @@
 namespace cncd::daemon {
 
 std::string Task::load_files() {
-  if (const auto& error = interp_->load_error(); error && std::filesystem::exists(error->file)) {
+  if (const auto& error = interp_->load_error()) {
     files_corrupt_ = true;
     // The parameter reader names the file and line itself.
     return error->message.rfind(error->file, 0) == 0 ? error->message : error->to_string();

@@ -216,6 +216,7 @@ struct Interpreter::Impl {
   CanonCommand command_;
   std::optional<InterpError> error_;
   std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
+  std::vector<std::string> load_warnings_;   // parameter file or tool table not there yet
   int current_line_ = 0;
   std::uint64_t loops_without_motion_ = 0;
   bool preamble_done_ = false;

@@ -18,12 +18,24 @@ std::string InterpError::to_string() const {
 Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
   block_.clear();  // no block has run yet: state() reports no group 0 code
   parameters_.set_predefined([this](std::string_view name) { return predefined_parameter(name); });
-  if (!options_.parameter_file.empty()) {
+  // A file that is not there yet starts from the defaults, as LinuxCNC does; whoever owns it
+  // (the daemon) writes it later. One that is there but unreadable is an error.
+  auto missing = [](const std::filesystem::path& path) {
+    std::error_code ec;
+    return !std::filesystem::exists(path, ec) && !ec;
+  };
+  if (!options_.parameter_file.empty() && missing(options_.parameter_file)) {
+    load_warnings_.push_back(options_.parameter_file.string() +
+                             ": parameter file does not exist; default parameters are used");
+  } else if (!options_.parameter_file.empty()) {
     if (auto problem = parameters_.load(options_.parameter_file)) {
       config_error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
     }
   }
-  if (!options_.tool_table.empty()) {
+  if (!options_.tool_table.empty() && missing(options_.tool_table)) {
+    load_warnings_.push_back(options_.tool_table.string() +
+                             ": tool table does not exist; the table is empty");
+  } else if (!options_.tool_table.empty()) {
     if (auto problem = tools_.load(options_.tool_table)) {
       config_error_ = InterpError{options_.tool_table.string(), 0, 0, *problem};
     }
@@ -270,6 +282,10 @@ const std::optional<InterpError>& Interpreter::error() const {
 
 const std::optional<InterpError>& Interpreter::load_error() const {
   return impl_->config_error_;
+}
+
+const std::vector<std::string>& Interpreter::load_warnings() const {
+  return impl_->load_warnings_;
 }
 
 int Interpreter::current_line() const {

@@ -50,11 +50,15 @@ TEST(ExampleConfigTest, SimMmLoadsWithoutProblemsOrWarnings) {
   EXPECT_EQ(c.joint_count, 3);
   ASSERT_EQ(c.joints.size(), 3u);
   EXPECT_EQ(c.max_linear_velocity, 250);
-  EXPECT_EQ(c.parameter_file, (kExamples / "sim_mm.var").lexically_normal());
-  EXPECT_EQ(c.tool_table, (kExamples / "sim_mm.tbl").lexically_normal());
-  EXPECT_TRUE(std::filesystem::exists(c.parameter_file));
-  EXPECT_TRUE(std::filesystem::exists(c.tool_table));
-  EXPECT_FALSE(c.position_file.empty());
+  // The state files live in the state directory, starting from the example's own copies.
+  EXPECT_FALSE(c.cncd.state_dir.empty());
+  EXPECT_EQ(c.parameter_file, c.cncd.state_dir / "sim_mm.var");
+  EXPECT_EQ(c.tool_table, c.cncd.state_dir / "sim_mm.tbl");
+  EXPECT_EQ(c.position_file, c.cncd.state_dir / "sim_mm.position");
+  EXPECT_EQ(c.parameter_file_seed, (kExamples / "sim_mm.var").lexically_normal());
+  EXPECT_EQ(c.tool_table_seed, (kExamples / "sim_mm.tbl").lexically_normal());
+  EXPECT_TRUE(std::filesystem::exists(c.parameter_file_seed));
+  EXPECT_TRUE(std::filesystem::exists(c.tool_table_seed));
   EXPECT_EQ(c.cncd.socket_path, "/run/cncd/cncd.sock");
   EXPECT_EQ(c.cncd.log_level, "info");
   for (const auto& j : c.joints) {

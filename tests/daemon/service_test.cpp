@@ -95,8 +95,10 @@ TEST(SocketActivation, ServesTheHandedOverSocketAndLeavesItToSystemd) {
   ASSERT_GE(listen_fd, 0);
   const pid_t pid = fork();
   if (pid == 0) {
-    // As systemd does: the socket as fd 3, LISTEN_FDS and LISTEN_PID naming this process.
+    // As systemd does: the socket as fd 3, LISTEN_FDS and LISTEN_PID naming this process,
+    // and the unit's StateDirectory= as $STATE_DIRECTORY.
     if (dup2(listen_fd, 3) != 3) _exit(127);
+    setenv("STATE_DIRECTORY", (dir.path() / "state").c_str(), 1);
     setenv("LISTEN_FDS", "1", 1);
     setenv("LISTEN_PID", std::to_string(getpid()).c_str(), 1);
     const int log = open((dir.path() / "cncd.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -116,6 +118,10 @@ TEST(SocketActivation, ServesTheHandedOverSocketAndLeavesItToSystemd) {
   waitpid(pid, &status, 0);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
   EXPECT_TRUE(std::filesystem::exists(handed));  // systemd's to remove, not cncd's
+  // The state files went to $STATE_DIRECTORY, the parameters starting from the seed.
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "state" / "sim_mm.position"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "state" / "sim_mm.var"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "sim_mm.position"));
 }
 
 TEST_F(MachineTest, SigtermDuringAMoveStopsOnThePathAndKeepsThePosition) {

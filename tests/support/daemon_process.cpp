@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -112,6 +113,11 @@ std::string DaemonProcess::start(const std::filesystem::path& dir,
   log_ = dir / "cncd.log";
   std::vector<std::string> argv{CNCD_BINARY};
   argv.insert(argv.end(), args.begin(), args.end());
+  // State files stay in the test's own directory, never in a state directory shared by runs.
+  if (!default_state_dir_ && std::find(args.begin(), args.end(), "--state-dir") == args.end()) {
+    argv.push_back("--state-dir");
+    argv.push_back(dir.string());
+  }
   argv.push_back("--socket");
   argv.push_back(socket_);
   pid_ = spawn(argv, dir / "cncd.out", log_);

@@ -44,7 +44,8 @@ class DaemonProcess {
   DaemonProcess(const DaemonProcess&) = delete;
   DaemonProcess& operator=(const DaemonProcess&) = delete;
 
-  // Starts cncd with `args` plus --socket; waits until the socket accepts connections.
+  // Starts cncd with `args` plus --socket, and --state-dir `dir` unless `args` name one or
+  // use_default_state_dir() was called; waits until the socket accepts connections.
   // Returns "" or what went wrong (with cncd's log).
   std::string start(const std::filesystem::path& dir, const std::vector<std::string>& args);
   // SIGTERM and wait; returns the exit status.
@@ -53,11 +54,14 @@ class DaemonProcess {
   void signal(int signal);
   // SIGKILL and wait: the daemon dies wherever it is. Returns the exit status.
   int kill_hard();
+  // The next start() leaves the state directory to the INI and the environment.
+  void use_default_state_dir() { default_state_dir_ = true; }
   const std::string& socket() const { return socket_; }
   std::string log() const;
 
  private:
   pid_t pid_ = -1;
+  bool default_state_dir_ = false;
   std::string socket_;
   std::filesystem::path log_;
 };

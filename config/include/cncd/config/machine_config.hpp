@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -88,6 +89,11 @@ struct CncdConfig {
   int rt_priority = 80;            // SCHED_FIFO priority of the servo thread
   int rt_cpu = -1;                 // CPU to pin the servo thread to, -1 = any
   std::string log_level = "info";  // trace|debug|info|warn|error|critical|off
+  // Where the parameter, tool and position files named by relative paths live: --state-dir,
+  // else [CNCD] STATE_DIR, else $STATE_DIRECTORY (systemd), else $XDG_STATE_HOME/cncd/<INI
+  // name> ($HOME/.local/state/cncd/<INI name>). Empty only when none of them is known.
+  std::filesystem::path state_dir;
+  std::string state_dir_origin;  // which of those chose it, for messages
 };
 
 struct MachineConfig {
@@ -98,12 +104,17 @@ struct MachineConfig {
   std::int64_t base_period_ns = 0;  // 0 = no base thread
   // [TASK]
   double task_cycle_time_s = 0.001;
-  // [RS274NGC]; paths are resolved relative to the INI file's directory.
+  // [RS274NGC]; paths are resolved relative to the INI file's directory, except the state
+  // files (parameter_file, tool_table, position_file): a relative one lives in the state
+  // directory, and its *_seed is the file of that name beside the INI, copied there when the
+  // state directory has none yet. An absolute one is used where it is, without a seed.
   std::filesystem::path parameter_file;
+  std::filesystem::path parameter_file_seed;
   std::string startup_code;
   std::vector<std::filesystem::path> subroutine_path;
   // [EMCIO]
   std::filesystem::path tool_table;
+  std::filesystem::path tool_table_seed;
   // [TRAJ]
   // [TRAJ] COORDINATES without blanks, upper case: the axes the machine has, a letter repeated
   // for every joint of a gantry ("XYYZ"). Which joint drives which axis is JointConfig::axis.
@@ -119,6 +130,7 @@ struct MachineConfig {
   // second ([TRAJ] PLANNER_TYPE, MAX_LINEAR_JERK).
   bool scurve = false;
   std::filesystem::path position_file;
+  std::filesystem::path position_file_seed;
   bool no_force_homing = false;
   // [KINS]
   std::string kinematics = "trivkins";  // module name only, e.g. "trivkins"
@@ -162,8 +174,23 @@ struct LoadResult {
   bool ok() const { return config.has_value(); }
 };
 
+struct LoadOptions {
+  // --state-dir: the state directory, before [CNCD] STATE_DIR; empty = not given.
+  std::filesystem::path state_dir;
+  // Looks up an environment variable ($STATE_DIRECTORY, $XDG_STATE_HOME, $HOME).
+  const char* (*getenv)(const char* name) = [](const char* name) -> const
+      char* { return std::getenv(name); };
+};
+
 // Reads, validates and types an INI file. Never throws on bad input; collects all problems.
-LoadResult load_machine_config(const std::filesystem::path& ini_path);
+LoadResult load_machine_config(const std::filesystem::path& ini_path,
+                               const LoadOptions& options = {});
+
+// The copy of a state file to read: `file` when it exists, else `seed` when that exists,
+// else `file` (which then does not exist: the defaults apply). cncd-check reads this way
+// without writing; the daemon copies the seed into place first (daemon/src/state_files.cpp).
+std::filesystem::path state_file_to_read(const std::filesystem::path& file,
+                                         const std::filesystem::path& seed);
 
 // A readable multi-line summary (axes, joints, limits, units, period, drivers) for
 // `cncd --check-config`.

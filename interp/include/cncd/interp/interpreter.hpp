@@ -97,6 +97,9 @@ class Interpreter {
   const std::optional<InterpError>& error() const;
   // Why the parameter file or the tool table could not be loaded at construction, if so.
   const std::optional<InterpError>& load_error() const;
+  // A parameter file or tool table that does not exist yet: the defaults (an empty table) are
+  // used, as LinuxCNC does; one line per file, naming it.
+  const std::vector<std::string>& load_warnings() const;
   // Line number of the block last executed.
   int current_line() const;
 
