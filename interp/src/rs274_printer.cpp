@@ -2,11 +2,13 @@
 
 #include <cstdio>
 
+#include "cncd/interp/fixed_text.hpp"
+
 namespace cncd::interp {
 namespace {
 
-void append(std::string& out, const char* format, double value) {
-  char buffer[64];
+void append_printf(std::string& out, const char* format, double value) {
+  char buffer[400];
   const int n = std::snprintf(buffer, sizeof buffer, format, value);
   if (n > 0) out.append(buffer, static_cast<std::size_t>(n));
 }
@@ -14,7 +16,7 @@ void append(std::string& out, const char* format, double value) {
 void append_pose(std::string& out, const Pose& pose, int axes) {
   for (int axis = 0; axis < axes; ++axis) {
     if (axis > 0) out += ", ";
-    append(out, "%.4f", pose[static_cast<std::size_t>(axis)]);
+    append_fixed4(out, pose[static_cast<std::size_t>(axis)]);
   }
 }
 
@@ -80,130 +82,164 @@ const char* simple_name(CanonKind kind) {
   }
 }
 
-}  // namespace
-
-std::string format_rs274(const CanonCommand& c, int axes) {
-  std::string out;
-  if (const char* name = simple_name(c.kind)) return name;
+// Appends the command's text without its newline; `out` keeps its capacity from one command
+// to the next, so printing a long program allocates nothing per command.
+void append_rs274(std::string& out, const CanonCommand& c, int axes) {
+  if (const char* name = simple_name(c.kind)) {
+    out += name;
+    return;
+  }
   switch (c.kind) {
     case CanonKind::straight_traverse:
     case CanonKind::straight_feed:
-      out = c.kind == CanonKind::straight_traverse ? "STRAIGHT_TRAVERSE(" : "STRAIGHT_FEED(";
+      out += c.kind == CanonKind::straight_traverse ? "STRAIGHT_TRAVERSE(" : "STRAIGHT_FEED(";
       append_pose(out, c.pos, axes);
       break;
     case CanonKind::arc_feed: {
-      out = "ARC_FEED(";
-      append(out, "%.4f", c.first_end);
-      append(out, ", %.4f", c.second_end);
-      append(out, ", %.4f", c.first_axis);
-      append(out, ", %.4f", c.second_axis);
-      out += ", " + std::to_string(c.rotation);
-      append(out, ", %.4f", c.axis_end_point);
-      for (int axis = 3; axis < axes; ++axis)
-        append(out, ", %.4f", c.pos[static_cast<std::size_t>(axis)]);
+      out += "ARC_FEED(";
+      append_fixed4(out, c.first_end);
+      out += ", ";
+      append_fixed4(out, c.second_end);
+      out += ", ";
+      append_fixed4(out, c.first_axis);
+      out += ", ";
+      append_fixed4(out, c.second_axis);
+      out += ", ";
+      append_int(out, c.rotation);
+      out += ", ";
+      append_fixed4(out, c.axis_end_point);
+      for (int axis = 3; axis < axes; ++axis) {
+        out += ", ";
+        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
+      }
       break;
     }
     case CanonKind::dwell:
-      out = "DWELL(";
-      append(out, "%.4f", c.value);
+      out += "DWELL(";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::set_feed_rate:
-      out = "SET_FEED_RATE(";
-      append(out, "%.4f", c.value);
+      out += "SET_FEED_RATE(";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::set_feed_mode:
-      out = "SET_FEED_MODE(0, " + std::to_string(c.ivalue);
+      out += "SET_FEED_MODE(0, ";
+      append_int(out, c.ivalue);
       break;
     case CanonKind::select_plane:
-      out = std::string("SELECT_PLANE(") + plane_name(c.plane);
+      out += "SELECT_PLANE(";
+      out += plane_name(c.plane);
       break;
     case CanonKind::use_length_units:
-      out = std::string("USE_LENGTH_UNITS(") + units_name(c.ivalue);
+      out += "USE_LENGTH_UNITS(";
+      out += units_name(c.ivalue);
       break;
     case CanonKind::set_g5x_offset:
-      out = "SET_G5X_OFFSET(" + std::to_string(c.ivalue) + ", ";
+      out += "SET_G5X_OFFSET(";
+      append_int(out, c.ivalue);
+      out += ", ";
       append_pose(out, c.pos, axes);
       break;
     case CanonKind::set_g92_offset:
-      out = "SET_G92_OFFSET(";
+      out += "SET_G92_OFFSET(";
       append_pose(out, c.pos, axes);
       break;
     case CanonKind::set_xy_rotation:
-      out = "SET_XY_ROTATION(";
-      append(out, "%.4f", c.value);
+      out += "SET_XY_ROTATION(";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::use_tool_length_offset:
-      out = "USE_TOOL_LENGTH_OFFSET(";
+      out += "USE_TOOL_LENGTH_OFFSET(";
       for (int axis = 0; axis < kAxes; ++axis) {
         if (axis > 0) out += axis % 3 == 0 ? ", " : " ";
-        append(out, "%.4f", c.pos[static_cast<std::size_t>(axis)]);
+        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
       }
       break;
     case CanonKind::set_motion_control_mode:
       switch (static_cast<MotionMode>(c.ivalue)) {
         case MotionMode::exact_stop:
-          out = "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP";
+          out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP";
           break;
         case MotionMode::exact_path:
-          out = "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH";
+          out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH";
           break;
         case MotionMode::continuous:
         default:
-          out = "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, ";
-          append(out, "%.6f", c.value);
+          out += "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, ";
+          append_printf(out, "%.6f", c.value);
           break;
       }
       break;
     case CanonKind::set_naivecam_tolerance:
-      out = "SET_NAIVECAM_TOLERANCE(";
-      append(out, "%.4f", c.value);
+      out += "SET_NAIVECAM_TOLERANCE(";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::set_spindle_speed:
-      out = "SET_SPINDLE_SPEED(0, ";
-      append(out, "%.4f", c.value);
+      out += "SET_SPINDLE_SPEED(0, ";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::orient_spindle:
-      out = "ORIENT_SPINDLE(0, ";
-      append(out, "%.4f", c.value);
-      out += ", " + std::to_string(c.ivalue);
+      out += "ORIENT_SPINDLE(0, ";
+      append_fixed4(out, c.value);
+      out += ", ";
+      append_int(out, c.ivalue);
       break;
     case CanonKind::set_tool_table_entry:
-      out = "SET_TOOL_TABLE_ENTRY(" + std::to_string(c.ivalue) + ", " + std::to_string(c.ivalue2) +
-            ", ";
+      out += "SET_TOOL_TABLE_ENTRY(";
+      append_int(out, c.ivalue);
+      out += ", ";
+      append_int(out, c.ivalue2);
+      out += ", ";
       for (int axis = 0; axis < kAxes; ++axis) {
         if (axis > 0) out += ' ';
-        append(out, "%.4f", c.pos[static_cast<std::size_t>(axis)]);
+        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
       }
-      append(out, ", %.4f", c.value);
-      append(out, ", %.4f", c.value2);
-      out += ", " + std::to_string(c.ivalue3);
+      out += ", ";
+      append_fixed4(out, c.value);
+      out += ", ";
+      append_fixed4(out, c.value2);
+      out += ", ";
+      append_int(out, c.ivalue3);
       break;
     case CanonKind::set_spindle_mode:
-      out = "SET_SPINDLE_MODE(0 ";
-      append(out, "%.4f", c.value);
+      out += "SET_SPINDLE_MODE(0 ";
+      append_fixed4(out, c.value);
       break;
     case CanonKind::select_tool:
-      out = "SELECT_TOOL(" + std::to_string(c.ivalue);
+      out += "SELECT_TOOL(";
+      append_int(out, c.ivalue);
       break;
     case CanonKind::change_tool:
-      out = "CHANGE_TOOL(" + std::to_string(c.ivalue);
+      out += "CHANGE_TOOL(";
+      append_int(out, c.ivalue);
       break;
     case CanonKind::change_tool_number:
-      out = "CHANGE_TOOL_NUMBER(" + std::to_string(c.ivalue);
+      out += "CHANGE_TOOL_NUMBER(";
+      append_int(out, c.ivalue);
       break;
     case CanonKind::set_feed_override_enable:
-      return c.ivalue != 0 ? "ENABLE_FEED_OVERRIDE()" : "DISABLE_FEED_OVERRIDE()";
+      out += c.ivalue != 0 ? "ENABLE_FEED_OVERRIDE()" : "DISABLE_FEED_OVERRIDE()";
+      return;
     case CanonKind::set_spindle_override_enable:
-      return c.ivalue != 0 ? "ENABLE_SPEED_OVERRIDE(0)" : "DISABLE_SPEED_OVERRIDE(0)";
+      out += c.ivalue != 0 ? "ENABLE_SPEED_OVERRIDE(0)" : "DISABLE_SPEED_OVERRIDE(0)";
+      return;
     case CanonKind::set_adaptive_feed_enable:
-      return c.ivalue != 0 ? "ENABLE_ADAPTIVE_FEED()" : "DISABLE_ADAPTIVE_FEED()";
+      out += c.ivalue != 0 ? "ENABLE_ADAPTIVE_FEED()" : "DISABLE_ADAPTIVE_FEED()";
+      return;
     case CanonKind::set_feed_hold_enable:
-      return c.ivalue != 0 ? "ENABLE_FEED_HOLD()" : "DISABLE_FEED_HOLD()";
+      out += c.ivalue != 0 ? "ENABLE_FEED_HOLD()" : "DISABLE_FEED_HOLD()";
+      return;
     case CanonKind::comment:
-      return "COMMENT(\"" + c.text + "\")";
+      out += "COMMENT(\"";
+      out += c.text;
+      out += "\")";
+      return;
     case CanonKind::message:
     case CanonKind::debug_message:
-      return "MESSAGE(\"" + c.text + "\")";
+      out += "MESSAGE(\"";
+      out += c.text;
+      out += "\")";
+      return;
     case CanonKind::start_spindle_clockwise:
     case CanonKind::start_spindle_counterclockwise:
     case CanonKind::stop_spindle_turning:
@@ -219,16 +255,24 @@ std::string format_rs274(const CanonCommand& c, int axes) {
     case CanonKind::finish:
     case CanonKind::start_change:
     case CanonKind::set_feed_reference:
-      return simple_name(c.kind);  // handled above; listed so the compiler checks coverage
+      return;  // handled above; listed so the compiler checks coverage
   }
   out += ')';
+}
+
+}  // namespace
+
+std::string format_rs274(const CanonCommand& command, int axes) {
+  std::string out;
+  append_rs274(out, command, axes);
   return out;
 }
 
 void Rs274Printer::emit(const CanonCommand& command) {
-  buffer_ = format_rs274(command, axes_);
+  buffer_.clear();
+  append_rs274(buffer_, command, axes_);
   buffer_ += '\n';
-  out_ << buffer_;
+  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
 }
 
 }  // namespace cncd::interp
