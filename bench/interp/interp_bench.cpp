@@ -1,8 +1,11 @@
 // Interpreter throughput and memory, side by side with LinuxCNC's rs274 when it is installed.
 // Generates into a temporary directory a G1 3D surfacing program (1,000,000 lines), a program
-// of 100,000 G81 blocks and, for memory, a 10,000,000-line surfacing program; interprets each
-// into a null sink in a child process of its own and prints lines/s and the child's peak
-// resident memory. rs274 runs on the same files (output to /dev/null, its own HOME).
+// of 100,000 G81 blocks and, for memory, a 10,000,000-line surfacing program. Each run is a
+// child process of its own: our interpreter into a null sink (interpretation alone),
+// `cncd-check --canon` (the canonical commands as text) and `rs274 -g` (its canonical text;
+// its own HOME), both with their output going to /dev/null. Prints lines/s by wall-clock and
+// by CPU time (user + system, which other load on the machine disturbs less), peak resident
+// memory, and the ratios to rs274.
 //
 //   cncd_interp_bench [--scale F] [--no-rs274] [--no-memory]
 //
@@ -11,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr const char* kRs274 = "/usr/bin/rs274";
+constexpr const char* kCncdCheck = CNCD_CHECK_BINARY;
 
 // A raster over a 100 x 100 mm sine-shaped surface: each line one G1 with X, Y and Z.
 void write_surfacing(const fs::path& path, long lines) {
@@ -71,9 +76,14 @@ long count_lines(const fs::path& path) {
 
 struct Run {
   bool ok = false;
-  double seconds = 0;
-  long peak_rss_kb = 0;  // the child's ru_maxrss
+  double seconds = 0;      // wall clock
+  double cpu_seconds = 0;  // the child's user + system time
+  long peak_rss_kb = 0;    // the child's ru_maxrss
 };
+
+double seconds_of(const timeval& t) {
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
+}
 
 // Runs `child` in a forked process; its exit status 0 means success. Times the whole child.
 template <typename Child>
@@ -90,6 +100,7 @@ Run in_child(Child child) {
   Run run;
   run.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
   run.seconds = elapsed.count();
+  run.cpu_seconds = seconds_of(usage.ru_utime) + seconds_of(usage.ru_stime);
   run.peak_rss_kb = usage.ru_maxrss;
   return run;
 }
@@ -105,39 +116,64 @@ Run run_ours(const fs::path& program) {
   });
 }
 
-Run run_rs274(const fs::path& program, const fs::path& home) {
-  return in_child([&program, &home] {
-    // The same invocation as the differential test: -g, its own HOME (rs274 keeps its tool
-    // data in a file there), canonical output thrown away.
+// Runs `binary -g|--canon program` with its output thrown away, in `home` (rs274 keeps its tool
+// data in a file there): the same invocation as the differential test.
+Run run_canon_text(const char* binary, const char* option, const fs::path& program,
+                   const fs::path& home) {
+  return in_child([&] {
     if (!freopen("/dev/null", "r", stdin) || !freopen("/dev/null", "w", stdout) ||
         !freopen("/dev/null", "w", stderr) || setenv("HOME", home.c_str(), 1) != 0 ||
         chdir(home.c_str()) != 0) {
       return 1;
     }
-    execl(kRs274, kRs274, "-g", program.c_str(), static_cast<char*>(nullptr));
+    execl(binary, binary, option, program.c_str(), static_cast<char*>(nullptr));
     return 127;
   });
 }
 
-void report(const char* name, const fs::path& program, bool with_rs274, const fs::path& home) {
+// One row: wall seconds, lines/s by wall clock, CPU seconds, lines/s by CPU time, peak RSS.
+void print_row(const char* what, const Run& run, long lines) {
+  if (!run.ok) {
+    std::printf("  %-34s FAILED\n", what);
+    return;
+  }
+  std::printf("  %-34s %7.2f %13.0f %7.2f %13.0f %13ld\n", what, run.seconds,
+              static_cast<double>(lines) / run.seconds, run.cpu_seconds,
+              static_cast<double>(lines) / run.cpu_seconds, run.peak_rss_kb);
+}
+
+// Our lines/s over rs274's.
+void print_ratio(const char* what, const Run& ours, const Run& theirs) {
+  if (!ours.ok || !theirs.ok) return;
+  std::printf("  %-34s %6.1fx by wall clock, %6.1fx by CPU time\n", what,
+              theirs.seconds / ours.seconds, theirs.cpu_seconds / ours.cpu_seconds);
+}
+
+// `text` adds the runs that print canonical commands: cncd-check --canon and, with `with_rs274`,
+// rs274 -g.
+void report(const char* name, const fs::path& program, bool text, bool with_rs274,
+            const fs::path& home) {
   const long lines = count_lines(program);
-  const Run ours = run_ours(program);
-  if (!ours.ok) {
-    std::printf("%-22s %10ld lines: cncd interpreter FAILED\n", name, lines);
-    return;
+  const std::string title = std::string(name) + ", " + std::to_string(lines) + " lines";
+  std::printf("%-36s %7s %13s %7s %13s %13s\n", title.c_str(), "wall s", "wall lines/s", "CPU s",
+              "CPU lines/s", "peak RSS KiB");
+  const Run interpretation = run_ours(program);
+  print_row("cncd interpretation alone", interpretation, lines);
+  if (!text) return;
+  const bool with_check = fs::exists(kCncdCheck);
+  Run canon;
+  if (with_check) {
+    canon = run_canon_text(kCncdCheck, "--canon", program, home);
+    print_row("cncd canon text (cncd-check)", canon, lines);
+  } else {
+    std::printf("  cncd-check --canon not run (%s not built)\n", kCncdCheck);
   }
-  const double our_rate = static_cast<double>(lines) / ours.seconds;
-  std::printf("%-22s %10ld lines  cncd %9.0f lines/s (%.2f s, peak RSS %ld KiB)\n", name, lines,
-              our_rate, ours.seconds, ours.peak_rss_kb);
   if (!with_rs274) return;
-  const Run theirs = run_rs274(program, home);
-  if (!theirs.ok) {
-    std::printf("%-22s rs274 failed on this file\n", "");
-    return;
-  }
-  const double their_rate = static_cast<double>(lines) / theirs.seconds;
-  std::printf("%-22s %10s        rs274 %8.0f lines/s (%.2f s, peak RSS %ld KiB)  ratio %.1fx\n", "",
-              "", their_rate, theirs.seconds, theirs.peak_rss_kb, our_rate / their_rate);
+  const Run theirs = run_canon_text(kRs274, "-g", program, home);
+  print_row("rs274 -g canon text", theirs, lines);
+  if (!theirs.ok) return;
+  print_ratio("cncd/rs274 interpretation alone", interpretation, theirs);
+  if (with_check) print_ratio("cncd/rs274 canon text", canon, theirs);
 }
 
 }  // namespace
@@ -176,17 +212,15 @@ int main(int argc, char** argv) {
 
   const auto scaled = [scale](long n) { return std::max(1L, std::lround(n * scale)); };
   write_surfacing(dir / "surface_1m.ngc", scaled(1'000'000));
-  report("G1 surfacing", dir / "surface_1m.ngc", rs274, home);
+  report("G1 surfacing", dir / "surface_1m.ngc", true, rs274, home);
   write_drilling(dir / "drill_g81.ngc", scaled(100'000));
-  report("G81 drilling", dir / "drill_g81.ngc", rs274, home);
+  report("G81 drilling", dir / "drill_g81.ngc", true, rs274, home);
   if (memory) {
     fs::remove(dir / "surface_1m.ngc");
     write_surfacing(dir / "surface_10m.ngc", scaled(10'000'000));
-    report("G1 surfacing (memory)", dir / "surface_10m.ngc", false, home);
+    report("G1 surfacing (memory)", dir / "surface_10m.ngc", false, false, home);
     write_surfacing(dir / "surface_10.ngc", 10);
-    const Run tiny = run_ours(dir / "surface_10.ngc");
-    std::printf("%-22s %10ld lines  peak RSS %ld KiB (for comparison)\n", "G1 surfacing (short)",
-                count_lines(dir / "surface_10.ngc"), tiny.peak_rss_kb);
+    report("G1 surfacing (short)", dir / "surface_10.ngc", false, false, home);
   }
   fs::remove_all(dir);
   return 0;
