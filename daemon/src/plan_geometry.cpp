@@ -116,7 +116,7 @@ double distance_to_path(const motion::Segment& segment, const motion::AxisPose& 
     return std::min(distance_to_path(in, point), distance_to_path(out, point));
   }
   // Arc: the candidates are the ends and, on every turn the sweep covers, the point at the
-  // sample's angle about the centre.
+  // sample's angle about the centre (a spiral's angle goes in proportion to the distance).
   double best = std::min(xyz_distance(segment.start, point), xyz_distance(segment.end, point));
   const double angle = std::atan2(point[segment.second_axis] - segment.center_second,
                                   point[segment.first_axis] - segment.center_first);

@@ -20,8 +20,9 @@ MoveLimits move_limits(const config::MachineConfig& machine, const motion::Segme
 // Time to cover `length` from rest to rest at most at `velocity` and `acceleration`.
 double rest_to_rest_s(double length, double velocity, double acceleration);
 
-// XYZ distance from `point` to the path of `segment` (line or arc, helices included: for
-// them the point of the same angle, an upper bound off by far less than the pitch).
+// XYZ distance from `point` to the path of `segment` (line or arc, helices and spirals
+// included: for them the point of the same angle, an upper bound off by far less than the
+// pitch or the radius change).
 double distance_to_path(const motion::Segment& segment, const motion::AxisPose& point);
 
 }  // namespace cncd::daemon

@@ -222,6 +222,9 @@ bool Planner::fillet(Held& held, Segment& next) {
   Segment& prev = held.segment;
   const Segment& arc = prev.kind == Segment::Kind::arc ? prev : next;
   if (arc.kind != Segment::Kind::arc) return false;
+  // The fit is made for circles: a spiral's end (a radius that changes along the sweep) is
+  // left to the kink rule, or stops.
+  if (prev.radius_change != 0 || next.radius_change != 0) return false;
   const int first = arc.first_axis, second = arc.second_axis;
   if (!planar(prev, first, second) || !planar(next, first, second)) return false;
   const AxisPose corner = prev.end;

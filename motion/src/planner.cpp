@@ -2,12 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 namespace cncd::motion {
 namespace {
 
 constexpr double kTiny = 1e-12;
+// Relative radius differences below this are rounding, not a program's spiral.
+constexpr double kRoundOff = 1e-9;
+
+// LinuxCNC lets a centre-format arc's end radius differ from its start radius by up to
+// 0.002 sqrt(2) in with G20 (0.02 sqrt(2) mm with G21), or by up to 0.1 % of the larger
+// radius but never more than 100 times that; the interpreter refuses the rest with LinuxCNC's
+// message. The planner takes anything the interpreter may pass in either unit (the inch
+// figures are the looser), with room for rounding through units, offsets and rotation: more
+// is not a program's arc.
+constexpr double kArcToleranceInch = 0.0028284271247461905;
+constexpr double kArcRelativeTolerance = 0.001;
+constexpr double kArcToleranceCap = 100.0;
+
+// `tolerance`: kArcToleranceInch in machine units.
+bool arc_radii_agree(double r0, double r1, double tolerance) {
+  constexpr double kSlack = 1.0 + 1e-6;
+  const double difference = std::abs(r1 - r0);
+  if (difference > kArcToleranceCap * tolerance * kSlack) return false;
+  return difference <= tolerance * kSlack ||
+         difference <= kArcRelativeTolerance * kSlack * std::max(r0, r1);
+}
+
+double plane_rate(const Segment& seg) {
+  // The in-plane speed per unit of the swept fraction, at the larger radius.
+  const double r_max = std::max(seg.radius, seg.radius + seg.radius_change);
+  return std::hypot(std::abs(seg.sweep) * r_max, seg.radius_change);
+}
 
 // LinuxCNC measures feed along XYZ when they move, else along UVW, else along ABC.
 double path_length(const AxisPose& delta) {
@@ -40,8 +68,9 @@ AxisPose Segment::point_at(double s) const noexcept {
     p[i] = start[i] + (end[i] - start[i]) * f;
   if (kind == Kind::arc) {
     const double angle = start_angle + sweep * f;
-    p[first_axis] = center_first + radius * std::cos(angle);
-    p[second_axis] = center_second + radius * std::sin(angle);
+    const double r = radius + radius_change * f;
+    p[first_axis] = center_first + r * std::cos(angle);
+    p[second_axis] = center_second + r * std::sin(angle);
     if (f >= 1.0) {
       p[first_axis] = end[first_axis];
       p[second_axis] = end[second_axis];
@@ -57,13 +86,15 @@ void Planner::set_directions(Segment& seg) {
   for (int i = 0; i < kAxes; ++i)
     start[i] = end[i] = seg.end[i] - seg.start[i];
   if (seg.kind == Segment::Kind::arc) {
-    const double k = seg.radius * seg.sweep;  // d(in-plane position)/d(fraction of the sweep)
-    const double a0 = seg.start_angle;
-    const double a1 = seg.start_angle + seg.sweep;
-    start[seg.first_axis] = -k * std::sin(a0);
-    start[seg.second_axis] = k * std::cos(a0);
-    end[seg.first_axis] = -k * std::sin(a1);
-    end[seg.second_axis] = k * std::cos(a1);
+    // d(in-plane position)/d(fraction of the sweep): radius x sweep across the radius, plus
+    // the radius change along it (a spiral's).
+    auto tangent = [&](double angle, double radius, AxisPose& d) {
+      const double k = radius * seg.sweep;
+      d[seg.first_axis] = seg.radius_change * std::cos(angle) - k * std::sin(angle);
+      d[seg.second_axis] = seg.radius_change * std::sin(angle) + k * std::cos(angle);
+    };
+    tangent(seg.start_angle, seg.radius, start);
+    tangent(seg.start_angle + seg.sweep, seg.radius + seg.radius_change, end);
   }
   auto normalize = [](AxisPose& d) {
     double sum = 0;
@@ -172,11 +203,23 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
                                  start[seg.second_axis] - move.center_second);
     const double r1 = std::hypot(seg.end[seg.first_axis] - move.center_first,
                                  seg.end[seg.second_axis] - move.center_second);
-    if (r0 < kTiny || std::abs(r0 - r1) > 1e-6 * std::max(1.0, r0) + 1e-6) {
-      error = "arc radius differs between start and end";
+    if (r0 < kTiny || r1 < kTiny) {
+      error = "arc starts or ends at its centre";
+      return std::nullopt;
+    }
+    if (!arc_radii_agree(r0, r1, kArcToleranceInch * 25.4 / config_.mm_per_unit())) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "arc radius differs between start and end by %.6g (%.6g to %.6g), more than "
+                    "any program's arc may",
+                    std::abs(r1 - r0), r0, r1);
+      error = text;
       return std::nullopt;
     }
     seg.radius = r0;
+    // Below rounding noise the arc stays a circle (the end point is still reached exactly):
+    // fillets round only circles.
+    if (std::abs(r1 - r0) > kRoundOff * std::max(1.0, r0)) seg.radius_change = r1 - r0;
     seg.start_angle = std::atan2(start[seg.second_axis] - move.center_second,
                                  start[seg.first_axis] - move.center_first);
     const double end_angle = std::atan2(seg.end[seg.second_axis] - move.center_second,
@@ -194,7 +237,7 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
       sweep -= two_pi * (-turns - 1);
     }
     seg.sweep = sweep;
-    const double arc_length = std::abs(sweep) * seg.radius;
+    const double arc_length = plane_rate(seg);
     double other = 0;
     for (int i = 0; i < kAxes; ++i) {
       if (i != seg.first_axis && i != seg.second_axis) other += delta[i] * delta[i];
@@ -227,10 +270,11 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
 
 void Planner::set_limits(Segment& seg) const {
   // Direction cosines along the path, per axis: for a line constant, for an arc the in-plane
-  // axes reach 1 somewhere on a large enough sweep, so they are bounded by 1.
+  // axes reach 1 somewhere on a large enough sweep, so they are bounded by 1 (times the
+  // in-plane share of the speed, which for a spiral is largest at its larger radius).
   AxisPose direction{};
   const bool arc = seg.kind == Segment::Kind::arc;
-  const double arc_length = arc ? std::abs(seg.sweep) * seg.radius : 0.0;
+  const double arc_length = arc ? plane_rate(seg) : 0.0;
   for (int i = 0; i < kAxes; ++i) {
     const bool in_plane = arc && (i == seg.first_axis || i == seg.second_axis);
     direction[i] = (in_plane ? arc_length : std::abs(seg.end[i] - seg.start[i])) / seg.length;
@@ -249,14 +293,31 @@ void Planner::set_limits(Segment& seg) const {
   if (arc) {
     // In the plane the acceleration is the tangential part (path acceleration x cos b, b the
     // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it.
-    const double plane_a =
+    double plane_a =
         std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
                  config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
     const double in_plane = direction[seg.first_axis];  // cos b
     const double fastest = seg.feed > 0 ? std::min(v, seg.feed * config_.max_feed_override) : v;
     double v_plane = v * in_plane;
     double a_plane = 0;
-    curve_limits(fastest * in_plane, seg.radius, plane_a, kArcNormalShare, v_plane, a_plane);
+    double radius = seg.radius;
+    if (seg.radius_change != 0) {
+      // A spiral's point is q e(theta), its angle turning at a rate w in proportion to the
+      // path speed and its radius q changing by dq per radian. At a steady path speed the
+      // in-plane acceleration is q w^2 inwards plus 2 dq w^2 across the radius, largest at the
+      // larger radius; against the largest in-plane speed squared (length's, also at the larger
+      // radius) that is the curvature of a circle of `radius`. It is not quite square to the
+      // velocity (the cosine between them is at most dq / q), so with the tangential part the
+      // plane's limit is shared as if it were lower by the factor sqrt(1 + dq / q).
+      const double sweep = std::abs(seg.sweep);
+      const double r_max = std::max(seg.radius, seg.radius + seg.radius_change);
+      const double r_min = std::min(seg.radius, seg.radius + seg.radius_change);
+      const double rate = plane_rate(seg);
+      radius = rate * rate / (sweep * std::hypot(sweep * r_max, 2.0 * seg.radius_change));
+      const double skew = std::min(1.0, std::abs(seg.radius_change) / (sweep * r_min));
+      plane_a /= std::sqrt(1.0 + skew);
+    }
+    curve_limits(fastest * in_plane, radius, plane_a, kArcNormalShare, v_plane, a_plane);
     a = std::min(a, a_plane / in_plane);
     v = std::min(v, v_plane / in_plane);
   }

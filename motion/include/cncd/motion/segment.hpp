@@ -21,10 +21,16 @@ struct Segment {
   double feed = 0;              // programmed feed, units/s; 0 = traverse (rapid override)
   double max_acceleration = 0;  // path acceleration limit, units/s^2
   double dwell_s = 0;
-  // Arc: centre in the plane, radius, start angle and signed sweep (rad), plane axes.
+  // Arc: centre in the plane, radius at the start, start angle and signed sweep (rad), plane
+  // axes. The radius goes linearly with the swept angle to radius + radius_change at the end:
+  // a spiral where a program's rounded centre words put the end off the start's circle, within
+  // the tolerance LinuxCNC allows (and runs the same way). The swept angle and every other axis
+  // advance in proportion to the path distance; `length` is the path length at the larger
+  // radius, so that the tool never goes faster than the planned path speed.
   std::int8_t first_axis = 0, second_axis = 1, normal_axis = 2;
   double center_first = 0, center_second = 0;
   double radius = 0;
+  double radius_change = 0;
   double start_angle = 0;
   double sweep = 0;
   // Blend: point(phi) = blend_center + radius (cos(phi) blend_u + sin(phi) blend_v) for phi
