@@ -148,7 +148,8 @@ void Task::open_program(const std::string& path) {
 }
 
 // Refuses a program whose moves leave the soft limits, from where the machine is now and with
-// the offsets and tools saved in the parameter file and tool table.
+// the offsets and tools saved in the parameter file and tool table, or that the interpreter
+// stops on: the error cncd-check gives, at the same line, and not part-way through a run.
 void Task::check_limits(const std::string& path) {
   CheckOptions options;
   options.interp = interpreter_options(config_);
@@ -163,7 +164,10 @@ void Task::check_limits(const std::string& path) {
   options.max_seconds = 5;
   const CheckReport report = check_program(path, options);
   if (report.stopped) events_.add("warning", "program", report.stopped->to_string());
-  if (report.limit_violations == 0) return;
+  if (report.limit_violations == 0) {
+    if (report.error) throw RpcError(kProgramError, report.error->to_string());
+    return;
+  }
   std::string message = report.problems.front().to_string();
   if (report.limit_violations > 1) {
     message += " (and " + std::to_string(report.limit_violations - 1) + " more)";

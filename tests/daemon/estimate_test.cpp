@@ -135,15 +135,22 @@ TEST_F(EstimateTest, RemainingTimeStandsStillWhilePaused) {
   EXPECT_EQ(done["program"]["result"], "done");
 }
 
-TEST_F(EstimateTest, WithoutAnEstimateRemainingIsNullWithTheReason) {
+TEST_F(EstimateTest, AProgramTheInterpreterStopsOnIsNotOpenedAndLeavesTheEstimate) {
   ready_machine();
-  // The interpreter stops at line 3: no estimate, and the reason names the line.
-  const json s = open_and_estimate(dir_.write("bad.ngc", "G21 G90\nG0 X5\nG1 X10\nM2\n"));
-  EXPECT_TRUE(s["program"]["estimated_s"].is_null()) << s.dump();
-  EXPECT_TRUE(s["program"]["remaining_s"].is_null());
-  EXPECT_NE(s["program"]["remaining_reason"].get<std::string>().find("bad.ngc:3:"),
-            std::string::npos)
-      << s.dump();
+  const auto good = dir_.write("good.ngc", "G21 G90\nG1 X10 F600\nM2\n");
+  const json opened = open_and_estimate(good);
+  ASSERT_TRUE(opened["program"]["estimated_s"].is_number()) << opened.dump();
+  // The interpreter stops at line 3 (a feed move without a feed): refused, naming the line,
+  // as cncd-check does; the program open before stays open with its estimate.
+  const json r = call("program.open", {{"path", dir_.write("bad.ngc",
+                                                           "G21 G90\nG0 X5\nG1 "
+                                                           "X10\nM2\n")
+                                                    .string()}});
+  EXPECT_EQ(error_code(r), 1003);
+  EXPECT_NE(r["error"].value("message", "").find("bad.ngc:3:"), std::string::npos) << r.dump();
+  const json s = status();
+  EXPECT_EQ(s["program"]["path"], good.string()) << s.dump();
+  EXPECT_EQ(s["program"]["estimated_s"], opened["program"]["estimated_s"]);
 }
 
 TEST_F(EstimateTest, ARunFromALineCountsDownFromThatLine) {

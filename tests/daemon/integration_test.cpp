@@ -112,8 +112,19 @@ TEST_F(DaemonTest, RunsTheSeedG81ExampleToItsEnd) {
 
 TEST_F(DaemonTest, ProgramErrorNamesFileAndLine) {
   ready_machine();
-  const auto program = dir_.write("bad.ngc", "G21 G90\nG0 X1\nG81 X2 Y2 Z1 R0.5\nM2\n");
-  const json s = run_to_end(program.string());
+  const std::string bad = "G21 G90\nG0 X1\nG81 X2 Y2 Z1 R0.5\nM2\n";
+  const auto program = dir_.write("bad.ngc", bad);
+  // program.open runs the program through the interpreter and refuses it there.
+  const json r = client_.call("program.open", {{"path", program.string()}});
+  ASSERT_TRUE(r.contains("error")) << r.dump();
+  EXPECT_EQ(r["error"]["code"], 1003);
+  EXPECT_NE(r["error"].value("message", "").find("bad.ngc:3"), std::string::npos) << r.dump();
+  // Changed on disk after it was opened, it stops the run at that line.
+  dir_.write("bad.ngc", "G21 G90\nM2\n");
+  result(client_.call("program.open", {{"path", program.string()}}));
+  dir_.write("bad.ngc", bad);
+  result(client_.call("program.run"));
+  const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
   EXPECT_EQ(s["program"]["result"], "error");
   const std::string error = s["program"]["error"];
   EXPECT_NE(error.find("bad.ngc:3"), std::string::npos) << error;
