@@ -34,11 +34,13 @@ PlaneAxes plane_axes(Plane plane) {
   }
 }
 
-// LinuxCNC's limits: a center-format arc may miss its radius by this much (and by 0.1 %),
-// a radius-format arc may be this much too short to reach its end point.
+// LinuxCNC's limits: a center-format arc may miss its radius by this much, or by 0.1 % of
+// the larger radius but never by more than 100 times this much (the motion planner runs what
+// passes as a spiral); a radius-format arc may be this much too short to reach its end point.
 constexpr double kCenterToleranceMm = 0.028284271247461905;  // 0.02 * sqrt(2)
 constexpr double kCenterToleranceInch = 0.0028284271247461905;
 constexpr double kCenterRelativeTolerance = 0.001;
+constexpr double kCenterToleranceCap = 100.0;
 constexpr double kRadiusToleranceInch = 0.00005;
 
 std::string format(const char* pattern, double a, double b) {
@@ -120,8 +122,9 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
     if (r1 == 0.0 || r2 == 0.0) fail("Zero-radius arc:" + where());
     const double abs_err = std::fabs(r1 - r2);
     const double rel_err = abs_err / std::max(r1, r2);
-    if (abs_err > (inches ? kCenterToleranceInch : kCenterToleranceMm) &&
-        rel_err > kCenterRelativeTolerance) {
+    const double tolerance = inches ? kCenterToleranceInch : kCenterToleranceMm;
+    if (abs_err > kCenterToleranceCap * tolerance ||
+        (abs_err > tolerance && rel_err > kCenterRelativeTolerance)) {
       fail("Radius to end of arc differs from radius to start:" + where() +
            format(" abs_err=%.4g rel_err=%.4f%%", abs_err, rel_err * 100.0));
     }
