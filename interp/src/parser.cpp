@@ -62,6 +62,7 @@ void BlockParser::parse(std::string_view line, Block& block) {
   normalize(line);
   pos_ = 0;
   depth_ = 0;
+  o_allowed_ = true;
   if (peek() == '/') {
     block.block_delete = true;
     ++pos_;
@@ -93,6 +94,8 @@ void BlockParser::read_comment(Block& block) {
 void BlockParser::read_word(Block& block) {
   const char c = peek();
   const int col = column();
+  if (c == 'o' && !o_allowed_) error("Bad character 'o' used");
+  o_allowed_ = o_allowed_ && c == 'n';
   if (c == '(' || c == ';') {
     read_comment(block);
     return;
@@ -201,6 +204,10 @@ void BlockParser::read_o(Block& block, int col) {
   std::string keyword;
   while (is_alpha(peek()))
     keyword.push_back(text_[pos_++]);
+  if (keyword.empty()) {
+    read_program_number(block);
+    return;
+  }
   struct Entry {
     const char* word;
     OKind kind;
@@ -247,6 +254,19 @@ void BlockParser::read_o(Block& block, int col) {
     default:
       break;
   }
+}
+
+void BlockParser::read_program_number(Block& block) {
+  // A bare O-word is a program number (Fanuc posts start with "O1234 (NAME)"): LinuxCNC
+  // ignores it, and the comments after it too (no message, no comment); anything else after
+  // it is refused.
+  const int comments_before = block.comment_count;
+  while (pos_ < text_.size()) {
+    if (peek() != '(' && peek() != ';') error("Unexpected character after O-word");
+    read_comment(block);
+  }
+  block.comment_count = comments_before;
+  block.o_kind = OKind::none;
 }
 
 void BlockParser::read_assignment(Block& block) {

@@ -31,6 +31,7 @@ class BlockParser {
   void read_g(Block& block, int column);
   void read_m(Block& block, int column);
   void read_o(Block& block, int column);
+  void read_program_number(Block& block);
   void read_assignment(Block& block);
 
   double read_real_value();
@@ -58,6 +59,9 @@ class BlockParser {
   std::string name_;
   std::size_t pos_ = 0;
   int depth_ = 0;  // nesting of the value being read
+  // Only block delete and a line number may come before an O-word (LinuxCNC: "Bad character
+  // 'o' used" after anything else).
+  bool o_allowed_ = true;
 };
 
 }  // namespace cncd::interp

@@ -104,5 +104,34 @@ TEST(Comments, LastCommentOfALineAndMessages) {
   EXPECT_NE(out.str().find("MESSAGE(\" Hello There\")"), std::string::npos);
 }
 
+// Fanuc-style posts put the program number first: LinuxCNC ignores a bare O-word, and the
+// comments after it.
+TEST(ProgramNumbers, ABareOWordIsIgnoredWithItsComments) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string(
+      "%\nO0001 (PART NAME)\nN5 O0002\no<named> (MSG,hidden)\nO3 ;note\nG0 X1\nM2\n%\n",
+      "number.ngc"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  const auto error = run_program(interp, printer);
+  ASSERT_FALSE(error) << error->to_string();
+  EXPECT_EQ(out.str().find("COMMENT"), std::string::npos) << out.str();
+  EXPECT_EQ(out.str().find("MESSAGE"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(1.0000"), std::string::npos) << out.str();
+}
+
+TEST(ProgramNumbers, AnythingButACommentAfterABareOWordIsRefused) {
+  EXPECT_EQ(error_of("O0001 G0 X1\nM2\n"), "Unknown control command in o word");
+  EXPECT_EQ(error_of("O0001 X1\nM2\n"), "Unknown control command in o word");
+  EXPECT_EQ(error_of("O0001 (NAME) G0 X1\nM2\n"), "Unexpected character after O-word");
+  EXPECT_EQ(error_of("O0001 (NAME\nM2\n"), "Unclosed comment found");
+  EXPECT_EQ(error_of("O0001 (a(b))\nM2\n"), "Nested comment found");
+  // Only block delete and a line number may come before an O-word.
+  EXPECT_EQ(error_of("G0 X1 O0001\nM2\n"), "Bad character 'o' used");
+  EXPECT_EQ(error_of("(NAME) O0001\nM2\n"), "Bad character 'o' used");
+  EXPECT_EQ(error_of("G0 X1 O100 call\nM2\n"), "Bad character 'o' used");
+  EXPECT_EQ(error_of("/N10 O0001\nM2\n"), "");
+}
+
 }  // namespace
 }  // namespace cncd::interp
