@@ -3,6 +3,7 @@
 // naming file and line, budgets, the trajectory CSV.
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -141,6 +142,26 @@ TEST_F(PlanSimTest, FilletsWhereArcsMeetLinesAreMeasuredAgainstTheProgrammedCurv
     EXPECT_LE(blended.peak_velocity[axis], machine().axes[axis].max_velocity * 1.001);
     EXPECT_LE(blended.peak_acceleration[axis], machine().axes[axis].max_acceleration * 1.001);
   }
+}
+
+TEST_F(PlanSimTest, ASpiralFromRoundedCentreWordsIsFollowedOnItsPathToItsEnd) {
+  motion::AxisPose last{};
+  options_.on_sample = [&last](double, const motion::AxisPose& p) { last = p; };
+  // I5.005: radius 5.005 at the start, 4.995 at the end; half a turn at 10 mm/s.
+  const auto r = simulate("G21 G90 G61\nG0 X0 Y0\nG2 X10 Y0 I5.005 J0 F600\nM2\n");
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : "");
+  EXPECT_LT(r.max_deviation, 1e-9);
+  EXPECT_EQ(last[0], 10.0);
+  EXPECT_EQ(last[1], 0.0);
+  for (int axis = 0; axis < 2; ++axis) {
+    EXPECT_LE(r.peak_velocity[axis], 200 * 1.001);
+    EXPECT_LE(r.peak_acceleration[axis], 2000 * 1.001);
+  }
+  // Planned over half a turn of the larger radius, 5.005, with the 0.01 mm it closes in by:
+  // 1.572 s at the feed, plus the ramps.
+  EXPECT_NEAR(r.feed_bound_s, std::hypot(std::numbers::pi * 5.005, 0.01) / 10, 1e-12);
+  EXPECT_GE(r.cycle_time_s, r.feed_bound_s);
+  EXPECT_LE(r.cycle_time_s, r.feed_bound_s + 0.02);
 }
 
 TEST_F(PlanSimTest, StartsWhereTheMachineStands) {
