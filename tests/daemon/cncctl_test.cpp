@@ -146,10 +146,17 @@ TEST_F(CncctlTest, ExitCodesTellDoneRefusedFailedAndUnreachable) {
   EXPECT_EQ(json::parse(r.out)["ok"], true);
   EXPECT_EQ(cncctl({"on"}).exit_status, 2);  // in estop
   ready();
+  // program.open refuses a program the interpreter stops on, naming the line.
   const auto bad = dir_.write("bad.ngc", "G21 G90\nG1 X5\nM2\n");  // no feed rate
   r = cncctl({"run", bad.string()});
-  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("bad.ngc:2"), std::string::npos) << r.err;
+  // A run that fails: from a line after the program's end.
+  const auto ends = dir_.write("ends.ngc", "G21 G90\nM2\nG0 X5\nG0 X6\n");
+  r = cncctl({"run", ends.string(), "--from", "4"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE((r.err + r.out).find("ends at line 2, before line 4"), std::string::npos)
+      << r.err << r.out;
   EXPECT_EQ(cncctl({"frobnicate"}).exit_status, 64);
   r = run_command({CNCCTL_BINARY, "--socket", (dir_.path() / "none.sock").string(), "status"});
   EXPECT_EQ(r.exit_status, 69);

@@ -111,8 +111,10 @@ TEST_F(SubscriptionTest, EveryClientSeesEveryError) {
   a.call("machine.on");
   a.call("machine.home");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  const auto program = dir_.write("bad.ngc", "G21\nG1 X1 Y1\nM2\n");  // no feed rate
+  // Opened, then changed on disk (program.open refuses it as it is now).
+  const auto program = dir_.write("bad.ngc", "G21\nM2\n");
   a.call("program.open", {{"path", program.string()}});
+  dir_.write("bad.ngc", "G21\nG1 X1 Y1\nM2\n");  // no feed rate
   a.call("program.run");
   for (daemon::Client* client : {&a, &b}) {
     json event;
