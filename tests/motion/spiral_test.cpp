@@ -77,14 +77,14 @@ TEST(Spiral, RoundedCentreWordsRunToTheirEnd) {
   run_spiral(m, arc_to(10, 0, 0, 5.005, 0, -1, 10));
 }
 
-TEST(Spiral, RandomSpiralsStayOnTheSpiralWithinEveryLimit) {
-  std::mt19937 rng(11);
+void random_spirals(const config::MachineConfig& config, unsigned seed) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> radius(0.05, 60);
   std::uniform_real_distribution<double> unit(-1, 1);
   std::uniform_real_distribution<double> angle(0, 2 * std::numbers::pi);
   std::uniform_int_distribution<int> turns(-2, 2);
   std::uniform_real_distribution<double> feed(5, 250);
-  VirtualMachine m(small_mill());
+  VirtualMachine m(config);
   m.ready();
   for (int i = 0; i < 16; ++i) {
     const auto from = m.status().commanded;
@@ -101,6 +101,16 @@ TEST(Spiral, RandomSpiralsStayOnTheSpiralWithinEveryLimit) {
                  std::to_string(r1) + " turns " + std::to_string(t));
     run_spiral(m, arc_to(cx + r1 * std::cos(a1), cy + r1 * std::sin(a1), z, cx, cy, t, feed(rng)));
   }
+}
+
+TEST(Spiral, RandomSpiralsStayOnTheSpiralWithinEveryLimit) {
+  random_spirals(small_mill(), 11);
+}
+
+TEST(Spiral, RandomSpiralsOnSCurveProfilesToo) {
+  auto config = small_mill();
+  config.max_linear_jerk = 40000;
+  random_spirals(config, 12);
 }
 
 // At a steady angular rate a spiral's radial and cross terms add to the centripetal part; a
