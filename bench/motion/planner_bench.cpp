@@ -1,8 +1,10 @@
 // Planner benchmark: cycle time of the real planner and servo loop (plan_sim, virtual time)
 // over the feed-limited bound on a small fast mill, peak axis velocity and acceleration over
 // the limits, path deviation and CPU time per move; side by side with LinuxCNC running the
-// same programs on the same limits (through /work/shared/tools/linuxcnc-bench/run.sh, in real
-// time, when it is there). Programs and INIs are generated (planner_programs.cpp).
+// same programs on the same limits (through the LinuxCNC bench harness run.sh, in real time,
+// when it is there: --run-sh, else $CNCD_LINUXCNC_BENCH, else
+// ../shared/tools/linuxcnc-bench/run.sh beside the source tree). Programs and INIs are generated
+// (planner_programs.cpp).
 //
 // For a program with a dense blended path (the raster's rows, the circle's chords, the cut of
 // 3D_Chips) it also prints the path alone against its own feed-limited bound and the floors of
@@ -41,7 +43,14 @@ namespace fs = std::filesystem;
 constexpr const char* kAxisMm =
     "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/axis_mm.ini";
 constexpr const char* kChips = "/usr/share/doc/linuxcnc/examples/nc_files/3D_Chips.ngc";
-constexpr const char* kRunSh = "/work/shared/tools/linuxcnc-bench/run.sh";
+std::string default_run_sh() {
+  if (const char* env = std::getenv("CNCD_LINUXCNC_BENCH"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return (std::filesystem::path(CNCD_SOURCE_DIR).parent_path() /
+          "shared/tools/linuxcnc-bench/run.sh")
+      .string();
+}
 
 struct LinuxcncRun {
   double run_s = 0;     // cycle start until the interpreter is idle
@@ -199,7 +208,7 @@ int main(int argc, char** argv) {
   bool linuxcnc = true;
   bool keep = false;
   double jerk = 0;
-  std::string run_sh = kRunSh;
+  std::string run_sh = default_run_sh();
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--no-linuxcnc") {
