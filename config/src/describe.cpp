@@ -75,8 +75,14 @@ std::string describe(const MachineConfig& c) {
   line(out, "State files:  " + (c.cncd.state_dir.empty() ? std::string("none")
                                                          : c.cncd.state_dir.string() + " (" +
                                                                c.cncd.state_dir_origin + ")"));
+  // Where a state file that is not there yet would start from.
   auto state_file = [&](const std::filesystem::path& file, const std::filesystem::path& seed) {
-    return or_none(file) + (seed.empty() ? "" : " (first copied from " + seed.string() + ")");
+    std::error_code ec;
+    if (file.empty() || std::filesystem::exists(file, ec)) return or_none(file);
+    if (!seed.empty() && std::filesystem::exists(seed, ec)) {
+      return file.string() + " (not there yet: starts as a copy of " + seed.string() + ")";
+    }
+    return file.string() + " (not there yet: starts from the defaults)";
   };
   line(out, "Parameters:   " + state_file(c.parameter_file, c.parameter_file_seed));
   line(out, "Tool table:   " + state_file(c.tool_table, c.tool_table_seed));
