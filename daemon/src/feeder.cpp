@@ -67,8 +67,11 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       return;
     case interp::CanonKind::program_stop:
     case interp::CanonKind::optional_program_stop:
-    case interp::CanonKind::pallet_shuttle:
       stop_seen = true;
+      return;
+    case interp::CanonKind::pallet_shuttle:
+      // No pallet changer to drive. M60 pauses through the PROGRAM_STOP that follows it; M30
+      // ends the program, as M2 does.
       return;
     case interp::CanonKind::start_spindle_clockwise:
       add_stop_point();

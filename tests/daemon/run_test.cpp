@@ -89,5 +89,31 @@ TEST_F(MachineTest, StepWhileAStepRunsIsRefused) {
   EXPECT_EQ(status()["program"]["result"], "aborted");
 }
 
+TEST_F(MachineTest, AFanucStyleProgramNumberLineIsIgnoredAsLinuxCncDoes) {
+  ready_machine();
+  // As Fanuc-style posts write it: %, the program number with its name, the program, %.
+  const auto program =
+      dir_.write("o0001.ngc", "%\nO0001 (BRACKET)\nG21 G90 G17\nG0 X12 Y7 Z3\nM30\n%\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run"));
+  const auto s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_EQ(s["position"]["commanded"]["x"], 12.0);
+  EXPECT_EQ(s["position"]["commanded"]["y"], 7.0);
+}
+
+TEST_F(MachineTest, M60PausesLikeM0AndResumeRunsOn) {
+  ready_machine();
+  const auto program = dir_.write("m60.ngc", "G21 G90\nG0 X5\nM60\nG0 X9\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run"));
+  auto s = wait_until([](const json& st) { return st["exec"] == "paused"; });
+  EXPECT_EQ(s["position"]["commanded"]["x"], 5.0);
+  result_of(call("program.resume"));
+  s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_EQ(s["position"]["commanded"]["x"], 9.0);
+}
+
 }  // namespace
 }  // namespace cncd::test
