@@ -1,7 +1,6 @@
 #include "jog_methods.hpp"
 
 #include <cctype>
-#include <cmath>
 
 namespace cncd::daemon {
 
@@ -16,27 +15,16 @@ RpcError jog_refused(const std::string& reason) {
 
 // The "axis" parameter: one of the machine's axis letters.
 int axis_param(const json& params, const config::MachineConfig& config) {
-  if (!params.is_object()) throw RpcError(kInvalidParams, "params must be an object");
-  const auto it = params.find("axis");
-  if (it == params.end() || !it->is_string() || it->get<std::string>().size() != 1)
-    throw RpcError(kInvalidParams, "\"axis\" must be an axis letter such as \"X\"");
-  const char letter =
-      static_cast<char>(std::toupper(static_cast<unsigned char>(it->get<std::string>()[0])));
-  const int axis = config::axis_index(letter);
-  if (axis < 0 || !config.axes[static_cast<std::size_t>(axis)].present)
-    throw RpcError(kInvalidParams, std::string("the machine has no axis ") + letter);
-  return axis;
-}
-
-double number_param(const json& params, const char* name, bool required, double fallback) {
-  const auto it = params.find(name);
-  if (it == params.end() || it->is_null()) {
-    if (required) throw RpcError(kInvalidParams, std::string("\"") + name + "\" is missing");
-    return fallback;
+  const auto& name = params["axis"].get_ref<const std::string&>();
+  const int axis =
+      name.size() == 1
+          ? config::axis_index(static_cast<char>(std::toupper(static_cast<unsigned char>(name[0]))))
+          : -1;
+  if (axis < 0 || !config.axes[static_cast<std::size_t>(axis)].present) {
+    throw RpcError(kInvalidParams,
+                   "parameter \"axis\": the machine has no axis " + quoted_text(name));
   }
-  if (!it->is_number() || !std::isfinite(it->get<double>()))
-    throw RpcError(kInvalidParams, std::string("\"") + name + "\" must be a number");
-  return it->get<double>();
+  return axis;
 }
 
 json ok() {
@@ -65,8 +53,8 @@ void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
                           const config::MachineConfig& config) {
   dispatcher.add("jog.start", [&task, &config](const json& params) {
     const int axis = axis_param(params, config);
-    const double velocity = number_param(params, "velocity", true, 0);
-    if (velocity == 0) throw RpcError(kInvalidParams, "\"velocity\" must not be 0");
+    const double velocity = params["velocity"].get<double>();
+    if (velocity == 0) throw RpcError(kInvalidParams, "parameter \"velocity\" must not be 0");
     task.jog_start(axis, velocity);
     return ok();
   });
@@ -76,12 +64,12 @@ void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
   });
   dispatcher.add("jog.increment", [&task, &config](const json& params) {
     const int axis = axis_param(params, config);
-    const double distance = number_param(params, "distance", true, 0);
-    if (distance == 0) throw RpcError(kInvalidParams, "\"distance\" must not be 0");
+    const double distance = params["distance"].get<double>();
+    if (distance == 0) throw RpcError(kInvalidParams, "parameter \"distance\" must not be 0");
     // Without a velocity, the axis's MAX_VELOCITY.
-    const double velocity = number_param(params, "velocity", false,
-                                         config.axes[static_cast<std::size_t>(axis)].max_velocity);
-    if (velocity <= 0) throw RpcError(kInvalidParams, "\"velocity\" must be above 0");
+    const double velocity =
+        params.value("velocity", config.axes[static_cast<std::size_t>(axis)].max_velocity);
+    if (velocity <= 0) throw RpcError(kInvalidParams, "parameter \"velocity\" must be above 0");
     task.jog_increment(axis, distance, velocity);
     return ok();
   });

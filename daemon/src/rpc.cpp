@@ -1,19 +1,61 @@
 #include "rpc.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <string>
+
+#include <spdlog/spdlog.h>
 
 namespace cncd::daemon {
 
 using nlohmann::json;
 
-void RpcDispatcher::add(const std::string& method, Handler handler, Access needs) {
-  handlers_[method] = Entry{std::move(handler), needs};
+RpcDispatcher::RpcDispatcher() : RpcDispatcher(method_table()) {}
+
+RpcDispatcher::RpcDispatcher(std::vector<MethodSpec> table) {
+  for (auto& spec : table) {
+    const std::string name(spec.name);
+    if (!table_.emplace(name, std::move(spec)).second) {
+      throw std::logic_error("method table lists '" + name + "' twice");
+    }
+  }
 }
 
-void RpcDispatcher::add(const std::string& method, SimpleHandler handler, Access needs) {
+void RpcDispatcher::add(const std::string& method, Handler handler,
+                        const std::vector<Range>& ranges) {
+  const auto spec = table_.find(method);
+  if (spec == table_.end()) {
+    throw std::logic_error("method '" + method + "' is not in the method table");
+  }
+  if (handlers_.contains(method)) throw std::logic_error("method '" + method + "' added twice");
+  MethodSpec bound = spec->second;
+  for (const auto& range : ranges) {
+    const auto param = std::find_if(bound.params.begin(), bound.params.end(),
+                                    [&](const ParamSpec& p) { return p.name == range.param; });
+    if (param == bound.params.end() ||
+        !(param->type == ParamType::number || param->type == ParamType::integer ||
+          param->type == ParamType::integer_list)) {
+      throw std::logic_error("method '" + method + "' has no number parameter '" +
+                             std::string(range.param) + "'");
+    }
+    param->min = range.min;
+    param->max = range.max;
+  }
+  handlers_.emplace(method, Entry{std::move(handler), std::move(bound)});
+}
+
+void RpcDispatcher::add(const std::string& method, SimpleHandler handler,
+                        const std::vector<Range>& ranges) {
   add(
-      method, [h = std::move(handler)](const json& params, Session&) { return h(params); }, needs);
+      method, [h = std::move(handler)](const json& params, Session&) { return h(params); }, ranges);
+}
+
+void RpcDispatcher::require_all_added() const {
+  std::string missing;
+  for (const auto& [name, spec] : table_) {
+    if (!handlers_.contains(name)) missing += (missing.empty() ? "" : ", ") + name;
+  }
+  if (!missing.empty()) throw std::logic_error("methods without a handler: " + missing);
 }
 
 json RpcDispatcher::error_object(int code, const std::string& message) {
@@ -77,21 +119,25 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
   if (method == request.end() || !method->is_string()) {
     return reply_error(kInvalidRequest, "\"method\" must be a string");
   }
-  json params = request.value("params", json());
-  if (!(params.is_null() || params.is_object() || params.is_array())) {
-    return reply_error(kInvalidParams, "\"params\" must be an object or an array");
-  }
-  const auto handler = handlers_.find(method->get<std::string>());
+  const std::string& name = method->get_ref<const std::string&>();
+  const auto handler = handlers_.find(name);
   if (handler == handlers_.end()) {
-    return reply_error(kMethodNotFound, "unknown method '" + method->get<std::string>() + "'");
+    return reply_error(kMethodNotFound, "unknown method " + quoted_text(name));
   }
-  if (session.access < handler->second.needs) {
-    return reply_error(kPermissionDenied, "permission denied: '" + method->get<std::string>() +
-                                              "' needs the control group");
+  const Entry& entry = handler->second;
+  if (session.access < entry.spec.needs) {
+    return reply_error(kPermissionDenied,
+                       "permission denied: " + quoted_text(name) + " needs the control group");
   }
+  const auto given = request.find("params");
+  auto checked = check_params(entry.spec, given == request.end() ? nullptr : &*given);
+  if (const auto* error = std::get_if<std::string>(&checked)) {
+    return reply_error(kInvalidParams, *error);
+  }
+  const json& params = std::get<json>(checked);
   try {
     session.defer_token = 0;
-    json result = handler->second.handler(params, session);
+    json result = entry.handler(params, session);
     if (session.defer_token != 0) {
       if (!notification) session.open_requests.emplace_back(session.defer_token, id);
       session.defer_token = 0;
@@ -101,10 +147,12 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
     return json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}};
   } catch (const RpcError& e) {
     return reply_error(e.code(), e.what());
-  } catch (const json::exception& e) {
-    return reply_error(kInvalidParams, std::string("invalid params: ") + e.what());
   } catch (const std::exception& e) {
-    return reply_error(kInternalError, e.what());
+    // The params were checked against the table: what is left is a fault of cncd's own, to be
+    // found in the log rather than in a library's words to the client.
+    spdlog::error("{}: {}", name, e.what());
+    return reply_error(kInternalError,
+                       "internal error in " + quoted_text(name) + "; see cncd's log");
   }
 }
 

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rpc_params.hpp"
+
 namespace cncd::daemon {
 
 // Stable error codes; docs/protocol.md lists them.
@@ -38,9 +40,6 @@ class RpcError : public std::runtime_error {
  private:
   int code_;
 };
-
-// What a connection may do, from its peer credentials.
-enum class Access { none, read, control };
 
 // Per-connection state a method may read or change.
 // Answers to requests that finish later (mdi.execute, program.abort): the handler takes a
@@ -82,14 +81,29 @@ struct Session {
 
 class RpcDispatcher {
  public:
-  // A handler gets the params (object, array or null) and the caller's session and returns the
-  // result; it reports failure by throwing RpcError. Called on the server's thread.
+  // A handler gets the params as checked against its method's entry in the table (always an
+  // object, holding only declared parameters of the declared types, optional ones left out
+  // when absent or null) and the caller's session, and returns the result; it reports failure
+  // by throwing RpcError. Called on the server's thread.
   using Handler = std::function<nlohmann::json(const nlohmann::json& params, Session& session)>;
   using SimpleHandler = std::function<nlohmann::json(const nlohmann::json& params)>;
+  // A range for a number parameter known only from the machine's configuration.
+  struct Range {
+    std::string_view param;
+    double min;
+    double max;
+  };
 
-  // `needs` is the access a caller must have: read for queries, control for commands.
-  void add(const std::string& method, Handler handler, Access needs = Access::control);
-  void add(const std::string& method, SimpleHandler handler, Access needs = Access::control);
+  // Serves the methods of method_table().
+  RpcDispatcher();
+  explicit RpcDispatcher(std::vector<MethodSpec> table);
+
+  // Throws std::logic_error for a method the table lacks, one added twice, or a range for a
+  // parameter that is not a number: no method is served without its parameters declared.
+  void add(const std::string& method, Handler handler, const std::vector<Range>& ranges = {});
+  void add(const std::string& method, SimpleHandler handler, const std::vector<Range>& ranges = {});
+  // Throws std::logic_error naming the methods of the table that have no handler.
+  void require_all_added() const;
   // Handles one line of input from a caller. Returns the serialized response without newline,
   // or nullopt when nothing is to be sent (notifications).
   std::optional<std::string> handle_line(const std::string& line, Session& session) const;
@@ -99,9 +113,10 @@ class RpcDispatcher {
  private:
   struct Entry {
     Handler handler;
-    Access needs;
+    MethodSpec spec;  // with the ranges given to add()
   };
   std::optional<nlohmann::json> handle_one(const nlohmann::json& request, Session& session) const;
+  std::map<std::string, MethodSpec, std::less<>> table_;
   std::map<std::string, Entry, std::less<>> handlers_;
 };
 

@@ -1,5 +1,9 @@
 #include "rpc.hpp"
 
+#include <set>
+#include <stdexcept>
+#include <string_view>
+
 #include <gtest/gtest.h>
 
 namespace cncd::daemon {
@@ -7,11 +11,33 @@ namespace {
 
 using nlohmann::json;
 
+// The dispatcher's own table here: the daemon's is tested through the daemon
+// (rpc_params_test.cpp).
+std::vector<MethodSpec> test_table() {
+  using enum ParamType;
+  return {
+      {"echo",
+       Access::control,
+       {{.name = "x", .type = integer, .min = 0, .max = 10, .note = "a digit"},
+        {.name = "s", .type = string, .note = "any text"},
+        {.name = "list", .type = integer_list, .min = 0, .max = 3, .note = "small numbers"}}},
+      {"need", Access::control, {{.name = "n", .type = number, .required = true, .note = "any"}}},
+      {"refuse", Access::control, {}},
+      {"query", Access::read, {}},
+      {"broken", Access::control, {{.name = "x", .type = integer, .note = "a number"}}},
+  };
+}
+
 class RpcTest : public ::testing::Test {
  protected:
+  RpcTest() : dispatcher_(test_table()) {}
   void SetUp() override {
     dispatcher_.add("echo", [](const json& params) { return params; });
+    dispatcher_.add("need", [](const json& params) { return params; }, {{"n", 0, 5}});
     dispatcher_.add("refuse", [](const json&) -> json { throw RpcError(kWrongState, "no"); });
+    dispatcher_.add("query", [](const json&) { return json(1); });
+    // A handler with a fault of its own: it reads an integer as a string.
+    dispatcher_.add("broken", [](const json& params) { return params["x"].get<std::string>(); });
   }
   json call(const std::string& line) {
     auto out = dispatcher_.handle_line(line, session_);
@@ -57,9 +83,10 @@ TEST_F(RpcTest, DeepNestingIsRefusedBeforeParsing) {
   // Brackets inside strings do not count; 64 levels are fine.
   r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"s":")" + deep + R"(\""}})");
   EXPECT_TRUE(r.contains("result")) << r.dump().substr(0, 200);
-  const std::string levels_64 = std::string(63, '[') + std::string(63, ']');
-  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":)" + levels_64 + "}");
-  EXPECT_TRUE(r.contains("result")) << r.dump().substr(0, 200);
+  // 64 levels are parsed (and then refused as params echo does not take).
+  const std::string levels_62 = std::string(62, '[') + std::string(62, ']');
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"s":)" + levels_62 + "}}");
+  EXPECT_EQ(r["error"]["code"], kInvalidParams) << r.dump().substr(0, 200);
 }
 
 TEST_F(RpcTest, BatchOfMoreThan256IsRefused) {
@@ -88,7 +115,7 @@ TEST_F(RpcTest, NotificationGetsNoAnswer) {
 }
 
 TEST_F(RpcTest, BatchAnswersEachRequestInOrder) {
-  const json r = call(R"([{"jsonrpc":"2.0","id":1,"method":"echo","params":[1]},)"
+  const json r = call(R"([{"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":1}},)"
                       R"({"jsonrpc":"2.0","method":"echo"},)"
                       R"({"jsonrpc":"2.0","id":2,"method":"nope"}])");
   ASSERT_TRUE(r.is_array());
@@ -98,12 +125,134 @@ TEST_F(RpcTest, BatchAnswersEachRequestInOrder) {
 }
 
 TEST_F(RpcTest, ReaderMayQueryButNotCommand) {
-  dispatcher_.add(
-      "query", [](const json&) { return json(1); }, Access::read);
   session_.access = Access::read;
   EXPECT_EQ(call(R"({"jsonrpc":"2.0","id":1,"method":"query"})")["result"], 1);
   EXPECT_EQ(call(R"({"jsonrpc":"2.0","id":2,"method":"echo"})")["error"]["code"],
             kPermissionDenied);
+}
+
+// The message of a -32602 answer (empty, with a failure, for any other answer).
+std::string invalid_params(const json& r) {
+  EXPECT_EQ(r["error"]["code"], kInvalidParams) << r.dump();
+  return r["error"].value("message", "");
+}
+
+TEST_F(RpcTest, UnknownParameterIsRefusedNamingIt) {
+  json r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":1,"lst":[1]}})");
+  EXPECT_EQ(invalid_params(r), "unknown parameter \"lst\" (echo takes: x, s, list)");
+  r = call(R"({"jsonrpc":"2.0","id":2,"method":"refuse","params":{"x":1}})");
+  EXPECT_EQ(invalid_params(r), "unknown parameter \"x\" (refuse takes no parameters)");
+  // A misspelling is named before a required parameter is found missing.
+  r = call(R"({"jsonrpc":"2.0","id":3,"method":"need","params":{"N":1}})");
+  EXPECT_EQ(invalid_params(r), "unknown parameter \"N\" (need takes: n)");
+}
+
+TEST_F(RpcTest, WrongTypesAreRefusedNamingParameterAndType) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"x":"1"})", R"(parameter "x" must be an integer from 0 to 10 (a digit), not "1")"},
+      {R"({"x":true})", R"(parameter "x" must be an integer from 0 to 10 (a digit), not true)"},
+      {R"({"x":[1]})", R"(parameter "x" must be an integer from 0 to 10 (a digit), not [1])"},
+      {R"({"s":1})", R"(parameter "s" must be a string (any text), not 1)"},
+      {R"({"list":3})", "parameter \"list\" must be an array of integers from 0 to 3"},
+      {R"({"list":[1,"2"]})", "(it holds \"2\")"},
+      {R"({"list":[1,7]})", "(it holds 7)"},
+  };
+  for (const auto& [params, message] : cases) {
+    const json r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":)" + params + "}");
+    EXPECT_NE(invalid_params(r).find(message), std::string::npos) << params << ": " << r.dump();
+  }
+  const json r = call(R"({"jsonrpc":"2.0","id":1,"method":"need","params":{"n":"5"}})");
+  EXPECT_EQ(invalid_params(r), R"(parameter "n" must be a number from 0 to 5 (any), not "5")");
+}
+
+TEST_F(RpcTest, FractionsAreNotIntegers) {
+  json r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":1.5}})");
+  EXPECT_EQ(invalid_params(r),
+            R"(parameter "x" must be an integer from 0 to 10 (a digit), not 1.5)");
+  for (const char* whole : {"2.0", "2e0"}) {
+    r = call(std::string(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":)") + whole +
+             "}}");
+    EXPECT_NE(invalid_params(r).find("(an integer is written without a fraction or exponent)"),
+              std::string::npos)
+        << r.dump();
+  }
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"list":[0,2.5]}})");
+  EXPECT_NE(invalid_params(r).find("(it holds 2.5)"), std::string::npos) << r.dump();
+  EXPECT_EQ(call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":2}})")["result"],
+            (json{{"x", 2}}));
+}
+
+TEST_F(RpcTest, RangesAreChecked) {
+  json r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":11}})");
+  EXPECT_EQ(invalid_params(r),
+            R"(parameter "x" must be an integer from 0 to 10 (a digit), not 11)");
+  // The range given when the handler was added.
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"need","params":{"n":5.5}})");
+  EXPECT_EQ(invalid_params(r), R"(parameter "n" must be a number from 0 to 5 (any), not 5.5)");
+  EXPECT_EQ(call(R"({"jsonrpc":"2.0","id":1,"method":"need","params":{"n":5}})")["result"]["n"], 5);
+}
+
+TEST_F(RpcTest, MissingAndNullParameters) {
+  json r = call(R"({"jsonrpc":"2.0","id":1,"method":"need","params":{}})");
+  EXPECT_EQ(invalid_params(r),
+            R"(parameter "n" is missing; it must be a number from 0 to 5 (any))");
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"need","params":{"n":null}})");
+  EXPECT_EQ(invalid_params(r), R"(parameter "n" must be a number from 0 to 5 (any), not null)");
+  // An optional parameter given as null is left out.
+  r = call(R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":null,"s":"a"}})");
+  EXPECT_EQ(r["result"], (json{{"s", "a"}})) << r.dump();
+}
+
+TEST_F(RpcTest, ParamsMustBeNamed) {
+  for (const char* params : {"[1]", "\"x\"", "3", "true"}) {
+    const json r =
+        call(std::string(R"({"jsonrpc":"2.0","id":1,"method":"need","params":)") + params + "}");
+    EXPECT_NE(invalid_params(r).find("params must be an object of named parameters, not "),
+              std::string::npos);
+    EXPECT_NE(r["error"]["message"].get<std::string>().find(
+                  R"(need takes: "n", a number from 0 to 5 (any), required)"),
+              std::string::npos)
+        << r.dump();
+  }
+  // Left out, null, {} and [] all say nothing.
+  for (const char* params : {"", R"(,"params":null)", R"(,"params":{})", R"(,"params":[])"}) {
+    const json r = call(std::string(R"({"jsonrpc":"2.0","id":1,"method":"echo")") + params + "}");
+    EXPECT_EQ(r["result"], json::object()) << params << ": " << r.dump();
+  }
+}
+
+TEST_F(RpcTest, LibraryErrorsAreNotShownToTheClient) {
+  const json r = call(R"({"jsonrpc":"2.0","id":1,"method":"broken","params":{"x":1}})");
+  EXPECT_EQ(r["error"]["code"], kInternalError) << r.dump();
+  EXPECT_EQ(r["error"]["message"].get<std::string>().find("json"), std::string::npos) << r.dump();
+}
+
+TEST(RpcTableTest, OnlyDeclaredMethodsCanBeAdded) {
+  RpcDispatcher dispatcher(test_table());
+  const auto nothing = [](const json&) { return json(); };
+  EXPECT_THROW(dispatcher.add("undeclared", nothing), std::logic_error);
+  dispatcher.add("echo", nothing);
+  EXPECT_THROW(dispatcher.add("echo", nothing), std::logic_error);
+  EXPECT_THROW(dispatcher.add("need", nothing, {{"m", 0, 1}}), std::logic_error);
+  try {
+    dispatcher.require_all_added();
+    ADD_FAILURE() << "methods without handlers were not found";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "methods without a handler: broken, need, query, refuse");
+  }
+  // Nor is a string parameter given a range.
+  EXPECT_THROW(dispatcher.add("echo", nothing, {{"s", 0, 1}}), std::logic_error);
+}
+
+TEST(RpcTableTest, TheDaemonTableDeclaresEachMethodAndParameterOnce) {
+  std::set<std::string_view> methods;
+  for (const auto& method : method_table()) {
+    EXPECT_TRUE(methods.insert(method.name).second) << method.name;
+    std::set<std::string_view> params;
+    for (const auto& param : method.params)
+      EXPECT_TRUE(params.insert(param.name).second) << method.name << " " << param.name;
+  }
+  EXPECT_NO_THROW(RpcDispatcher());
 }
 
 TEST_F(RpcTest, EmptyBatchIsInvalid) {

@@ -73,7 +73,7 @@ TEST_F(MachineTest, ToolSetRejectsBadValuesClearly) {
       {json{{"number", 1.5}}, "\"number\" must be an integer"},
       {json{{"number", 1}, {"offset", {{"a", 1}}}}, "axis \"a\", which this machine lacks"},
       {json{{"number", 1}, {"offset", {{"z", "long"}}}}, "\"offset.z\" must be a number"},
-      {json{{"number", 1}, {"diameter", -1}}, "\"diameter\" must be from 0"},
+      {json{{"number", 1}, {"diameter", -1}}, "\"diameter\" must be a number from 0"},
       {json{{"number", 1}, {"comment", "two\nlines"}}, "\"comment\" must be one line"},
       {json{{"number", 1}, {"length", 3}}, "unknown parameter \"length\""},
   };
@@ -143,7 +143,7 @@ TEST_F(MachineTest, OffsetsSetRejectsBadValuesClearly) {
       {json{{"system", 10}, {"origin", {{"x", 1}}}}, "\"system\" must be an integer from 1 to 9"},
       {json{{"system", "g54"}}, "give \"origin\" axis values or a \"rotation\""},
       {json{{"system", "G54"}, {"origin", {{"w", 1}}}}, "axis \"w\", which this machine lacks"},
-      {json{{"system", "G54"}, {"rotation", 400}}, "\"rotation\" must be from -360"},
+      {json{{"system", "G54"}, {"rotation", 400}}, "\"rotation\" must be a number from -360"},
   };
   for (const auto& [params, message] : cases) {
     const json r = call("offsets.set", params);

@@ -1,0 +1,135 @@
+// Every method and its parameters, in one place: the dispatcher refuses to register a method
+// that is not here and checks each request against its entry before the handler runs.
+// docs/protocol.md's parameter table lists the same (tests/daemon/rpc_params_test.cpp checks).
+// Ranges that depend on the machine's configuration are narrowed when the handler is
+// registered; the handlers check what depends on state (a program's length, an axis letter).
+#include "rpc_params.hpp"
+
+namespace cncd::daemon {
+
+namespace {
+
+using enum ParamType;
+
+// A bitmask of joints holds 32.
+constexpr double kMaxJoint = 31;
+constexpr double kMaxTool = 99999;
+
+}  // namespace
+
+const std::vector<MethodSpec>& method_table() {
+  static const std::vector<MethodSpec> table = {
+      {"status.get",
+       Access::read,
+       {{.name = "fields", .type = string_list, .note = "top-level status fields; all if empty"}}},
+      {"status.subscribe",
+       Access::read,
+       {{.name = "interval_ms",
+         .type = integer,
+         .min = 10,
+         .max = 3'600'000,
+         .note = "milliseconds between updates, default 100"},
+        {.name = "fields", .type = string_list, .note = "top-level status fields; all if empty"}}},
+      {"status.unsubscribe", Access::read, {}},
+      {"errors.list",
+       Access::read,
+       {{.name = "since", .type = integer, .min = 0, .note = "the last event seq already seen"}}},
+      {"system.info", Access::read, {}},
+      {"machine.estop", Access::control, {}},
+      {"machine.reset", Access::control, {}},
+      {"machine.on", Access::control, {}},
+      {"machine.off", Access::control, {}},
+      {"machine.home",
+       Access::control,
+       {{.name = "joints",
+         .type = integer_list,
+         .min = 0,
+         .max = kMaxJoint,
+         .note = "joint numbers"}}},
+      {"jog.start",
+       Access::control,
+       {{.name = "axis", .type = string, .required = true, .note = "an axis letter such as \"X\""},
+        {.name = "velocity",
+         .type = number,
+         .required = true,
+         .note = "machine units per second, signed, not 0"}}},
+      {"jog.stop",
+       Access::control,
+       {{.name = "axis",
+         .type = string,
+         .required = true,
+         .note = "an axis letter such as \"X\""}}},
+      {"jog.increment",
+       Access::control,
+       {{.name = "axis", .type = string, .required = true, .note = "an axis letter such as \"X\""},
+        {.name = "distance",
+         .type = number,
+         .required = true,
+         .note = "machine units, signed, not 0"},
+        {.name = "velocity", .type = number, .note = "machine units per second, above 0"}}},
+      {"program.open",
+       Access::control,
+       {{.name = "path", .type = string, .required = true, .note = "the program file"}}},
+      {"program.run",
+       Access::control,
+       {{.name = "from_line",
+         .type = integer,
+         .min = 1,
+         .max = 100'000'000,
+         .note = "the program line to run from"}}},
+      {"program.step", Access::control, {}},
+      {"program.pause", Access::control, {}},
+      {"program.resume", Access::control, {}},
+      {"program.abort", Access::control, {}},
+      {"mdi.execute",
+       Access::control,
+       {{.name = "line", .type = string, .required = true, .note = "one block of G code"}}},
+      {"override.feed",
+       Access::control,
+       {{.name = "value",
+         .type = number,
+         .required = true,
+         .min = 0,
+         .note = "feed override ratio, 1.0 = 100 %"}}},
+      {"override.rapid",
+       Access::control,
+       {{.name = "value",
+         .type = number,
+         .required = true,
+         .min = 0,
+         .max = 1,
+         .note = "rapid override ratio, 1.0 = 100 %"}}},
+      {"override.spindle",
+       Access::control,
+       {{.name = "value",
+         .type = number,
+         .required = true,
+         .min = 0,
+         .note = "spindle override ratio, 1.0 = 100 %"}}},
+      {"tool.list", Access::read, {}},
+      {"tool.set",
+       Access::control,
+       {{.name = "number",
+         .type = integer,
+         .required = true,
+         .min = 1,
+         .max = kMaxTool,
+         .note = "tool number"},
+        {.name = "pocket", .type = integer, .min = 1, .max = kMaxTool, .note = "pocket number"},
+        {.name = "offset", .type = axis_values, .note = "tool offset, machine units"},
+        {.name = "diameter", .type = number, .min = 0, .max = 1e6, .note = "machine units"},
+        {.name = "front_angle", .type = number, .min = -360, .max = 360, .note = "degrees"},
+        {.name = "back_angle", .type = number, .min = -360, .max = 360, .note = "degrees"},
+        {.name = "orientation", .type = integer, .min = 0, .max = 9, .note = "lathe tool"},
+        {.name = "comment", .type = string, .note = "one line of at most 200 characters"}}},
+      {"offsets.get", Access::read, {}},
+      {"offsets.set",
+       Access::control,
+       {{.name = "system", .type = coord_system, .required = true, .note = "the one to set"},
+        {.name = "origin", .type = axis_values, .note = "machine units"},
+        {.name = "rotation", .type = number, .min = -360, .max = 360, .note = "degrees about Z"}}},
+  };
+  return table;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,227 @@
+#include "rpc_params.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+
+namespace cncd::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+// Values and names quoted in messages are cut short: a request may carry 1 MiB of them.
+constexpr std::size_t kShownChars = 60;
+
+std::string shown(const json& value) {
+  std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (text.size() > kShownChars) text = text.substr(0, kShownChars) + "...";
+  return text;
+}
+
+// 1, 1.5, 100000000: as written in the protocol's documentation, never 1e+08.
+std::string number_text(double value) {
+  if (std::abs(value) < 1e15 && value == std::floor(value)) {
+    return std::to_string(static_cast<std::int64_t>(value));
+  }
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
+  return std::string(buffer, end);
+}
+
+bool has_range(ParamType type) {
+  return type == ParamType::integer || type == ParamType::number || type == ParamType::integer_list;
+}
+
+std::string_view kind(const json& value) {
+  switch (value.type()) {
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::null:
+      return "null";
+    default:
+      return "a number";
+  }
+}
+
+bool in_range(const ParamSpec& param, const json& number) {
+  const double v = number.get<double>();
+  return v >= param.min && v <= param.max;
+}
+
+// The one message for a value of the wrong type or outside the range.
+std::string wrong_value(const ParamSpec& param, const json& value) {
+  std::string message = "parameter " + quoted_text(param.name) + " must be " + describe(param) +
+                        ", not " + shown(value);
+  if (value.is_number_float() && value.get<double>() == std::floor(value.get<double>()) &&
+      (param.type == ParamType::integer || param.type == ParamType::coord_system)) {
+    message += " (an integer is written without a fraction or exponent)";
+  }
+  return message;
+}
+
+// "" when `value` is what `param` takes.
+std::string check_value(const ParamSpec& param, const json& value) {
+  switch (param.type) {
+    case ParamType::integer:
+      if (!value.is_number_integer()) return wrong_value(param, value);
+      return in_range(param, value) ? "" : wrong_value(param, value);
+    case ParamType::number:
+      if (!value.is_number()) return wrong_value(param, value);
+      return in_range(param, value) ? "" : wrong_value(param, value);
+    case ParamType::string:
+      return value.is_string() ? "" : wrong_value(param, value);
+    case ParamType::string_list:
+      if (!value.is_array()) return wrong_value(param, value);
+      for (const auto& item : value) {
+        if (!item.is_string()) return wrong_value(param, value) + " (it holds " + shown(item) + ")";
+      }
+      return "";
+    case ParamType::integer_list:
+      if (!value.is_array()) return wrong_value(param, value);
+      for (const auto& item : value) {
+        if (!item.is_number_integer()) {
+          return wrong_value(param, value) + " (it holds " + shown(item) + ")";
+        }
+        if (!in_range(param, item)) {
+          return wrong_value(param, value) + " (it holds " + shown(item) + ")";
+        }
+      }
+      return "";
+    case ParamType::axis_values:
+      return value.is_object() ? "" : wrong_value(param, value);
+    case ParamType::coord_system:
+      return value.is_string() || value.is_number_integer() ? "" : wrong_value(param, value);
+  }
+  return wrong_value(param, value);
+}
+
+std::string parameter_names(const MethodSpec& method) {
+  if (method.params.empty()) return std::string(method.name) + " takes no parameters";
+  std::string text = std::string(method.name) + " takes: ";
+  for (std::size_t i = 0; i < method.params.size(); ++i) {
+    if (i > 0) text += ", ";
+    text += method.params[i].name;
+  }
+  return text;
+}
+
+std::string parameter_descriptions(const MethodSpec& method) {
+  if (method.params.empty()) return std::string(method.name) + " takes no parameters";
+  std::string text = std::string(method.name) + " takes: ";
+  for (std::size_t i = 0; i < method.params.size(); ++i) {
+    const ParamSpec& param = method.params[i];
+    if (i > 0) text += "; ";
+    text += quoted_text(param.name) + ", " + describe(param) + (param.required ? ", required" : "");
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string quoted_text(std::string_view text) {
+  const bool cut = text.size() > kShownChars;
+  const std::string shown_text = json(std::string(text.substr(0, kShownChars)))
+                                     .dump(-1, ' ', false, json::error_handler_t::replace);
+  return cut ? shown_text.substr(0, shown_text.size() - 1) + "...\"" : shown_text;
+}
+
+std::string_view type_name(ParamType type) {
+  switch (type) {
+    case ParamType::integer:
+      return "integer";
+    case ParamType::number:
+      return "number";
+    case ParamType::string:
+      return "string";
+    case ParamType::string_list:
+      return "array of strings";
+    case ParamType::integer_list:
+      return "array of integers";
+    case ParamType::axis_values:
+      return "object of axis values";
+    case ParamType::coord_system:
+      return "string or integer";
+  }
+  return "?";
+}
+
+std::string describe(const ParamSpec& param) {
+  std::string text;
+  switch (param.type) {
+    case ParamType::integer:
+      text = "an integer";
+      break;
+    case ParamType::number:
+      text = "a number";
+      break;
+    case ParamType::string:
+      text = "a string";
+      break;
+    case ParamType::string_list:
+      text = "an array of strings";
+      break;
+    case ParamType::integer_list:
+      text = "an array of integers";
+      break;
+    case ParamType::axis_values:
+      text = "an object of axis values such as {\"x\": 1.5}";
+      break;
+    case ParamType::coord_system:
+      text = "a coordinate system, \"G54\" .. \"G59.3\" or 1 .. 9";
+      break;
+  }
+  if (has_range(param.type)) {
+    const bool low = std::isfinite(param.min);
+    const bool high = std::isfinite(param.max);
+    if (low && high) {
+      text += " from " + number_text(param.min) + " to " + number_text(param.max);
+    } else if (low) {
+      text += " of at least " + number_text(param.min);
+    } else if (high) {
+      text += " of at most " + number_text(param.max);
+    }
+  }
+  if (!param.note.empty()) text += " (" + std::string(param.note) + ")";
+  return text;
+}
+
+std::variant<json, std::string> check_params(const MethodSpec& method, const json* params) {
+  static const json none = json::object();
+  // An empty array is an empty list of positional parameters: nothing said.
+  if (params == nullptr || params->is_null() || (params->is_array() && params->empty())) {
+    params = &none;
+  }
+  if (!params->is_object()) {
+    return "params must be an object of named parameters, not " + std::string(kind(*params)) +
+           "; " + parameter_descriptions(method);
+  }
+  for (const auto& [key, value] : params->items()) {
+    bool known = false;
+    for (const auto& param : method.params)
+      known = known || param.name == key;
+    if (!known)
+      return "unknown parameter " + quoted_text(key) + " (" + parameter_names(method) + ")";
+  }
+  json checked = json::object();
+  for (const auto& param : method.params) {
+    const auto it = params->find(param.name);
+    if (it == params->end() || (it->is_null() && !param.required)) continue;
+    if (auto error = check_value(param, *it); !error.empty()) return error;
+    checked[std::string(param.name)] = *it;
+  }
+  for (const auto& param : method.params) {
+    if (param.required && !checked.contains(param.name)) {
+      return "parameter " + quoted_text(param.name) + " is missing; it must be " + describe(param);
+    }
+  }
+  return checked;
+}
+
+}  // namespace cncd::daemon
