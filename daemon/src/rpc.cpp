@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <set>
 #include <string>
 
 #include <spdlog/spdlog.h>
@@ -97,12 +98,13 @@ json error_response(const json& id, int code, const std::string& message) {
 }
 }  // namespace
 
-std::optional<json> RpcDispatcher::handle_one(const json& request, Session& session) const {
+std::optional<json> RpcDispatcher::handle_one(const json& request, Session& session,
+                                              const RepeatedKey* repeated) const {
   if (!request.is_object())
     return error_response(nullptr, kInvalidRequest, "request must be an object");
   json id = nullptr;
   const bool notification = !request.contains("id");
-  if (!notification) {
+  if (!notification && !(repeated != nullptr && repeated->id)) {
     id = request["id"];
     if (!(id.is_null() || id.is_string() || id.is_number())) {
       return error_response(nullptr, kInvalidRequest, "id must be a string, a number or null");
@@ -112,6 +114,10 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
     if (notification) return std::nullopt;
     return error_response(id, code, message);
   };
+  if (repeated != nullptr) {
+    return reply_error(kInvalidRequest, "duplicate key " + quoted_text(repeated->key) +
+                                            ": a request names each key of an object once");
+  }
   if (request.value("jsonrpc", json()) != "2.0") {
     return reply_error(kInvalidRequest, "\"jsonrpc\" must be \"2.0\"");
   }
@@ -156,6 +162,53 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
   }
 }
 
+namespace {
+
+// Parses a request line, noting for each request (by its index in a batch; 0 alone) the first
+// key it repeats in any of its objects: nlohmann::json would keep the last value silently.
+json parse_noting_repeats(const std::string& line,
+                          std::map<std::size_t, RpcDispatcher::RepeatedKey>& repeats) {
+  std::vector<std::optional<std::set<std::string>>> open;  // keys of each open object
+  bool batch = false;
+  std::size_t requests = 0;
+  const auto element_starts = [&](int depth) {
+    if (depth == 1 && batch) ++requests;
+  };
+  const auto callback = [&](int depth, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        element_starts(depth);
+        open.emplace_back(std::set<std::string>());
+        break;
+      case json::parse_event_t::array_start:
+        element_starts(depth);
+        if (depth == 0) batch = true;
+        open.emplace_back(std::nullopt);
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!open.empty()) open.pop_back();
+        break;
+      case json::parse_event_t::key:
+        if (!open.empty() && open.back() && parsed.is_string() &&
+            !open.back()->insert(parsed.get<std::string>()).second) {
+          auto& repeat = repeats[batch ? requests - 1 : 0];
+          if (repeat.key.empty()) repeat.key = parsed.get<std::string>();
+          // The request's own keys sit one level inside it.
+          if (parsed == "id" && depth == (batch ? 2 : 1)) repeat.id = true;
+        }
+        break;
+      case json::parse_event_t::value:
+        element_starts(depth);
+        break;
+    }
+    return true;
+  };
+  return json::parse(line, callback, /*allow_exceptions=*/false);
+}
+
+}  // namespace
+
 std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
                                                       Session& session) const {
   if (nested_too_deep(line)) {
@@ -163,10 +216,15 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
                           "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
         .dump();
   }
-  json request = json::parse(line, nullptr, /*allow_exceptions=*/false);
+  std::map<std::size_t, RepeatedKey> repeats;
+  json request = parse_noting_repeats(line, repeats);
   if (request.is_discarded()) {
     return error_response(nullptr, kParseError, "parse error: not valid JSON").dump();
   }
+  const auto repeated = [&](std::size_t index) -> const RepeatedKey* {
+    const auto it = repeats.find(index);
+    return it == repeats.end() ? nullptr : &it->second;
+  };
   if (request.is_array()) {
     if (request.empty()) return error_response(nullptr, kInvalidRequest, "empty batch").dump();
     if (request.size() > kMaxBatch) {
@@ -176,14 +234,15 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
     }
     json responses = json::array();
     session.in_batch = true;
-    for (const auto& one : request) {
-      if (auto response = handle_one(one, session)) responses.push_back(std::move(*response));
+    for (std::size_t i = 0; i < request.size(); ++i) {
+      if (auto response = handle_one(request[i], session, repeated(i)))
+        responses.push_back(std::move(*response));
     }
     session.in_batch = false;
     if (responses.empty()) return std::nullopt;
     return responses.dump(-1, ' ', false, json::error_handler_t::replace);
   }
-  auto response = handle_one(request, session);
+  auto response = handle_one(request, session, repeated(0));
   if (!response) return std::nullopt;
   return response->dump(-1, ' ', false, json::error_handler_t::replace);
 }

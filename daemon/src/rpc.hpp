@@ -110,12 +110,20 @@ class RpcDispatcher {
 
   static nlohmann::json error_object(int code, const std::string& message);
 
+  // The first key a request repeats in one of its objects; `id` when that request's own "id"
+  // is among the repeated keys.
+  struct RepeatedKey {
+    std::string key;
+    bool id = false;
+  };
+
  private:
   struct Entry {
     Handler handler;
     MethodSpec spec;  // with the ranges given to add()
   };
-  std::optional<nlohmann::json> handle_one(const nlohmann::json& request, Session& session) const;
+  std::optional<nlohmann::json> handle_one(const nlohmann::json& request, Session& session,
+                                           const RepeatedKey* repeated) const;
   std::map<std::string, MethodSpec, std::less<>> table_;
   std::map<std::string, Entry, std::less<>> handlers_;
 };

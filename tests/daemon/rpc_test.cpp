@@ -131,10 +131,16 @@ TEST_F(RpcTest, ReaderMayQueryButNotCommand) {
             kPermissionDenied);
 }
 
-// The message of a -32602 answer (empty, with a failure, for any other answer).
+// The error object of an answer (empty, with a failure, for a result).
+json error_of(const json& r) {
+  EXPECT_TRUE(r.contains("error")) << r.dump();
+  return r.value("error", json::object());
+}
+
+// The message of a -32602 answer.
 std::string invalid_params(const json& r) {
-  EXPECT_EQ(r["error"]["code"], kInvalidParams) << r.dump();
-  return r["error"].value("message", "");
+  EXPECT_EQ(error_of(r)["code"], kInvalidParams) << r.dump();
+  return error_of(r).value("message", "");
 }
 
 TEST_F(RpcTest, UnknownParameterIsRefusedNamingIt) {
@@ -209,22 +215,69 @@ TEST_F(RpcTest, ParamsMustBeNamed) {
         call(std::string(R"({"jsonrpc":"2.0","id":1,"method":"need","params":)") + params + "}");
     EXPECT_NE(invalid_params(r).find("params must be an object of named parameters, not "),
               std::string::npos);
-    EXPECT_NE(r["error"]["message"].get<std::string>().find(
-                  R"(need takes: "n", a number from 0 to 5 (any), required)"),
+    EXPECT_NE(error_of(r)
+                  .value("message", "")
+                  .find(R"(need takes: "n", a number from 0 to 5 (any), required)"),
               std::string::npos)
         << r.dump();
   }
   // Left out, null, {} and [] all say nothing.
   for (const char* params : {"", R"(,"params":null)", R"(,"params":{})", R"(,"params":[])"}) {
     const json r = call(std::string(R"({"jsonrpc":"2.0","id":1,"method":"echo")") + params + "}");
-    EXPECT_EQ(r["result"], json::object()) << params << ": " << r.dump();
+    EXPECT_EQ(r.value("result", json()), json::object()) << params << ": " << r.dump();
   }
 }
 
 TEST_F(RpcTest, LibraryErrorsAreNotShownToTheClient) {
   const json r = call(R"({"jsonrpc":"2.0","id":1,"method":"broken","params":{"x":1}})");
-  EXPECT_EQ(r["error"]["code"], kInternalError) << r.dump();
-  EXPECT_EQ(r["error"]["message"].get<std::string>().find("json"), std::string::npos) << r.dump();
+  EXPECT_EQ(error_of(r)["code"], kInternalError) << r.dump();
+  EXPECT_EQ(error_of(r).value("message", "").find("json"), std::string::npos) << r.dump();
+}
+
+TEST_F(RpcTest, DuplicateKeysAreInvalidRequests) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"jsonrpc":"2.0","id":1,"method":"echo","method":"refuse"})", "method"},
+      {R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":1,"x":2}})", "x"},
+      {R"({"jsonrpc":"2.0","jsonrpc":"2.0","id":1,"method":"echo"})", "jsonrpc"},
+      {R"({"jsonrpc":"2.0","id":1,"method":"echo","params":{"s":"a"},"params":{}})", "params"},
+  };
+  for (const auto& [line, key] : cases) {
+    const json r = call(line);
+    EXPECT_EQ(error_of(r)["code"], kInvalidRequest) << line;
+    EXPECT_EQ(error_of(r)["message"],
+              "duplicate key \"" + key + "\": a request names each key of an object once");
+    EXPECT_EQ(r["id"], 1) << line;
+  }
+  // Repeated ids: which one is meant is unknown, so the answer has none.
+  json r = call(R"({"jsonrpc":"2.0","id":1,"id":2,"method":"echo"})");
+  EXPECT_EQ(error_of(r)["code"], kInvalidRequest);
+  EXPECT_TRUE(r["id"].is_null()) << r.dump();
+  // An "id" repeated inside params is not the request's id.
+  r = call(R"({"jsonrpc":"2.0","id":3,"method":"echo","params":{"id":1,"id":2}})");
+  EXPECT_EQ(error_of(r)["code"], kInvalidRequest);
+  EXPECT_EQ(r["id"], 3);
+  // A notification with a repeated key is not carried out and not answered.
+  EXPECT_FALSE(
+      dispatcher_
+          .handle_line(R"({"jsonrpc":"2.0","method":"need","params":{"n":1,"n":2}})", session_)
+          .has_value());
+}
+
+TEST_F(RpcTest, ADuplicateKeyRefusesOnlyItsRequestInABatch) {
+  const json r = call(R"([{"jsonrpc":"2.0","id":1,"method":"echo","params":{"x":1}},)"
+                      R"(7,)"
+                      R"({"jsonrpc":"2.0","id":2,"method":"echo","params":{"s":"a","s":"b"}},)"
+                      R"([1,{"a":1}],)"
+                      R"({"jsonrpc":"2.0","id":3,"method":"echo","params":{"s":"c"}}])");
+  ASSERT_TRUE(r.is_array()) << r.dump();
+  ASSERT_EQ(r.size(), 5u) << r.dump();
+  EXPECT_EQ(r[0].value("result", json()), (json{{"x", 1}}));
+  EXPECT_EQ(error_of(r[1])["code"], kInvalidRequest);
+  EXPECT_EQ(r[2]["id"], 2);
+  EXPECT_EQ(error_of(r[2])["message"],
+            "duplicate key \"s\": a request names each key of an object once");
+  EXPECT_EQ(error_of(r[3])["code"], kInvalidRequest);
+  EXPECT_EQ(r[4].value("result", json()), (json{{"s", "c"}}));
 }
 
 TEST(RpcTableTest, OnlyDeclaredMethodsCanBeAdded) {
