@@ -66,6 +66,13 @@ std::string wrong_value(const ParamSpec& param, const json& value) {
   return message;
 }
 
+// A list shown cut short is followed by the item at fault.
+std::string wrong_item(const ParamSpec& param, const json& list, const json& item) {
+  std::string message = wrong_value(param, list);
+  if (message.ends_with("...")) message += " (it holds " + shown(item) + ")";
+  return message;
+}
+
 // "" when `value` is what `param` takes.
 std::string check_value(const ParamSpec& param, const json& value) {
   switch (param.type) {
@@ -80,17 +87,14 @@ std::string check_value(const ParamSpec& param, const json& value) {
     case ParamType::string_list:
       if (!value.is_array()) return wrong_value(param, value);
       for (const auto& item : value) {
-        if (!item.is_string()) return wrong_value(param, value) + " (it holds " + shown(item) + ")";
+        if (!item.is_string()) return wrong_item(param, value, item);
       }
       return "";
     case ParamType::integer_list:
       if (!value.is_array()) return wrong_value(param, value);
       for (const auto& item : value) {
-        if (!item.is_number_integer()) {
-          return wrong_value(param, value) + " (it holds " + shown(item) + ")";
-        }
-        if (!in_range(param, item)) {
-          return wrong_value(param, value) + " (it holds " + shown(item) + ")";
+        if (!item.is_number_integer() || !in_range(param, item)) {
+          return wrong_item(param, value, item);
         }
       }
       return "";
