@@ -164,48 +164,59 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
 
 namespace {
 
-// Parses a request line, noting for each request (by its index in a batch; 0 alone) the first
-// key it repeats in any of its objects: nlohmann::json would keep the last value silently.
-json parse_noting_repeats(const std::string& line,
-                          std::map<std::size_t, RpcDispatcher::RepeatedKey>& repeats) {
-  std::vector<std::optional<std::set<std::string>>> open;  // keys of each open object
-  bool batch = false;
-  std::size_t requests = 0;
-  const auto element_starts = [&](int depth) {
-    if (depth == 1 && batch) ++requests;
-  };
-  const auto callback = [&](int depth, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-        element_starts(depth);
-        open.emplace_back(std::set<std::string>());
-        break;
-      case json::parse_event_t::array_start:
-        element_starts(depth);
-        if (depth == 0) batch = true;
-        open.emplace_back(std::nullopt);
-        break;
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        if (!open.empty()) open.pop_back();
-        break;
-      case json::parse_event_t::key:
-        if (!open.empty() && open.back() && parsed.is_string() &&
-            !open.back()->insert(parsed.get<std::string>()).second) {
-          auto& repeat = repeats[batch ? requests - 1 : 0];
-          if (repeat.key.empty()) repeat.key = parsed.get<std::string>();
-          // The request's own keys sit one level inside it.
-          if (parsed == "id" && depth == (batch ? 2 : 1)) repeat.id = true;
-        }
-        break;
-      case json::parse_event_t::value:
-        element_starts(depth);
-        break;
-    }
+// Notes for each request of a line (by its index in a batch; 0 alone) the first key it repeats
+// in any of its objects: nlohmann::json keeps the last value silently. A SAX pass of its own,
+// as the parser's callback interface takes quadratic time over a batch of many objects.
+class RepeatFinder : public json::json_sax_t {
+ public:
+  std::map<std::size_t, RpcDispatcher::RepeatedKey> repeats;
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    value();
+    open_.emplace_back(std::set<std::string>());
     return true;
-  };
-  return json::parse(line, callback, /*allow_exceptions=*/false);
-}
+  }
+  bool key(string_t& key) override {
+    if (open_.empty() || !open_.back() || open_.back()->insert(key).second) return true;
+    auto& repeat = repeats[batch_ ? requests_ - 1 : 0];
+    if (repeat.key.empty()) repeat.key = key;
+    // The request's own keys: those of the top-level object or of a batch's element.
+    if (key == "id" && open_.size() == (batch_ ? 2u : 1u)) repeat.id = true;
+    return true;
+  }
+  bool end_object() override { return end(); }
+  bool start_array(std::size_t) override {
+    value();
+    if (open_.empty()) batch_ = true;
+    open_.emplace_back(std::nullopt);
+    return true;
+  }
+  bool end_array() override { return end(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  // A value begins: in a batch, at its top level, that is the next request.
+  bool value() {
+    if (batch_ && open_.size() == 1) ++requests_;
+    return true;
+  }
+  bool end() {
+    if (!open_.empty()) open_.pop_back();
+    return true;
+  }
+  std::vector<std::optional<std::set<std::string>>> open_;  // keys of each open object
+  bool batch_ = false;
+  std::size_t requests_ = 0;
+};
 
 }  // namespace
 
@@ -216,15 +227,10 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
                           "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
         .dump();
   }
-  std::map<std::size_t, RepeatedKey> repeats;
-  json request = parse_noting_repeats(line, repeats);
+  json request = json::parse(line, nullptr, /*allow_exceptions=*/false);
   if (request.is_discarded()) {
     return error_response(nullptr, kParseError, "parse error: not valid JSON").dump();
   }
-  const auto repeated = [&](std::size_t index) -> const RepeatedKey* {
-    const auto it = repeats.find(index);
-    return it == repeats.end() ? nullptr : &it->second;
-  };
   if (request.is_array()) {
     if (request.empty()) return error_response(nullptr, kInvalidRequest, "empty batch").dump();
     if (request.size() > kMaxBatch) {
@@ -232,6 +238,14 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
                             "a batch may hold at most " + std::to_string(kMaxBatch) + " requests")
           .dump();
     }
+  }
+  RepeatFinder finder;
+  json::sax_parse(line, &finder);
+  const auto repeated = [&](std::size_t index) -> const RepeatedKey* {
+    const auto it = finder.repeats.find(index);
+    return it == finder.repeats.end() ? nullptr : &it->second;
+  };
+  if (request.is_array()) {
     json responses = json::array();
     session.in_batch = true;
     for (std::size_t i = 0; i < request.size(); ++i) {
