@@ -17,7 +17,6 @@
 #include <thread>
 
 namespace cncd::test {
-namespace {
 
 std::string slurp(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -25,6 +24,8 @@ std::string slurp(const std::filesystem::path& path) {
   s << in.rdbuf();
   return s.str();
 }
+
+namespace {
 
 int decode_status(int status) {
   if (WIFEXITED(status)) return WEXITSTATUS(status);

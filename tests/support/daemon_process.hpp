@@ -23,6 +23,9 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// The whole content of a file; "" when it cannot be read.
+std::string slurp(const std::filesystem::path& path);
+
 // Copies config/examples/<name>.* (INI, parameter and tool files) into `dir`, so that a
 // daemon under test writes its state there and not into the source tree. Returns the INI.
 std::filesystem::path copy_example_machine(const std::filesystem::path& dir,
