@@ -2,6 +2,7 @@
 // coordinate system origins (offsets.get / offsets.set).
 #include <algorithm>
 
+#include "cncd/interp/stored_values.hpp"
 #include "persist.hpp"
 #include "task.hpp"
 #include "tool_file.hpp"
@@ -47,6 +48,8 @@ void Task::set_tool(const interp::ToolEntry& entry) {
   if (config_.tool_table.empty()) {
     throw RpcError(kWrongState, "the machine has no tool table ([EMCIO] TOOL_TABLE)");
   }
+  // Before the file: a value the interpreter would refuse never reaches the disk.
+  if (auto problem = interp::tool_entry_problem(entry)) throw RpcError(kInvalidParams, *problem);
   auto tools = interp_->tools();
   const auto it = std::find_if(tools.begin(), tools.end(),
                                [&](const auto& t) { return t.number == entry.number; });
@@ -60,7 +63,7 @@ void Task::set_tool(const interp::ToolEntry& entry) {
   // The file first: when it cannot be written, nothing has changed.
   const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
   if (!error.empty()) throw RpcError(kFileError, error);
-  interp_->set_tool(entry);
+  if (auto problem = interp_->set_tool(entry)) throw RpcError(kInvalidParams, *problem);
   saved_tools_ = std::move(tools);
   events_.add("info", "tools", "tool " + std::to_string(entry.number) + " changed");
 }
@@ -97,7 +100,9 @@ json Task::offsets() const {
 void Task::set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,
                        std::optional<double> rotation_deg) {
   if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
-  interp_->set_coord_system_origin(system, origin, axes, rotation_deg);
+  if (auto problem = interp_->set_coord_system_origin(system, origin, axes, rotation_deg)) {
+    throw RpcError(kInvalidParams, *problem);
+  }
   if (const auto error = interp_->save_parameters()) {
     events_.add("error", "parameters", error->to_string());
     throw RpcError(kFileError, error->to_string());

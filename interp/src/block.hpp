@@ -66,7 +66,12 @@ struct Block {
   double o_value = 0;
   std::vector<double> call_args;
 
-  std::vector<std::pair<int, double>> numbered_assignments;
+  struct NumberedAssignment {
+    int number;
+    double value;
+    int column;  // of its '#'
+  };
+  std::vector<NumberedAssignment> numbered_assignments;
   std::vector<std::pair<std::string, double>> named_assignments;
   int named_assignment_count = 0;
 

@@ -161,7 +161,11 @@ struct Interpreter::Impl {
   void set_coord_system_data(int l, int system);
   void set_tool_data(int l, int tool);
   Pose read_offset_parameters(int base) const;
+  // Writes the axes in `axes` (bit 0 = X) of an offset in program units to the parameters
+  // from `base` on, in machine units: all of them, or (Failure) none when one is not storable.
   void write_offset_parameters(int base, const Pose& offset, std::uint32_t axes);
+  // Where the block names `letter`, else its group 0 code (G10, G92, G28.1 ...).
+  int word_column(char letter) const;
   double to_machine_units(double program_value) const;
   void do_g92(int code);
   void do_home(int code);
@@ -191,10 +195,9 @@ struct Interpreter::Impl {
 
   // emit helpers
   CanonCommand& make(CanonKind kind);
-  void emit(const CanonCommand& command) {
-    if (command.kind <= CanonKind::dwell) loops_without_motion_ = 0;  // a move or a dwell
-    sink_->emit(command);
-  }
+  // Every canonical command leaves here; one carrying a number that is not finite (a position
+  // that overflowed) fails the block instead.
+  void emit(const CanonCommand& command);
   // Jumps back to the start of a loop; fails once loops have run max_loops_without_motion
   // times in a row without a move or dwell (an endless loop that would never end).
   void loop_back(std::int64_t offset, int line_before);

@@ -1,5 +1,7 @@
 #include "cncd/interp/interpreter.hpp"
 
+#include <cmath>
+
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -70,6 +72,18 @@ CanonCommand& Interpreter::Impl::make(CanonKind kind) {
   command_.value2 = 0;
   command_.text.clear();
   return command_;
+}
+
+void Interpreter::Impl::emit(const CanonCommand& command) {
+  bool finite = std::isfinite(command.first_end) && std::isfinite(command.second_end) &&
+                std::isfinite(command.first_axis) && std::isfinite(command.second_axis) &&
+                std::isfinite(command.axis_end_point) && std::isfinite(command.value) &&
+                std::isfinite(command.value2);
+  for (const double v : command.pos)
+    finite = finite && std::isfinite(v);
+  if (!finite) fail("Result is not a finite number (overflow)");
+  if (command.kind <= CanonKind::dwell) loops_without_motion_ = 0;  // a move or a dwell
+  sink_->emit(command);
 }
 
 void Interpreter::Impl::emit_simple(CanonKind kind, int ivalue, double value) {
@@ -188,15 +202,17 @@ void Interpreter::Impl::run_line() {
   if (block_.block_delete && options_.block_delete) return;
   // The tool (#5400-#5413) and position (#5420-#5428) parameters and the predefined names
   // belong to the interpreter.
+  // All of a line's assignments or none of them.
   for (const auto& assignment : block_.numbered_assignments) {
-    if (assignment.first >= 5400 && assignment.first <= 5428) fail("Parameter is readonly");
+    if (assignment.number >= 5400 && assignment.number <= 5428) fail("Parameter is readonly");
+    parameters_.check(assignment.number, assignment.value, assignment.column);
   }
   for (int i = 0; i < block_.named_assignment_count; ++i) {
     const std::string& name = block_.named_assignments[static_cast<std::size_t>(i)].first;
     if (predefined_parameter(name)) fail("Cannot assign to read-only parameter #<" + name + ">");
   }
-  for (const auto& [number, value] : block_.numbered_assignments)
-    parameters_.set(number, value);
+  for (const auto& assignment : block_.numbered_assignments)
+    parameters_.set(assignment.number, assignment.value, assignment.column);
   for (int i = 0; i < block_.named_assignment_count; ++i) {
     const auto& [name, value] = block_.named_assignments[static_cast<std::size_t>(i)];
     parameters_.set_named(name, value);

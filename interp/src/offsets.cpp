@@ -1,9 +1,11 @@
 // Coordinate systems, G92/G52 offsets, units and tool length offsets. Offsets are kept in
 // program units; the parameters hold them in machine units, as LinuxCNC's .var file does.
 // Whenever an offset changes, the machine position stays put and the program position moves.
+#include <cctype>
 #include <cmath>
 #include <numbers>
 
+#include "cncd/interp/stored_values.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -50,11 +52,29 @@ Pose Interpreter::Impl::read_offset_parameters(int base) const {
   return offset;
 }
 
+int Interpreter::Impl::word_column(char letter) const {
+  return block_.has(letter) ? block_.col(letter)
+                            : block_.g_column[static_cast<std::size_t>(GGroup::non_modal)];
+}
+
 void Interpreter::Impl::write_offset_parameters(int base, const Pose& offset, std::uint32_t axes) {
+  Pose machine{};
   for (int axis = 0; axis < kAxes; ++axis) {
-    if (((axes >> axis) & 1U) == 0) continue;
     const double value = offset[static_cast<std::size_t>(axis)];
-    parameters_.set(base + axis, is_linear_axis(axis) ? to_machine_units(value) : value);
+    machine[static_cast<std::size_t>(axis)] =
+        is_linear_axis(axis) ? to_machine_units(value) : value;
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int axis = 0; axis < kAxes; ++axis) {
+      if (((axes >> axis) & 1U) == 0) continue;
+      const double value = machine[static_cast<std::size_t>(axis)];
+      const int column = word_column(kAxisLetters[axis]);
+      if (pass == 0) {
+        parameters_.check(base + axis, value, column);
+      } else {
+        parameters_.set(base + axis, value, column);
+      }
+    }
   }
 }
 
@@ -135,13 +155,23 @@ void Interpreter::Impl::apply_tool_length(int code) {
       if (block_.has(letter)) offset[static_cast<std::size_t>(axis)] = block_.get(letter);
     }
   }
+  // The one check on the tool length offset that takes effect (G43.1 words, or a table entry
+  // scaled to the program's units).
+  Pose machine{};
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    machine[a] = is_linear_axis(axis) ? to_machine_units(offset[a]) : offset[a];
+    if (!storable(machine[a])) {
+      fail(out_of_range_message(std::string("Tool length offset ") +
+                                    static_cast<char>(std::toupper(kAxisLetters[axis])),
+                                machine[a]),
+           block_.has(kAxisLetters[axis]) ? block_.col(kAxisLetters[axis]) : 0);
+    }
+  }
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     pos_[axis] += tool_offset_[axis] - offset[axis];
   tool_offset_ = offset;
-  for (int axis = 0; axis < kAxes; ++axis) {
-    const auto a = static_cast<std::size_t>(axis);
-    tool_offset_machine_[a] = is_linear_axis(axis) ? to_machine_units(offset[a]) : offset[a];
-  }
+  tool_offset_machine_ = machine;
   modal_.tool_length_code = code;
   CanonCommand& command = make(CanonKind::use_tool_length_offset);
   command.pos = tool_offset_;
@@ -174,6 +204,7 @@ Pose Interpreter::Impl::machine_to_program(const Pose& machine) const {
 // amount on that axis (so with an XY rotation the machine point is not kept exactly).
 void Interpreter::Impl::do_g92(int code) {
   const Pose old_offset = g92_offset_;
+  Pose offset = g92_offset_;
   if (code == 920 || code == 520) {
     std::uint32_t axes = 0;
     for (int axis = 0; axis < kAxes; ++axis) {
@@ -183,21 +214,23 @@ void Interpreter::Impl::do_g92(int code) {
       const auto a = static_cast<std::size_t>(axis);
       const double value = block_.get(letter);
       // G92: the current point gets the given coordinate; G52: the offset is the given value.
-      g92_offset_[a] = code == 920 ? pos_[a] + g92_offset_[a] - value : value;
+      offset[a] = code == 920 ? pos_[a] + g92_offset_[a] - value : value;
     }
     if (axes == 0) fail("All axes missing with g52 or g92", block_.g_column[0]);
+    // The parameters first: an offset they refuse changes nothing.
+    write_offset_parameters(kG92Base, offset, 0x1FFU);
     parameters_.set(5210, 1);
-    write_offset_parameters(kG92Base, g92_offset_, 0x1FFU);
   } else if (code == 921 || code == 922) {
-    g92_offset_ = Pose{};
+    offset = Pose{};
     if (code == 921) {
+      write_offset_parameters(kG92Base, offset, 0x1FFU);
       parameters_.set(5210, 0);
-      write_offset_parameters(kG92Base, g92_offset_, 0x1FFU);
     }
   } else {
-    g92_offset_ = read_offset_parameters(kG92Base);
+    offset = read_offset_parameters(kG92Base);
     parameters_.set(5210, 1);
   }
+  g92_offset_ = offset;
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     pos_[axis] += old_offset[axis] - g92_offset_[axis];
   emit_g92();

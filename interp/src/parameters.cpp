@@ -7,6 +7,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "cncd/interp/stored_values.hpp"
+#include "failure.hpp"
+
 namespace cncd::interp {
 
 bool is_persistent_parameter(int number) {
@@ -51,6 +54,12 @@ void Parameters::pop_scope() {
   if (scopes_.size() > 1) scopes_.pop_back();
 }
 
+void Parameters::check(int number, double value, int column) const {
+  if (is_persistent_parameter(number) && !storable(value)) {
+    throw Failure{out_of_range_message("Parameter #" + std::to_string(number), value), column};
+  }
+}
+
 std::optional<std::string> Parameters::load(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) return "Unable to open parameter file: " + path.string();
@@ -75,6 +84,14 @@ std::optional<std::string> Parameters::load(const std::filesystem::path& path) {
 
 std::optional<std::string> Parameters::save(const std::filesystem::path& path) const {
   const std::filesystem::path temp = path.string() + ".tmp";
+  // set() lets no such value in: this is the last line of defence for the file.
+  for (int number = 1; number < kMaxParameter; ++number) {
+    const double value = numbered_[static_cast<std::size_t>(number)];
+    if (is_persistent_parameter(number) && !storable(value)) {
+      return path.string() + ": not written: " +
+             out_of_range_message("parameter #" + std::to_string(number), value);
+    }
+  }
   {
     std::FILE* out = std::fopen(temp.c_str(), "w");
     if (out == nullptr) return "Unable to write parameter file: " + temp.string();

@@ -23,7 +23,15 @@ class Parameters {
   Parameters();
 
   double get(int number) const { return numbered_[static_cast<std::size_t>(number)]; }
-  void set(int number, double value) { numbered_[static_cast<std::size_t>(number)] = value; }
+  // Every numbered parameter is assigned here, so the persistent ones (offsets, origins,
+  // G28/G30 points) can only ever hold storable values (stored_values.hpp): for anything else
+  // this throws Failure (at `column` of the line) and changes nothing. check() is the same
+  // test without the assignment, for a block that sets several: all or none.
+  void set(int number, double value, int column = 0) {
+    check(number, value, column);
+    numbered_[static_cast<std::size_t>(number)] = value;
+  }
+  void check(int number, double value, int column = 0) const;
 
   // Named parameters. Read-only predefined names (_x, _metric ...) come from `predefined_`.
   std::optional<double> get_named(std::string_view name) const;

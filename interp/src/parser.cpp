@@ -270,6 +270,7 @@ void BlockParser::read_program_number(Block& block) {
 }
 
 void BlockParser::read_assignment(Block& block) {
+  const int col = column();
   ++pos_;  // '#'
   if (peek() == '<') {
     const auto index = static_cast<std::size_t>(block.named_assignment_count++);
@@ -285,7 +286,7 @@ void BlockParser::read_assignment(Block& block) {
   if (peek() != '=') error("Equal sign missing in parameter setting");
   ++pos_;
   const double value = read_real_value();
-  block.numbered_assignments.emplace_back(number, value);
+  block.numbered_assignments.push_back({number, value, col});
 }
 
 void BlockParser::read_name(std::string& name) {

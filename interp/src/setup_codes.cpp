@@ -64,8 +64,9 @@ void Interpreter::Impl::set_coord_system_data(int l, int system) {
     }
     if (block_.has('r')) rotation = block_.get('r');
   }
+  parameters_.check(base + 9, rotation, word_column('r'));
   write_offset_parameters(base, origin, axes);
-  parameters_.set(base + 9, rotation);
+  parameters_.set(base + 9, rotation, word_column('r'));
   if (system != modal_.coord_system) {
     emit_comment("interpreter: setting coordinate system origin");
     return;
@@ -113,7 +114,7 @@ void Interpreter::Impl::set_tool_data(int l, int tool) {
   if (block_.has('i')) entry.front_angle = block_.get('i');
   if (block_.has('j')) entry.back_angle = block_.get('j');
   if (block_.has('q')) entry.orientation = to_int(block_.get('q'));
-  tools_.set(entry);
+  if (auto problem = tools_.set(entry)) fail(*problem, block_.g_column[0]);
   auto report = [&](int pocket) {
     CanonCommand& command = make(CanonKind::set_tool_table_entry);
     command.ivalue = pocket;

@@ -101,20 +101,31 @@ Pose Interpreter::coord_system_origin(int system, double* rotation_deg) const {
   return origin;
 }
 
-void Interpreter::set_coord_system_origin(int system, const Pose& origin, std::uint32_t axes,
-                                          std::optional<double> rotation_deg) {
+std::optional<std::string> Interpreter::set_coord_system_origin(
+    int system, const Pose& origin, std::uint32_t axes, std::optional<double> rotation_deg) {
   Impl& s = *impl_;
+  if (system < 1 || system > 9) return "coordinate system " + std::to_string(system) + " (1-9)";
   const int base = kG5xBase + 20 * (system - 1);
+  try {
+    for (int axis = 0; axis < kAxes; ++axis) {
+      if (((axes >> axis) & 1U) != 0)
+        s.parameters_.check(base + axis, origin[static_cast<std::size_t>(axis)]);
+    }
+    if (rotation_deg) s.parameters_.check(base + 9, *rotation_deg);
+  } catch (const Failure& failure) {
+    return failure.message;
+  }
   const Pose machine = s.program_to_machine(s.pos_);
   for (int axis = 0; axis < kAxes; ++axis) {
     if (((axes >> axis) & 1U) != 0)
       s.parameters_.set(base + axis, origin[static_cast<std::size_t>(axis)]);
   }
   if (rotation_deg) s.parameters_.set(base + 9, *rotation_deg);
-  if (system != s.modal_.coord_system) return;
+  if (system != s.modal_.coord_system) return std::nullopt;
   s.load_coord_system(system);
   s.pos_ = s.machine_to_program(machine);
   s.resend_g5x_ = true;
+  return std::nullopt;
 }
 
 std::vector<ToolEntry> Interpreter::tools() const {
@@ -130,8 +141,8 @@ std::optional<ToolEntry> Interpreter::tool(int number) const {
   return *entry;
 }
 
-void Interpreter::set_tool(const ToolEntry& entry) {
-  impl_->tools_.set(entry);
+std::optional<std::string> Interpreter::set_tool(const ToolEntry& entry) {
+  return impl_->tools_.set(entry);
 }
 
 }  // namespace cncd::interp

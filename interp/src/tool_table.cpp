@@ -4,6 +4,7 @@
 #include <charconv>
 #include <fstream>
 
+#include "cncd/interp/stored_values.hpp"
 #include "failure.hpp"
 
 namespace cncd::interp {
@@ -11,6 +12,7 @@ namespace cncd::interp {
 std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) return "Unable to open tool table: " + path.string();
+  std::map<int, ToolEntry> loaded;
   std::string text;
   int line_number = 0;
   while (std::getline(in, text)) {
@@ -72,8 +74,19 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
       }
       i = end;
     }
-    if (has_tool) tools_[entry.number] = entry;
+    if (!has_tool) continue;
+    if (auto problem = tool_entry_problem(entry)) {
+      return path.string() + ":" + std::to_string(line_number) + ": " + *problem;
+    }
+    loaded[entry.number] = entry;
   }
+  tools_ = std::move(loaded);
+  return std::nullopt;
+}
+
+std::optional<std::string> ToolTable::set(const ToolEntry& entry) {
+  if (auto problem = tool_entry_problem(entry)) return problem;
+  tools_[entry.number] = entry;
   return std::nullopt;
 }
 

@@ -13,10 +13,13 @@ namespace cncd::interp {
 
 class ToolTable {
  public:
-  // Returns an error text ("FILE:LINE: ...") on a malformed table.
+  // Returns an error text ("FILE:LINE: ...") on a malformed table or a value that is not
+  // storable; nothing is loaded then.
   std::optional<std::string> load(const std::filesystem::path& path);
   const ToolEntry* find(int number) const;
-  void set(const ToolEntry& entry) { tools_[entry.number] = entry; }
+  // Adds or replaces the entry; refuses (returns why, changes nothing) one that is not
+  // storable (stored_values.hpp). Every entry comes in here or through load().
+  std::optional<std::string> set(const ToolEntry& entry);
   const std::map<int, ToolEntry>& entries() const { return tools_; }
 
  private:

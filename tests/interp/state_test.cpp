@@ -60,7 +60,7 @@ TEST(InterpreterState, OffsetsAreReportedInMachineUnits) {
 
 TEST(InterpreterState, SetCoordSystemOriginActsLikeG10L2) {
   Interpreter interp;
-  interp.set_coord_system_origin(2, Pose{5, 6, 7}, 0b101, 30.0);
+  ASSERT_FALSE(interp.set_coord_system_origin(2, Pose{5, 6, 7}, 0b101, 30.0));
   double rotation = 0;
   const Pose origin = interp.coord_system_origin(2, &rotation);
   EXPECT_EQ(origin[0], 5.0);
@@ -71,7 +71,7 @@ TEST(InterpreterState, SetCoordSystemOriginActsLikeG10L2) {
   EXPECT_EQ(interp.state().g5x_offset[0], 5.0);
   EXPECT_EQ(interp.state().rotation_deg, 30.0);
   // A change to the active system reaches the canonical stream before the next block's moves.
-  interp.set_coord_system_origin(2, Pose{8}, 0b1, std::nullopt);
+  ASSERT_FALSE(interp.set_coord_system_origin(2, Pose{8}, 0b1, std::nullopt));
   ASSERT_FALSE(interp.open_mdi("G0 X0"));
   std::ostringstream out;
   Rs274Printer printer(out);
@@ -97,7 +97,7 @@ TEST(InterpreterState, ToolTableKeepsCommentsAndTakesNewEntries) {
   t2.number = 2;
   t2.pocket = 2;
   t2.offset[2] = 4;
-  interp.set_tool(t2);
+  ASSERT_FALSE(interp.set_tool(t2));
   run(interp, "T2 M6 G43");
   EXPECT_EQ(interp.state().tool_in_spindle, 2);
   EXPECT_EQ(interp.state().tool_offset[2], 4.0);

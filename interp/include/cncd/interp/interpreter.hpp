@@ -109,16 +109,19 @@ class Interpreter {
   // Sets the origin of coordinate system `system` (1..9) for the axes in the `axes` mask
   // (bit 0 = X), in machine units, and its XY rotation when given, as G10 L2 does. The
   // machine stays where it is; a program position in the active system moves with it. Call
-  // between programs only.
-  void set_coord_system_origin(int system, const Pose& origin, std::uint32_t axes,
-                               std::optional<double> rotation_deg);
+  // between programs only. Refuses values that are not storable (stored_values.hpp): returns
+  // why, and nothing changes.
+  std::optional<std::string> set_coord_system_origin(int system, const Pose& origin,
+                                                     std::uint32_t axes,
+                                                     std::optional<double> rotation_deg);
 
   // The tool table as the interpreter holds it (offsets in the table's units), by number.
   std::vector<ToolEntry> tools() const;
   std::optional<ToolEntry> tool(int number) const;
   // Adds or replaces one entry, as G10 L1 does: the tool in the spindle takes a new length at
-  // its next G43. Call between programs only.
-  void set_tool(const ToolEntry& entry);
+  // its next G43. Call between programs only. Refuses an entry that is not storable
+  // (tool_entry_problem()): returns why, and nothing changes.
+  std::optional<std::string> set_tool(const ToolEntry& entry);
 
   // Writes the persistent parameters (coordinate systems, G28/G30 points, G92 offsets) to
   // InterpOptions::parameter_file, as LinuxCNC does when its interpreter shuts down: temp file,
