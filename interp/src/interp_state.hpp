@@ -219,6 +219,7 @@ struct Interpreter::Impl {
   CanonCommand command_;
   std::optional<InterpError> error_;
   std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
+  bool parameter_file_refused_ = false;      // never written then
   std::vector<std::string> load_warnings_;   // parameter file or tool table not there yet
   int current_line_ = 0;
   std::uint64_t loops_without_motion_ = 0;

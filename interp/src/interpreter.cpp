@@ -32,6 +32,7 @@ Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
   } else if (!options_.parameter_file.empty()) {
     if (auto problem = parameters_.load(options_.parameter_file)) {
       config_error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
+      parameter_file_refused_ = true;
     }
   }
   if (!options_.tool_table.empty() && missing(options_.tool_table)) {
@@ -311,6 +312,10 @@ int Interpreter::current_line() const {
 std::optional<InterpError> Interpreter::save_parameters() const {
   const auto& path = impl_->options_.parameter_file;
   if (path.empty()) return std::nullopt;
+  if (impl_->parameter_file_refused_) {
+    return InterpError{path.string(), 0, 0,
+                       path.string() + ": not written: it was refused when it was read"};
+  }
   if (auto problem = impl_->parameters_.save(path)) {
     return InterpError{path.string(), 0, 0, *problem};
   }

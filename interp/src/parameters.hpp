@@ -46,7 +46,10 @@ class Parameters {
   using Predefined = std::function<std::optional<double>(std::string_view)>;
   void set_predefined(Predefined lookup) { predefined_ = std::move(lookup); }
 
-  // Reads a LinuxCNC .var file ("number value" per line). Returns an error text on failure.
+  // Reads a LinuxCNC .var file: "NUMBER VALUE" a line (blanks between and around), numbers
+  // increasing, values storable; blank lines are allowed. Anything else (a line that is not
+  // such a pair, a repeated number, a value that is not storable) is refused with
+  // "FILE:LINE: what is wrong" and nothing is loaded.
   std::optional<std::string> load(const std::filesystem::path& path);
   // Writes the persistent parameters: temp file, flush, rename, so a crash never loses them.
   std::optional<std::string> save(const std::filesystem::path& path) const;

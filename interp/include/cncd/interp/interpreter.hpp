@@ -125,7 +125,8 @@ class Interpreter {
 
   // Writes the persistent parameters (coordinate systems, G28/G30 points, G92 offsets) to
   // InterpOptions::parameter_file, as LinuxCNC does when its interpreter shuts down: temp file,
-  // flush, rename. Does nothing without a parameter file.
+  // flush, rename. Does nothing without a parameter file. Never writes over a file that was
+  // refused at construction (load_error()): that one may not be a parameter file at all.
   std::optional<InterpError> save_parameters() const;
 
  private:
