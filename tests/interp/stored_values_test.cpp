@@ -141,6 +141,24 @@ TEST(StoredValues, AMoveToAPointThatIsNotFiniteIsRefusedAtItsLine) {
   EXPECT_NE(error.find("not a finite number"), std::string::npos) << error;
 }
 
+TEST(StoredValues, AToolTableHoldingValuesThatAreNotStorableIsRefusedWithItsLine) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("cncd_stored_" + std::to_string(::getpid()) + ".tbl");
+  for (const char* line : {"T2 P2 Znan", "T2 P2 Z-inf", "T2 P2 X1e10", "T2 P2 Z1 D1e300"}) {
+    SCOPED_TRACE(line);
+    std::ofstream(path) << "T1 P1 Z1 ;fine\n" << line << " ;bad\n";
+    InterpOptions options;
+    options.tool_table = path;
+    const Interpreter interp(options);
+    ASSERT_TRUE(interp.load_error().has_value());
+    const std::string message = interp.load_error()->message;
+    EXPECT_TRUE(starts_with(message, path.string() + ":2: Tool 2 ")) << message;
+    EXPECT_NE(message.find("out of range"), std::string::npos) << message;
+    EXPECT_TRUE(interp.tools().empty());
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(StoredValues, OriginsAndToolsSetBetweenProgramsAreCheckedToo) {
   Interpreter interp;
   const double nan = std::numeric_limits<double>::quiet_NaN();
