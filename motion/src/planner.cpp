@@ -125,6 +125,28 @@ void Planner::curve_limits(double fastest, double radius, double plane_a, double
   a = std::sqrt(1.0 - normal * normal) * plane_a;
 }
 
+namespace {
+
+// A coordinate as messages show it: four decimals, or (for the absurd ones, where %.4f would
+// print hundreds of digits) its ten significant ones.
+void format_coordinate(char* out, std::size_t size, double value) {
+  std::snprintf(out, size, std::fabs(value) <= kMaxCoordinate ? "%.4f" : "%.10g", value);
+}
+
+void limit_error(std::string& error, int axis, double value, double min, double max) {
+  char v[40], lo[40], hi[40];
+  format_coordinate(v, sizeof v, value);
+  format_coordinate(lo, sizeof lo, min);
+  format_coordinate(hi, sizeof hi, max);
+  const char letter = config::kAxisLetters[static_cast<std::size_t>(axis)];
+  char text[200];
+  std::snprintf(text, sizeof text, "move to %c %s is outside the %c soft limits [%s, %s]", letter,
+                v, letter, lo, hi);
+  error = text;
+}
+
+}  // namespace
+
 bool Planner::within_limits(const Segment& segment, std::string& error) const {
   // Lines are convex: their ends suffice. Arcs are sampled densely enough that a bulge past a
   // limit is found (the chord error of 256 steps is below 1e-4 of the radius).
@@ -134,13 +156,9 @@ bool Planner::within_limits(const Segment& segment, std::string& error) const {
     for (int i = 0; i < kAxes; ++i) {
       const auto& axis = config_.axes[static_cast<std::size_t>(i)];
       if (!axis.present) continue;
-      if (p[i] < axis.min_limit - 1e-9 || p[i] > axis.max_limit + 1e-9) {
-        char text[160];
-        std::snprintf(
-            text, sizeof text, "move to %c %.4f is outside the %c soft limits [%.4f, %.4f]",
-            config::kAxisLetters[static_cast<std::size_t>(i)], p[i],
-            config::kAxisLetters[static_cast<std::size_t>(i)], axis.min_limit, axis.max_limit);
-        error = text;
+      // Written so that a NaN is outside.
+      if (!(p[i] >= axis.min_limit - 1e-9 && p[i] <= axis.max_limit + 1e-9)) {
+        limit_error(error, i, p[i], axis.min_limit, axis.max_limit);
         return false;
       }
     }
@@ -158,6 +176,28 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   if (!finite) {
     error = "move has a non-finite coordinate, feed or time";
     return std::nullopt;
+  }
+  // Beyond kMaxCoordinate the path arithmetic itself overflows (a length of infinity makes
+  // every point NaN): refused homed or not, with the soft limits when they apply.
+  if (move.kind != Move::Kind::dwell) {
+    for (int i = 0; i < kAxes; ++i) {
+      const auto& axis = config_.axes[static_cast<std::size_t>(i)];
+      if (!axis.present || std::fabs(move.end[i]) <= kMaxCoordinate) continue;
+      if (check_limits) {
+        limit_error(error, i, move.end[i], axis.min_limit, axis.max_limit);
+      } else {
+        char v[40];
+        format_coordinate(v, sizeof v, move.end[i]);
+        error = std::string("move to ") + config::kAxisLetters[static_cast<std::size_t>(i)] + " " +
+                v + " is beyond 1e9, the largest coordinate any move may have";
+      }
+      return std::nullopt;
+    }
+    if (move.kind == Move::Kind::arc && (std::fabs(move.center_first) > kMaxCoordinate ||
+                                         std::fabs(move.center_second) > kMaxCoordinate)) {
+      error = "arc centre is beyond 1e9, the largest coordinate any move may have";
+      return std::nullopt;
+    }
   }
   if (move.kind == Move::Kind::arc) {
     for (int axis : move.plane_axes) {

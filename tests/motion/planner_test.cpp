@@ -235,6 +235,19 @@ TEST(Planner, RefusesNonFiniteMoves) {
   EXPECT_NE(error.find("differ"), std::string::npos) << error;
 }
 
+// An absurd target (a work offset of 1e300 that got this far) is refused with a readable
+// message naming the axis and its limits, homed or not: never a servo fault.
+TEST(Planner, RefusesAbsurdTargetsReadably) {
+  const auto config = small_mill();
+  motion::Planner planner(config);
+  std::string error;
+  EXPECT_FALSE(planner.plan(line_to(Move::Kind::traverse, 1e300, 0, 0), {}, true, error));
+  EXPECT_EQ(error, "move to X 1e+300 is outside the X soft limits [-1000.0000, 1000.0000]");
+  EXPECT_FALSE(planner.plan(line_to(Move::Kind::feed, 0, -2e9, 0, 10), {}, false, error));
+  EXPECT_EQ(error, "move to Y -2000000000 is beyond 1e9, the largest coordinate any move may have");
+  EXPECT_TRUE(planner.plan(line_to(Move::Kind::feed, 0, -1e9, 0, 10), {}, false, error)) << error;
+}
+
 TEST(Planner, RefusesImpossibleMoves) {
   const auto config = small_mill();
   motion::Planner planner(config);

@@ -22,13 +22,18 @@
 
 namespace cncd::motion {
 
+// The largest coordinate (machine units or degrees) a move may have, homed or not: the bound
+// the interpreter puts on offsets too (docs/motion.md).
+inline constexpr double kMaxCoordinate = 1e9;
+
 class Planner {
  public:
   explicit Planner(const config::MachineConfig& config);
 
   // Plans `move` alone starting at `start` (it ends at rest). Returns nullopt and sets
   // `error` when the move cannot be made (a zero feed, an arc whose ends are not on one
-  // circle, an end outside the soft limits of an axis in `check_limits`).
+  // circle, an end outside the soft limits of an axis in `check_limits`, a coordinate that is
+  // not finite or beyond kMaxCoordinate).
   std::optional<Segment> plan(const Move& move, const AxisPose& start, bool check_limits,
                               std::string& error) const;
 
