@@ -118,6 +118,24 @@ drivers::JointCommand ServoLoop::answered_command(std::size_t k,
   return latest;
 }
 
+void ServoLoop::guard_set_points() noexcept {
+  bool held = false;
+  for (int j = 0; j < joint_count_; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    if (std::isfinite(joints_.command[k] + joints_.motor_offset[k])) continue;
+    // An offset or a first command taken from feedback that was not a number is none at all.
+    if (!std::isfinite(joints_.motor_offset[k])) joints_.motor_offset[k] = 0;
+    if (!std::isfinite(last_motor_cmd_[k])) last_motor_cmd_[k] = 0;
+    joints_.command[k] = last_motor_cmd_[k] - joints_.motor_offset[k];
+    status_.joint_fault[k] = true;
+    held = true;
+    char text[64];
+    std::snprintf(text, sizeof text, "non-finite set-point on joint %d", j);
+    latch_fault(text);
+  }
+  if (held) sync_axes_from_joints();
+}
+
 void ServoLoop::write_drivers() noexcept {
   const bool enable = status_.machine == MachineState::on;
   drives_enabled_ = enable;

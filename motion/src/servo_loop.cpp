@@ -307,6 +307,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     joints_.command = joints_.feedback;
     sync_axes_from_joints();
   }
+  guard_set_points();
   write_drivers();
   publish();
 }

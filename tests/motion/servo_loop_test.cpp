@@ -256,6 +256,70 @@ TEST(ServoLoop, FeedbackThatIsNotANumberLatches) {
   EXPECT_STREQ(loop.status().fault_reason, "joint 1: feedback position is not a number");
 }
 
+// A set-point that is not a number (a segment that reached the ring without the planner's
+// checks, or feedback that is not a number while the drives are off) is a fault with its
+// reason, and never reaches a driver.
+TEST(ServoLoop, ANonFiniteSetPointIsAFaultAndNeverSentToADriver) {
+  VirtualMachine m(small_mill());
+  m.ready();
+  motion::Planner planner(m.config());
+  std::string error;
+  auto segment = planner.plan(line_to(Move::Kind::feed, 10, 5, 0, 100), {}, true, error);
+  ASSERT_TRUE(segment.has_value()) << error;
+  segment->end[1] = std::nan("");
+  ASSERT_TRUE(m.loop().segments().push(*segment));
+  m.clear_trajectory();
+  m.cycles(50);
+  const auto s = m.status();
+  EXPECT_EQ(s.machine, MachineState::off);
+  EXPECT_STREQ(s.fault_reason, "non-finite set-point on joint 1");
+  EXPECT_TRUE(s.joint_fault[1]);
+  ASSERT_FALSE(m.motor_trajectory().empty());
+  for (const auto& joints : m.motor_trajectory()) {
+    for (int j = 0; j < 3; ++j)
+      EXPECT_TRUE(std::isfinite(joints[static_cast<std::size_t>(j)]));
+  }
+  for (int j = 0; j < 3; ++j)
+    EXPECT_TRUE(std::isfinite(s.commanded[j])) << j;
+}
+
+// Keeps what the loop writes, and reports a position that is not a number when `broken`.
+class NanRecordingDriver final : public drivers::Driver {
+ public:
+  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
+    return "";
+  }
+  void enable() override {}
+  void disable() override {}
+  void write(const drivers::JointCommand* commands, int count) noexcept override {
+    for (int i = 0; i < count; ++i)
+      all_finite =
+          all_finite && std::isfinite(commands[i].position) && std::isfinite(commands[i].velocity);
+  }
+  void read(drivers::JointFeedback* feedback, int count) noexcept override {
+    for (int i = 0; i < count; ++i)
+      feedback[i] = drivers::JointFeedback{};
+    if (broken) feedback[1].position = std::nan("");
+  }
+  std::uint32_t capabilities() const noexcept override { return 0; }
+  const char* name() const noexcept override { return "nan"; }
+  bool broken = false;
+  bool all_finite = true;
+};
+
+TEST(ServoLoop, FeedbackThatIsNotANumberNeverComesBackAsACommand) {
+  const auto config = small_mill();
+  NanRecordingDriver driver;
+  motion::ServoLoop loop(config, {{&driver, {0, 1, 2}}});
+  ASSERT_TRUE(loop.commands().push(Command{Command::Kind::reset_estop, 0}));
+  loop.cycle(0);
+  driver.broken = true;  // drives off: the command follows the feedback
+  for (int i = 0; i < 10; ++i)
+    loop.cycle(0);
+  EXPECT_TRUE(driver.all_finite);
+  EXPECT_STREQ(loop.status().fault_reason, "non-finite set-point on joint 1");
+}
+
 config::MachineConfig gantry_mill() {
   auto config = small_mill();
   config.coordinates = "XYYZ";

@@ -134,6 +134,9 @@ class ServoLoop {
   // written yet is the latest one written, one that fell out of the history its oldest.
   drivers::JointCommand answered_command(std::size_t k, std::uint64_t cycle) const noexcept;
   void write_drivers() noexcept;
+  // RT: a joint whose set-point is not a number keeps its last command and the machine
+  // faults ("non-finite set-point on joint N"): a drive never sees a NaN or an infinity.
+  void guard_set_points() noexcept;
   void update_stats(std::int64_t wake_error_ns) noexcept;
   void latch_fault(const char* reason) noexcept;
   void post(Event::Level level, const char* text) noexcept;
