@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -57,6 +58,36 @@ std::string atomic_write_file(const std::filesystem::path& path, const std::stri
   return "";
 }
 
+namespace {
+std::string show_number(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.10g", value);
+  return text;
+}
+}  // namespace
+
+std::string position_problem(int joint, double value, const JointRange& range) {
+  const std::string where = "joint " + std::to_string(joint) + " position " + show_number(value);
+  if (!std::isfinite(value)) return where + " is not a finite number";
+  const double margin = kPositionMarginShare * (range.max - range.min);
+  if (value >= range.min - margin && value <= range.max + margin) return "";
+  return where + " is outside its limits [" + show_number(range.min) + ", " +
+         show_number(range.max) + "] by more than 10 % of its travel";
+}
+
+std::string write_position_file(const std::filesystem::path& path,
+                                const std::vector<double>& joints,
+                                const std::vector<JointRange>& ranges) {
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    const std::string problem = position_problem(static_cast<int>(j), joints[j],
+                                                 j < ranges.size() ? ranges[j] : JointRange{});
+    if (!problem.empty()) {
+      return path.string() + ": not written (the positions saved before stay): " + problem;
+    }
+  }
+  return atomic_write_file(path, format_position_file(joints));
+}
+
 std::string format_position_file(const std::vector<double>& joints) {
   std::string out;
   char line[64];
@@ -68,7 +99,9 @@ std::string format_position_file(const std::vector<double>& joints) {
 }
 
 std::optional<std::vector<double>> read_position_file(const std::filesystem::path& path,
-                                                      std::size_t joint_count, std::string& error) {
+                                                      const std::vector<JointRange>& ranges,
+                                                      std::string& error) {
+  const std::size_t joint_count = ranges.size();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::vector<double>{};
   std::ifstream in(path, std::ios::binary);
@@ -96,6 +129,14 @@ std::optional<std::vector<double>> read_position_file(const std::filesystem::pat
       error = path.string() + ":" + std::to_string(number) + ": '" + line.substr(first) +
               "' is not a position";
       return std::nullopt;
+    }
+    if (joints.size() < joint_count) {
+      const std::string problem =
+          position_problem(static_cast<int>(joints.size()), value, ranges[joints.size()]);
+      if (!problem.empty()) {
+        error = path.string() + ":" + std::to_string(number) + ": " + problem;
+        return std::nullopt;
+      }
     }
     joints.push_back(value);
   }

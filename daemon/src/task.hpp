@@ -19,6 +19,7 @@
 #include "cncd/motion/controller.hpp"
 #include "event_log.hpp"
 #include "feeder.hpp"
+#include "persist.hpp"
 #include "plan_estimate.hpp"
 #include "rpc.hpp"
 
@@ -115,6 +116,8 @@ class Task {
   void drain_servo_events();
   void save_parameters();
   void save_positions();
+  // Each joint's limits, for the position file (task_persist.cpp).
+  std::vector<JointRange> joint_ranges() const;
   // Rewrites the tool table when G10 L1/L10/L11 changed it (task_setup.cpp).
   void save_tools_if_changed();
   void finish_program(const std::string& result, const std::string& error);

@@ -8,6 +8,13 @@
 
 namespace cncd::daemon {
 
+std::vector<JointRange> Task::joint_ranges() const {
+  std::vector<JointRange> ranges;
+  for (const auto& joint : config_.joints)
+    ranges.push_back({joint.min_limit, joint.max_limit});
+  return ranges;
+}
+
 std::string Task::load_files() {
   if (const auto& error = interp_->load_error()) {
     files_corrupt_ = true;
@@ -16,7 +23,7 @@ std::string Task::load_files() {
   }
   if (config_.position_file.empty()) return "";
   std::string error;
-  const auto joints = read_position_file(config_.position_file, config_.joints.size(), error);
+  const auto joints = read_position_file(config_.position_file, joint_ranges(), error);
   if (!joints) {
     files_corrupt_ = true;
     return error;
@@ -31,7 +38,7 @@ void Task::save_positions() {
   const std::vector<double> joints(
       status.joint_actual.begin(),
       status.joint_actual.begin() + static_cast<std::ptrdiff_t>(config_.joints.size()));
-  if (const auto error = atomic_write_file(config_.position_file, format_position_file(joints));
+  if (const auto error = write_position_file(config_.position_file, joints, joint_ranges());
       !error.empty()) {
     events_.add("error", "positions", error);
     spdlog::error("{}", error);

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,14 +62,14 @@ TEST_F(PersistTest, PositionFileRoundTrips) {
   const auto file = dir_ / "position.txt";
   ASSERT_EQ(atomic_write_file(file, format_position_file({1.5, -2.25, 3})), "");
   std::string error;
-  const auto joints = read_position_file(file, 3, error);
+  const auto joints = read_position_file(file, std::vector<JointRange>(3), error);
   ASSERT_TRUE(joints.has_value()) << error;
   EXPECT_EQ(*joints, (std::vector<double>{1.5, -2.25, 3}));
 }
 
 TEST_F(PersistTest, MissingPositionFileIsNotAnError) {
   std::string error;
-  const auto joints = read_position_file(dir_ / "none.txt", 3, error);
+  const auto joints = read_position_file(dir_ / "none.txt", std::vector<JointRange>(3), error);
   ASSERT_TRUE(joints.has_value());
   EXPECT_TRUE(joints->empty());
 }
@@ -77,7 +78,7 @@ TEST_F(PersistTest, CorruptPositionFileNamesFileAndLine) {
   const auto file = dir_ / "position.txt";
   std::ofstream(file) << "1.0\nbanana\n3.0\n";
   std::string error;
-  EXPECT_FALSE(read_position_file(file, 3, error).has_value());
+  EXPECT_FALSE(read_position_file(file, std::vector<JointRange>(3), error).has_value());
   EXPECT_NE(error.find("position.txt:2"), std::string::npos) << error;
 }
 
@@ -85,8 +86,38 @@ TEST_F(PersistTest, EmptyOrShortPositionFileIsCorrupt) {
   const auto file = dir_ / "position.txt";
   std::ofstream(file) << "";
   std::string error;
-  EXPECT_FALSE(read_position_file(file, 3, error).has_value());
+  EXPECT_FALSE(read_position_file(file, std::vector<JointRange>(3), error).has_value());
   EXPECT_NE(error.find("0 positions"), std::string::npos) << error;
+}
+
+TEST_F(PersistTest, PositionsThatAreNotFiniteOrFarOutsideTheLimitsAreNeverWritten) {
+  const auto file = dir_ / "position.txt";
+  const std::vector<JointRange> ranges{{-10, 300}, {-10, 200}, {-100, 50}};
+  ASSERT_EQ(write_position_file(file, {1, 2, 3}, ranges), "");
+  for (const double bad : {std::nan(""), HUGE_VAL, -HUGE_VAL, 1e300, -116.0}) {
+    SCOPED_TRACE(bad);
+    const std::string error = write_position_file(file, {1, 2, bad}, ranges);
+    EXPECT_NE(error.find("position.txt: not written"), std::string::npos) << error;
+    EXPECT_NE(error.find("joint 2 position"), std::string::npos) << error;
+    EXPECT_EQ(read(file), "1.000000000\n2.000000000\n3.000000000\n");
+  }
+  // 10 % of the travel past a limit is still a place an unhomed machine may stand.
+  EXPECT_EQ(write_position_file(file, {330, -30, -115}, ranges), "");
+  std::string error;
+  const auto joints = read_position_file(file, ranges, error);
+  ASSERT_TRUE(joints.has_value()) << error;
+  EXPECT_EQ((*joints)[2], -115);
+}
+
+TEST_F(PersistTest, ReadingRefusesPositionsFarOutsideTheLimitsWithFileLineAndLimits) {
+  const auto file = dir_ / "position.txt";
+  std::ofstream(file) << "0\n\n500\n0\n";
+  std::string error;
+  EXPECT_FALSE(read_position_file(file, {{-10, 300}, {-10, 200}, {-100, 50}}, error));
+  EXPECT_NE(error.find("position.txt:3: joint 1 position 500 is outside its limits [-10, 200] "
+                       "by more than 10 % of its travel"),
+            std::string::npos)
+      << error;
 }
 
 TEST(MergeDiff, KeepsOnlyChangedLeaves) {
