@@ -30,7 +30,8 @@ interp::Units machine_units(const config::MachineConfig& config) {
 
 std::string number(double value) {
   char text[64];
-  std::snprintf(text, sizeof text, "%.4f", value);
+  // %.4f of an absurd number would print hundreds of digits.
+  std::snprintf(text, sizeof text, std::abs(value) <= 1e9 ? "%.4f" : "%.10g", value);
   return text;
 }
 
@@ -153,9 +154,10 @@ class CheckSink final : public interp::CanonSink {
     const char letter = config::kAxisLetters[axis];
     if (machine->coordinates.find(letter) == std::string::npos) return;
     const config::AxisConfig& limits = machine->axes[axis];
+    const bool finite = std::isfinite(value);
     const bool below = value < limits.min_limit - kLimitSlack;
     const bool above = value > limits.max_limit + kLimitSlack;
-    if (!below && !above) return;
+    if (finite && !below && !above) return;
     // One report per axis, side and line: an arc or a cycle may cross the same limit often.
     const Reported key{line, axis, above};
     if (std::find(reported_.begin(), reported_.end(), key) != reported_.end()) return;
@@ -163,11 +165,13 @@ class CheckSink final : public interp::CanonSink {
     reported_.push_back(key);
     ++report_.limit_violations;
     if (report_.problems.size() >= options_.max_problems) return;
-    std::string message = std::string(what) + ": " + letter + " " + number(value) + " is " +
-                          (above ? "above" : "below") + " [AXIS_" + letter + "] " +
-                          (above ? "MAX_LIMIT " : "MIN_LIMIT ") +
-                          number(above ? limits.max_limit : limits.min_limit) +
-                          " (machine coordinates)";
+    std::string message =
+        !finite
+            ? std::string(what) + ": " + letter + " " + number(value) + " is not a finite number"
+            : std::string(what) + ": " + letter + " " + number(value) + " is " +
+                  (above ? "above" : "below") + " [AXIS_" + letter + "] " +
+                  (above ? "MAX_LIMIT " : "MIN_LIMIT ") +
+                  number(above ? limits.max_limit : limits.min_limit) + " (machine coordinates)";
     report_.problems.push_back({file_, line, std::move(message)});
   }
 

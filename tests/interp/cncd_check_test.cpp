@@ -75,6 +75,14 @@ TEST_F(CncdCheckTest, MovesBeyondTheSoftLimitsNameTheLineTheAxisAndTheLimit) {
   EXPECT_NE(r.out.find("soft limits: 2 violations"), std::string::npos) << r.out;
 }
 
+TEST_F(CncdCheckTest, AbsurdTargetsAreNamedWithTheirValueNotHundredsOfDigits) {
+  const auto r = check_ini("G0 X[10**300]\nM2\n");
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find(":1: rapid move: X 1e+300 is above [AXIS_X] MAX_LIMIT 300.0000"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(CncdCheckTest, LimitsApplyInMachineCoordinatesAndUnits) {
   // G54 X250 puts program X60 at machine X310; 12 inches are 304.8 mm.
   auto r = check_ini("G10 L2 P1 X250\nG0 X40\nG0 X60\nM2\n");
