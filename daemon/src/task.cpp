@@ -322,8 +322,8 @@ void Task::feed() {
       if (result == motion::MotionController::EnqueueResult::refused) {
         const int line = feeder_->pending.front().line;
         motion_.abort();
-        finish_program("error",
-                       program_path_ + ":" + std::to_string(line) + ": " + motion_.enqueue_error());
+        finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
+                                    std::to_string(line) + ": " + motion_.enqueue_error());
         return;
       }
       feeder_->pending.pop_front();
