@@ -8,6 +8,8 @@
 namespace cncd::interp {
 
 std::string InterpError::to_string() const {
+  // The file loaders' messages name their file and line already ("FILE:LINE: ...").
+  if (line == 0 && !file.empty() && message.rfind(file + ":", 0) == 0) return message;
   std::string text = file;
   if (line > 0) {
     text += ":" + std::to_string(line);

@@ -145,6 +145,8 @@ TEST_F(ForeignParameterFileTest, APasswdFileIsRefusedAtStartAndLeftAlone) {
                                   dir_.path().string(), program.string()});
   EXPECT_NE(check.exit_status, 0);
   EXPECT_NE(check.err.find(foreign_.string() + ":1:"), std::string::npos) << check.err;
+  EXPECT_EQ(check.err.find(foreign_.string() + ": " + foreign_.string()), std::string::npos)
+      << check.err;
   EXPECT_EQ(slurp(foreign_), passwd);
   for (const auto& entry : fs::directory_iterator(dir_.path()))
     EXPECT_EQ(entry.path().filename().string().find(".passwd"), std::string::npos)
