@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "cncd/interp/stored_values.hpp"
+
 namespace cncd::daemon {
 
 using nlohmann::json;
@@ -15,7 +17,8 @@ namespace {
 // {"x": 1.5, "z": -2} for the machine's axes; sets the bits of the axes named in `mask`.
 void read_axes(const json& value, const std::string& name, const config::MachineConfig& config,
                interp::Pose& pose, std::uint32_t& mask) {
-  constexpr double kLimit = 1e9;
+  // The interpreter's bound on every stored offset and tool value.
+  constexpr double kLimit = interp::kMaxStoredValue;
   for (const auto& [key, number] : value.items()) {
     const auto index = key.size() == 1 ? config::kAxisLetters.find(static_cast<char>(
                                              std::toupper(static_cast<unsigned char>(key[0]))))
