@@ -36,6 +36,28 @@ void check_spindle_override(TypedReader& r, const MachineConfig& c) {
                 format_number(c.max_spindle_override));
 }
 
+// Homing ends with the joint at HOME; beyond a soft limit it would be stuck there (LinuxCNC
+// stops with "Exceeded soft limit" right after homing). HOME_OFFSET, the switch position, may
+// lie beyond a limit: shipped configs put the switch just past the end of travel.
+void check_home(TypedReader& r, const MachineConfig& c, const std::string& s,
+                const JointConfig& j) {
+  if (r.failed(s, "HOME") || r.failed(s, "MIN_LIMIT") || r.failed(s, "MAX_LIMIT") ||
+      j.min_limit > j.max_limit)
+    return;
+  const bool below = j.home < j.min_limit;
+  if (!below && j.home <= j.max_limit) return;
+  const char* key = below ? "MIN_LIMIT" : "MAX_LIMIT";
+  // Joint limits not given follow the axis (load_joint).
+  const std::string limit_from = r.given(s, key) || j.axis == '\0' || !c.axis(j.axis).present
+                                     ? std::string(key)
+                                     : "[AXIS_" + std::string(1, j.axis) + "] " + key;
+  r.problem(s, "HOME",
+            format_number(j.home) + (r.given(s, "HOME") ? "" : " (the default)") + " is " +
+                (below ? "below " : "above ") + limit_from + " " +
+                format_number(below ? j.min_limit : j.max_limit) +
+                ": homing would leave the joint beyond its soft limit");
+}
+
 void check_joint(TypedReader& r, const MachineConfig& c, int index, const JointConfig& j) {
   const std::string s = "JOINT_" + std::to_string(index);
   check_limits(r, s, j.min_limit, j.max_limit);
@@ -57,9 +79,7 @@ void check_joint(TypedReader& r, const MachineConfig& c, int index, const JointC
       }
     }
   }
-  if (j.home < j.min_limit || j.home > j.max_limit) {
-    r.warning(s, "HOME", format_number(j.home) + " is outside the joint limits");
-  }
+  check_home(r, c, s, j);
   if (j.min_ferror > j.ferror) {
     r.warning(s, "MIN_FERROR", "larger than FERROR " + format_number(j.ferror));
   }

@@ -1,6 +1,9 @@
 // Every trivkins configuration LinuxCNC ships must load as LinuxCNC itself would load it.
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+
 #include "cncd/config/ini_file.hpp"
 #include "cncd/config/machine_config.hpp"
 
@@ -25,22 +28,40 @@ std::vector<std::filesystem::path> trivkins_samples() {
   return found;
 }
 
+// Samples that cannot work in LinuxCNC either, with the one problem each must get.
+const std::map<std::string, std::string> kBrokenSamples = {
+    // HOME -4 below MIN_LIMIT -3: LinuxCNC stops with "Exceeded NEGATIVE soft limit" as
+    // soon as the joint is homed.
+    {"sim/gmoccapy/lathe_configs/lathe_imperial.ini",
+     ":144: [JOINT_1] HOME: -4 is below MIN_LIMIT -3"},
+};
+
 TEST(LinuxCncSampleConfigsTest, EveryTrivkinsSampleLoadsWithoutProblems) {
   if (!std::filesystem::is_directory(kSamples)) {
     GTEST_SKIP() << kSamples << " not found (package linuxcnc-uspace)";
   }
   const auto samples = trivkins_samples();
   EXPECT_GT(samples.size(), 100u);
+  std::size_t broken = 0;
   for (const auto& path : samples) {
     const auto result = load_machine_config(path);
     std::string problems;
     for (const auto& p : result.problems)
       problems += "\n  " + p.to_string();
+    const auto known = kBrokenSamples.find(path.lexically_relative(kSamples).string());
+    if (known != kBrokenSamples.end()) {
+      ++broken;
+      ASSERT_EQ(result.problems.size(), 1u) << path << problems;
+      EXPECT_NE(result.problems[0].to_string().find(known->second), std::string::npos)
+          << path << problems;
+      continue;
+    }
     EXPECT_TRUE(result.ok()) << path << problems;
     if (result.ok()) {
       EXPECT_FALSE(describe(*result.config).empty());
     }
   }
+  EXPECT_EQ(broken, kBrokenSamples.size());
 }
 
 TEST(LinuxCncSampleConfigsTest, EverySampleLoadsWithoutThrowing) {

@@ -1,0 +1,57 @@
+// A configuration that loads must be able to run the machine: settings that contradict each
+// other are refused at their FILE:LINE, slips that LinuxCNC tolerates are warned about there.
+#include <gtest/gtest.h>
+
+#include "cncd/config/machine_config.hpp"
+#include "temp_dir.hpp"
+
+namespace cncd::config::test {
+namespace {
+
+// Line numbers of minimal_ini(): [TRAJ] COORDINATES 6, LINEAR_UNITS 7, ANGULAR_UNITS 8,
+// [KINS] KINEMATICS 10, JOINTS 11, [AXIS_X] 12 (MIN_LIMIT 13, MAX_LIMIT 14), [JOINT_0] 27
+// (MIN_LIMIT 28, MAX_LIMIT 29, MAX_VELOCITY 30, MAX_ACCELERATION 31), [JOINT_1] 32,
+// [JOINT_2] 37 .. 41.
+std::string replace_line(std::string ini, int line, const std::string& text) {
+  std::size_t start = 0;
+  for (int i = 1; i < line; ++i)
+    start = ini.find('\n', start) + 1;
+  const std::size_t end = ini.find('\n', start);
+  return ini.replace(start, end - start, text);
+}
+
+class WorkableConfigTest : public TempDirTest {
+ protected:
+  LoadResult load(const std::string& ini) { return load_machine_config(write("m.ini", ini)); }
+  std::vector<std::string> problems_of(const std::string& ini) {
+    const auto result = load(ini);
+    EXPECT_FALSE(result.ok());
+    return strings(result.problems);
+  }
+  std::string at(int line) const { return TempDirTest::at("m.ini", line); }
+};
+
+TEST_F(WorkableConfigTest, HomeOutsideTheJointLimitsIsRefused) {
+  EXPECT_EQ(
+      problems_of(replace_line(minimal_ini(), 31, "MAX_ACCELERATION = 500\nHOME = 150")),
+      std::vector<std::string>{at(32) + ": [JOINT_0] HOME: 150 is above MAX_LIMIT 100: "
+                                        "homing would leave the joint beyond its soft limit"});
+  // Joint limits not given are the axis limits; HOME not given is 0.
+  auto ini = replace_line(minimal_ini(), 13, "MIN_LIMIT = 10");
+  ini = replace_line(ini, 28, "");
+  EXPECT_EQ(problems_of(ini),
+            std::vector<std::string>{at(27) + ": [JOINT_0] HOME: 0 (the default) is below [AXIS_X] "
+                                              "MIN_LIMIT 10: homing would leave the joint beyond "
+                                              "its soft limit"});
+}
+
+TEST_F(WorkableConfigTest, HomeOffsetBeyondALimitIsTheSwitchPosition) {
+  // LinuxCNC's shipped configs put the home switch just past the end of travel: the joint
+  // homes there and then moves to HOME, inside the limits.
+  const auto result =
+      load(replace_line(minimal_ini(), 31, "MAX_ACCELERATION = 500\nHOME_OFFSET = 101\nHOME = 99"));
+  EXPECT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+}
+
+}  // namespace
+}  // namespace cncd::config::test
