@@ -153,11 +153,7 @@ JointConfig load_joint(TypedReader& r, const MachineConfig& c, int index, char l
   JointConfig j;
   j.axis = letter;
   j.source = r.where(s, "");
-  if (!r.ini().has_section(s)) {
-    r.warning(s, "",
-              "section missing; LinuxCNC defaults used (MAX_VELOCITY 1, "
-              "MAX_ACCELERATION 1)");
-  } else {
+  if (r.ini().has_section(s)) {
     for (const auto* key : {"MAX_VELOCITY", "MAX_ACCELERATION"}) {
       if (!r.given(s, key)) r.warning(s, key, "not given; LinuxCNC default 1 used");
     }
@@ -179,6 +175,30 @@ JointConfig load_joint(TypedReader& r, const MachineConfig& c, int index, char l
   if (const auto v = r.real(s, "OUTPUT_SCALE")) j.output_scale = *v;
   if (const auto v = r.choice(s, "DRIVER")) j.driver = *v;
   return j;
+}
+
+// A joint without its [JOINT_n] section runs on LinuxCNC's made-up defaults (1 unit/s, no
+// limits of its own). Shipped lathes keep such a joint for an axis they do not have (trivkins
+// without coordinates=, joint 1 = Y); a joint that moves an axis of the machine must be
+// configured, and a [JOINT_n] numbered past JOINTS is then most likely the one meant for it.
+void check_joint_section(TypedReader& r, const MachineConfig& c, int index, char letter) {
+  const std::string s = joint_section(index);
+  if (r.ini().has_section(s)) return;
+  if (letter == '\0' || c.coordinates.find(letter) == std::string::npos) {
+    r.warning(s, "",
+              "section missing; LinuxCNC defaults used (MAX_VELOCITY 1, "
+              "MAX_ACCELERATION 1)");
+    return;
+  }
+  std::string beyond;
+  for (int n = c.joint_count; n < kMaxJoints; ++n) {
+    if (r.ini().has_section(joint_section(n))) beyond += " [" + joint_section(n) + "]";
+  }
+  r.problem(
+      "KINS", "JOINTS",
+      "JOINTS = " + std::to_string(c.joint_count) + ", but joint " + std::to_string(index) +
+          " (axis " + letter + ") has no [" + s + "] section" +
+          (beyond.empty() ? "" : "; the file has" + beyond + " instead, which JOINTS leaves out"));
 }
 
 // Path limits not given in [TRAJ] follow the axes, as LinuxCNC lets the axis limits apply.
@@ -231,6 +251,7 @@ void load_motion(TypedReader& r, MachineConfig& c) {
   for (int index = 0; index < c.joint_count; ++index) {
     const char letter =
         index < static_cast<int>(map.size()) ? map[static_cast<std::size_t>(index)] : '\0';
+    check_joint_section(r, c, index, letter);
     if (letter == '\0' && index < c.joint_count - c.extra_joints) {
       r.warning(joint_section(index), "", "joint is driven by no axis");
     } else if (letter != '\0' && c.coordinates.find(letter) == std::string::npos) {

@@ -34,6 +34,10 @@ const std::map<std::string, std::string> kBrokenSamples = {
     // soon as the joint is homed.
     {"sim/gmoccapy/lathe_configs/lathe_imperial.ini",
      ":144: [JOINT_1] HOME: -4 is below MIN_LIMIT -3"},
+    // JOINTS = 2 with [JOINT_0] and [JOINT_2]: LinuxCNC ignores [JOINT_2] and drives Z
+    // (joint 1) with its defaults, 1 inch/s and no joint limits.
+    {"sim/axis/panelui-demo/panelui-demo.ini",
+     ":68: [KINS] JOINTS: JOINTS = 2, but joint 1 (axis Z) has no [JOINT_1] section"},
 };
 
 TEST(LinuxCncSampleConfigsTest, EveryTrivkinsSampleLoadsWithoutProblems) {

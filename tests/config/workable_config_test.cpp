@@ -53,5 +53,19 @@ TEST_F(WorkableConfigTest, HomeOffsetBeyondALimitIsTheSwitchPosition) {
   EXPECT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
 }
 
+TEST_F(WorkableConfigTest, JointOfAnAxisWithoutItsSectionIsRefused) {
+  // [JOINT_2] written as [JOINT_3]: LinuxCNC would drive Z at 1 mm/s without joint limits.
+  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 37, "[JOINT_3]")),
+            std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 3, but joint 2 (axis Z) "
+                                              "has no [JOINT_2] section; the file has [JOINT_3] "
+                                              "instead, which JOINTS leaves out"});
+  // A lathe converted from LinuxCNC 2.7 keeps a joint for the Y it does not have: a warning.
+  const auto lathe =
+      load(replace_line(replace_line(minimal_ini(), 6, "COORDINATES = X Z"), 32, "[SPARE]"));
+  ASSERT_TRUE(lathe.ok()) << ::testing::PrintToString(strings(lathe.problems));
+  EXPECT_TRUE(any_contains(lathe.warnings, "m.ini: [JOINT_1] section missing"))
+      << ::testing::PrintToString(strings(lathe.warnings));
+}
+
 }  // namespace
 }  // namespace cncd::config::test
