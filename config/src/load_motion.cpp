@@ -65,6 +65,35 @@ Kinematics load_kinematics(TypedReader& r) {
   return k;
 }
 
+// "Y is" or "X and Y are": the letters written more than once.
+std::string repeated_letters(const std::string& letters) {
+  std::string found;
+  for (const char letter : kAxisLetters) {
+    if (std::count(letters.begin(), letters.end(), letter) > 1) found += letter;
+  }
+  std::string text;
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    text += (i == 0 ? "" : i + 1 == found.size() ? " and " : ", ") + std::string(1, found[i]);
+  }
+  return text + (found.size() == 1 ? " is" : " are");
+}
+
+// With coordinates= the joints are trivkins', and [TRAJ] COORDINATES only names the axes: a
+// letter it repeats more often than trivkins gives that axis joints is no gantry.
+void check_repeats_match_kinematics(TypedReader& r, const Kinematics& k,
+                                    const std::string& coordinates) {
+  for (const char letter : kAxisLetters) {
+    const auto written = std::count(coordinates.begin(), coordinates.end(), letter);
+    const auto joints = std::count(k.coordinates.begin(), k.coordinates.end(), letter);
+    if (written < 2 || joints >= written) continue;
+    r.problem("TRAJ", "COORDINATES",
+              std::string(1, letter) + " is written " + std::to_string(written) +
+                  " times, but trivkins coordinates=" + k.coordinates + " drives it with " +
+                  std::to_string(joints) + " joint" + (joints == 1 ? "" : "s") +
+                  "; a gantry repeats the letter in both");
+  }
+}
+
 // Which axis each joint drives, as trivkins assigns them: the letters of coordinates= in
 // joint order; without it joint n drives the n-th of XYZABCUVW. A gantry written only in
 // [TRAJ] COORDINATES (XYYZ) is taken as that joint list, since identity cannot mean it.
@@ -80,9 +109,17 @@ std::string joint_map(TypedReader& r, const Kinematics& k, MachineConfig& c) {
                 jstr + " is too few: trivkins coordinates=" + map + " needs " +
                     std::to_string(map.size() + c.extra_joints) + " joints");
     }
+    check_repeats_match_kinematics(r, k, c.coordinates);
   } else if (distinct.size() != c.coordinates.size()) {
     map = c.coordinates;
-    if (static_cast<int>(map.size()) != kinematic_joints) {
+    if (static_cast<int>(distinct.size()) == kinematic_joints) {
+      // One joint an axis: the repeat cannot be a gantry, it is a slip.
+      r.problem("TRAJ", "COORDINATES",
+                repeated_letters(c.coordinates) + " repeated, but a repeated letter is a " +
+                    "gantry, one joint a letter (" + std::to_string(map.size()) + "), and " + jstr +
+                    " gives each axis one joint; write each letter once, or JOINTS = " +
+                    std::to_string(map.size() + c.extra_joints) + " for a gantry");
+    } else if (static_cast<int>(map.size()) != kinematic_joints) {
       r.problem("KINS", "JOINTS",
                 jstr + " does not match COORDINATES " + c.coordinates + ", which names " +
                     std::to_string(map.size()) + " joints");

@@ -113,8 +113,9 @@ TEST_F(ValidationTest, UnknownUnits) {
 }
 
 TEST_F(ValidationTest, JointsMustMatchCoordinates) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 6, "COORDINATES = X Y Y Z")),
-            std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 3 does not match "
+  EXPECT_EQ(problems_of(replace_line(replace_line(minimal_ini(), 6, "COORDINATES = X Y Y Z"), 11,
+                                     "JOINTS = 2")),
+            std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 2 does not match "
                                               "COORDINATES XYYZ, which names 4 joints"});
   EXPECT_EQ(problems_of(replace_line(minimal_ini(), 10, "KINEMATICS = trivkins coordinates=XYYZ")),
             std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 3 is too few: trivkins "

@@ -53,6 +53,31 @@ TEST_F(WorkableConfigTest, HomeOffsetBeyondALimitIsTheSwitchPosition) {
   EXPECT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
 }
 
+TEST_F(WorkableConfigTest, RepeatedCoordinateLetterWithOneJointAnAxisIsRefused) {
+  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 6, "COORDINATES = X Y Y Z")),
+            std::vector<std::string>{
+                at(6) + ": [TRAJ] COORDINATES: Y is repeated, but a repeated letter is a gantry, "
+                        "one joint a letter (4), and JOINTS = 3 gives each axis one joint; write "
+                        "each letter once, or JOINTS = 4 for a gantry"});
+  // trivkins coordinates= says which joints there are; COORDINATES cannot add one.
+  EXPECT_EQ(problems_of(replace_line(replace_line(minimal_ini(), 6, "COORDINATES = X Y Y Z"), 10,
+                                     "KINEMATICS = trivkins coordinates=XYZ")),
+            std::vector<std::string>{at(6) + ": [TRAJ] COORDINATES: Y is written 2 times, but "
+                                             "trivkins coordinates=XYZ drives it with 1 joint; a "
+                                             "gantry repeats the letter in both"});
+}
+
+TEST_F(WorkableConfigTest, GantryLoads) {
+  auto ini = replace_line(minimal_ini(), 6, "COORDINATES = X Y Y Z");
+  ini = replace_line(ini, 10, "KINEMATICS = trivkins coordinates=XYYZ kinstype=both");
+  ini = replace_line(ini, 11, "JOINTS = 4");
+  ini += "[JOINT_3]\nMIN_LIMIT = -10\nMAX_LIMIT = 100\nMAX_VELOCITY = 50\nMAX_ACCELERATION = 500\n";
+  const auto result = load(ini);
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(result.config->joints[2].axis, 'Y');
+  EXPECT_TRUE(result.warnings.empty()) << ::testing::PrintToString(strings(result.warnings));
+}
+
 TEST_F(WorkableConfigTest, JointOfAnAxisWithoutItsSectionIsRefused) {
   // [JOINT_2] written as [JOINT_3]: LinuxCNC would drive Z at 1 mm/s without joint limits.
   EXPECT_EQ(problems_of(replace_line(minimal_ini(), 37, "[JOINT_3]")),
