@@ -253,8 +253,9 @@ void derive_traj_limits(TypedReader& r, MachineConfig& c) {
   if (c.default_linear_acceleration == 0) c.default_linear_acceleration = c.max_linear_acceleration;
   if (c.default_linear_velocity > c.max_linear_velocity) {
     r.warning("TRAJ", "DEFAULT_LINEAR_VELOCITY",
-              "higher than MAX_LINEAR_VELOCITY " + format_number(c.max_linear_velocity) +
-                  "; that limit applies");
+              format_number(c.default_linear_velocity) + " is above MAX_LINEAR_VELOCITY " +
+                  format_number(c.max_linear_velocity) + "; lowered to it");
+    c.default_linear_velocity = c.max_linear_velocity;
   }
 }
 

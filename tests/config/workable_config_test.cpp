@@ -92,5 +92,16 @@ TEST_F(WorkableConfigTest, JointOfAnAxisWithoutItsSectionIsRefused) {
       << ::testing::PrintToString(strings(lathe.warnings));
 }
 
+TEST_F(WorkableConfigTest, DefaultVelocityAboveTheMaximumIsLowered) {
+  const auto result = load(
+      replace_line(minimal_ini(), 7,
+                   "LINEAR_UNITS = mm\nMAX_LINEAR_VELOCITY = 40\nDEFAULT_LINEAR_VELOCITY = 60"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(result.config->default_linear_velocity, 40);
+  EXPECT_EQ(strings(result.warnings),
+            std::vector<std::string>{at(9) + ": [TRAJ] DEFAULT_LINEAR_VELOCITY: 60 is above "
+                                             "MAX_LINEAR_VELOCITY 40; lowered to it"});
+}
+
 }  // namespace
 }  // namespace cncd::config::test
