@@ -249,4 +249,11 @@ const KeySpec* find_key_spec(std::string_view section, std::string_view key) {
   return nullptr;
 }
 
+std::string_view key_table_section(std::string_view section) {
+  for (const auto& spec : kKeys) {
+    if (matches_section(spec.section, section)) return spec.section;
+  }
+  return {};
+}
+
 }  // namespace cncd::config

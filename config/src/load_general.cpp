@@ -135,7 +135,8 @@ void load_cncd(TypedReader& r, CncdConfig& cncd) {
   for (const auto& entry : r.ini().entries()) {
     if (entry.section == "CNCD" && entry.section_occurrence == 0 &&
         find_key_spec("CNCD", entry.key) == nullptr) {
-      r.problem("CNCD", entry.key, "unknown key in cncd's own section");
+      r.problem("CNCD", entry.key,
+                "unknown key in cncd's own section" + did_you_mean("CNCD", entry.key));
     }
   }
 }

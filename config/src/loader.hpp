@@ -2,6 +2,9 @@
 // collects problems instead of stopping.
 #pragma once
 
+#include <string>
+#include <string_view>
+
 #include "cncd/config/machine_config.hpp"
 #include "typed_reader.hpp"
 
@@ -15,6 +18,11 @@ void load_state_files(TypedReader& reader, MachineConfig& config, const LoadOpti
 void load_motion(TypedReader& reader, MachineConfig& config);
 // Cross-checks between keys and sections.
 void validate(TypedReader& reader, const MachineConfig& config);
+// Repeated single-valued keys, and unknown keys that look like a misspelt known one.
+void check_keys(TypedReader& reader);
+// "; did you mean MAX_VELOCITY?" for a key that is a typo away from a known key of the
+// section, else "".
+std::string did_you_mean(std::string_view section, std::string_view key);
 // Section names: duplicates, bad [JOINT_n] / [AXIS_L] names. False for a LinuxCNC 2.7-style
 // file with numbered [AXIS_n] sections, which cannot be read as joints and axes.
 bool check_sections(TypedReader& reader);

@@ -61,6 +61,7 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
     load_motion(reader, config);
     validate(reader, config);
   }
+  check_keys(reader);
   config.ini = std::move(ini);
   sort_by_place(result.problems);
   sort_by_place(result.warnings);

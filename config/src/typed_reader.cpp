@@ -29,16 +29,9 @@ std::optional<TypedReader::Raw> TypedReader::raw(std::string_view section, std::
 const IniEntry* TypedReader::entry(std::string_view section, std::string_view key) {
   const auto all = ini_.find_all(section, key);
   if (all.empty()) return nullptr;
+  // A repeated key is reported once by check_keys.
   for (const IniEntry* e : all)
     ini_.mark_used(*e);
-  for (std::size_t i = 1; i < all.size(); ++i) {
-    if (all[i]->value != all.front()->value) {
-      warnings_.push_back(
-          Problem{all[i]->source.file, all[i]->source.line, std::string(section), std::string(key),
-                  "repeated with another value; the first (" + all.front()->value + " at line " +
-                      std::to_string(all.front()->source.line) + ") is used"});
-    }
-  }
   return all.front();
 }
 

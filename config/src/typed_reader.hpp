@@ -32,7 +32,7 @@ class TypedReader {
   // The choice as the table spells it (the INI may use any case).
   std::optional<std::string> choice(std::string_view section, std::string_view key);
 
-  // The first entry of the key (marked used), nullptr when absent.
+  // The first entry of the key (every one marked used), nullptr when absent.
   const IniEntry* entry(std::string_view section, std::string_view key);
   bool given(std::string_view section, std::string_view key) const {
     return ini_.find(section, key) != nullptr;
@@ -50,6 +50,7 @@ class TypedReader {
 
   const IniFile& ini() const { return ini_; }
   std::vector<Problem>& problems() { return problems_; }
+  std::vector<Problem>& warnings() { return warnings_; }
 
  private:
   // The spec and the text to interpret (the INI value or the default), with its entry.

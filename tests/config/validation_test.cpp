@@ -246,7 +246,10 @@ TEST_F(ValidationTest, RepeatedSectionThatSaysSomethingElse) {
 
 TEST_F(ValidationTest, UnknownKeyInCncdSection) {
   EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nSOCKT = /tmp/x\n"),
-            std::vector<std::string>{at(43) + ": [CNCD] SOCKT: unknown key in cncd's own section"});
+            std::vector<std::string>{at(43) + ": [CNCD] SOCKT: unknown key in cncd's own section; "
+                                              "did you mean SOCKET?"});
+  EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nSPEED = 3\n"),
+            std::vector<std::string>{at(43) + ": [CNCD] SPEED: unknown key in cncd's own section"});
 }
 
 TEST_F(ValidationTest, AllProblemsAreCollected) {

@@ -103,5 +103,60 @@ TEST_F(WorkableConfigTest, DefaultVelocityAboveTheMaximumIsLowered) {
                                              "MAX_LINEAR_VELOCITY 40; lowered to it"});
 }
 
+TEST_F(WorkableConfigTest, RepeatedKeyWarnsWithBothLines) {
+  const auto result = load(replace_line(minimal_ini(), 31,
+                                        "MAX_ACCELERATION = 500\nMAX_VELOCITY = 20\n"
+                                        "MAX_ACCELERATION = 500"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(result.config->joints[0].max_velocity, 50);  // the first, as LinuxCNC reads it
+  EXPECT_EQ(strings(result.warnings),
+            (std::vector<std::string>{
+                at(32) + ": [JOINT_0] MAX_VELOCITY: given again with another value (20), which is "
+                         "ignored: the first, at line 30 (50), is used",
+                at(33) + ": [JOINT_0] MAX_ACCELERATION: given again; the first, at line 31, has "
+                         "the same value"}));
+}
+
+TEST_F(WorkableConfigTest, RepeatedKeyInAnIncludeNamesTheOtherFile) {
+  write("more.inc", "MAX_LINEAR_VELOCITY = 30\n");
+  const auto result = load(replace_line(minimal_ini(), 7,
+                                        "LINEAR_UNITS = mm\nMAX_LINEAR_VELOCITY = 40\n"
+                                        "#INCLUDE more.inc"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(strings(result.warnings),
+            std::vector<std::string>{TempDirTest::at("more.inc", 1) +
+                                     ": [TRAJ] MAX_LINEAR_VELOCITY: given again with another "
+                                     "value (30), which is ignored: the first, at " +
+                                     at(8) + " (40), is used"});
+}
+
+TEST_F(WorkableConfigTest, KeysLinuxCncRepeatsOrCncdIgnoresAreNotReported) {
+  const auto result =
+      load(replace_line(minimal_ini(), 7, "LINEAR_UNITS = mm\nARC_BLEND_ENABLE = 1") +
+           "[HAL]\nHALFILE = a.hal\nHALFILE = b.hal\n"
+           "[RS274NGC]\nREMAP = M6 modalgroup=6\nREMAP = M61 modalgroup=6\n"
+           "[FILTER]\nPROGRAM_EXTENSION = .py Python\nPROGRAM_EXTENSION = .png\n"
+           "[DISPLAY]\nDISPLAY = axis\nEMBED_TAB_NAME = a\nEMBED_TAB_NAME = b\n");
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_TRUE(result.warnings.empty()) << ::testing::PrintToString(strings(result.warnings));
+}
+
+TEST_F(WorkableConfigTest, MisspeltKeyGetsTheClosestKnownOne) {
+  const auto result = load(replace_line(minimal_ini(), 31,
+                                        "MAX_ACCELERATION = 500\nMAX_VELOCTY = 20\n"
+                                        "HOME_SEARCH_VELL = 5\nmin_ferror = 0.1\n"
+                                        "MY_PID_GAIN = 3\nP = 100\nDEADBAND = 0.01"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  // Keys far from any known one may be read by HAL files ([JOINT_0]MY_PID_GAIN): no warning.
+  EXPECT_EQ(strings(result.warnings),
+            (std::vector<std::string>{
+                at(32) + ": [JOINT_0] MAX_VELOCTY: unknown key, ignored; did you mean "
+                         "MAX_VELOCITY?",
+                at(33) + ": [JOINT_0] HOME_SEARCH_VELL: unknown key, ignored; did you mean "
+                         "HOME_SEARCH_VEL?",
+                at(34) + ": [JOINT_0] min_ferror: unknown key, ignored; did you mean MIN_FERROR? "
+                         "(key names are case-sensitive)"}));
+}
+
 }  // namespace
 }  // namespace cncd::config::test

@@ -38,4 +38,8 @@ std::span<const KeySpec> key_table();
 // nullptr when cncd does not interpret the key.
 const KeySpec* find_key_spec(std::string_view section, std::string_view key);
 
+// The table's name for a section ("JOINT_n" for [JOINT_3], "TRAJ" for [TRAJ]); empty when cncd
+// interprets no key of that section.
+std::string_view key_table_section(std::string_view section);
+
 }  // namespace cncd::config
