@@ -16,13 +16,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // Every line of `text` as numbers; fails the test on a line that is not `fields` numbers.
 std::vector<std::vector<double>> numbers(const std::string& text, std::size_t fields,
                                          const std::string& name) {

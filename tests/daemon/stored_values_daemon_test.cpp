@@ -15,13 +15,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The largest magnitude of any value in a "NUMBER VALUE" parameter file, and #5221.
 struct VarSummary {
   double largest = 0;
