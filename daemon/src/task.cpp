@@ -207,7 +207,9 @@ void Task::run_program(int from_line, bool step) {
   stepping_ = step;
   step_budget_ = step ? 1 : 0;
   started_at_ = Clock::now();
+  started_cycles_ = status.rt.cycles;
   elapsed_s_ = 0;
+  motion_s_ = 0;
   last_result_.clear();
   last_error_.clear();
   events_.add("info", "program",
@@ -296,6 +298,7 @@ void Task::finish_program(const std::string& result, const std::string& error) {
   skip_to_line_ = 0;
   moves_completed_ = motion_.status().moves_done - moves_done_base_;
   elapsed_s_ = std::chrono::duration<double>(Clock::now() - started_at_).count();
+  motion_s_ = servo_seconds_since(started_cycles_);
   last_result_ = result;
   last_error_ = error;
   if (result == "done") {

@@ -113,6 +113,8 @@ class Task {
   nlohmann::json time_estimate(std::uint64_t moves_done) const;
   // Time the current run has spent moving: since it started, without its pauses.
   double moving_s() const;
+  // Servo periods run since the servo thread had run `cycles`, in seconds.
+  double servo_seconds_since(std::uint64_t cycles) const;
   void drain_servo_events();
   void save_parameters();
   void save_positions();
@@ -156,6 +158,10 @@ class Task {
   int step_budget_ = 0;    // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
+  // The run on the servo clock: servo periods since program.run (rt.cycles) x the period. Falls
+  // behind elapsed_s_ only when the servo thread stalled and skipped periods.
+  std::uint64_t started_cycles_ = 0;
+  double motion_s_ = 0;
   PlanEstimator estimator_;  // the open program's running time, worked out in the background
   bool from_top_ = false;    // the run started at the program's first line
   int run_from_line_ = 0;    // run from line: the line it started at

@@ -190,6 +190,12 @@ json Task::time_estimate(std::uint64_t moves_done) const {
   return out;
 }
 
+double Task::servo_seconds_since(std::uint64_t cycles) const {
+  const std::uint64_t now = motion_.status().rt.cycles;
+  return static_cast<double>(now > cycles ? now - cycles : 0) *
+         static_cast<double>(config_.servo_period_ns) * 1e-9;
+}
+
 double Task::moving_s() const {
   const auto until = exec_ == ExecState::paused ? paused_since_ : std::chrono::steady_clock::now();
   return std::chrono::duration<double>(until - started_at_).count() - paused_s_;
@@ -218,6 +224,8 @@ json Task::status() const {
       exec_ == ExecState::idle
           ? elapsed_s_
           : std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count();
+  const double motion_time =
+      exec_ == ExecState::idle ? motion_s_ : servo_seconds_since(started_cycles_);
   // Between steps nothing is read ahead: the interpreter's line is the one just carried out.
   const int line = exec_ == ExecState::idle                  ? 0
                    : stepping_ && exec_ == ExecState::paused ? interp_->current_line()
@@ -264,6 +272,7 @@ json Task::status() const {
         {"stepping", stepping_},
         {"moves", moves},
         {"elapsed_s", elapsed},
+        {"motion_s", motion_time},
         {"estimated_s", times["estimated_s"]},
         {"remaining_s", times["remaining_s"]},
         {"remaining_reason", times["remaining_reason"]},

@@ -66,13 +66,18 @@ class EstimateTest : public MachineTest {
     const double measured = seconds_since(start);
     ASSERT_EQ(done["program"]["result"], "done") << done.dump();
     EXPECT_EQ(done["program"]["remaining_s"], 0.0);
-    // The daemon's own run time, and program.run to idle seen through the socket: polling every
-    // 5 ms and two calls' round trips, which on a busy shared machine (sanitizer builds running
-    // beside this test) take up to a few tens of milliseconds.
-    EXPECT_NEAR(done["program"]["elapsed_s"].get<double>(), estimated, 0.01 * estimated);
-    EXPECT_NEAR(measured, estimated, 0.01 * estimated + 0.05) << "estimated " << estimated;
-    std::printf("estimated %.3f s, run %.3f s (daemon), %.3f s (program.run to idle)\n", estimated,
-                done["program"]["elapsed_s"].get<double>(), measured);
+    // The run on the servo clock (servo periods x the period) is what the estimate predicts. Wall
+    // time is never shorter, and longer only by the periods a stalled servo thread skipped (a busy
+    // shared machine, sanitizer builds): printed, not held to the estimate.
+    const double motion = done["program"]["motion_s"].get<double>();
+    const double elapsed = done["program"]["elapsed_s"].get<double>();
+    EXPECT_NEAR(motion, estimated, 0.01 * estimated) << done.dump();
+    EXPECT_GE(elapsed + 0.002, motion) << done.dump();
+    EXPECT_GE(measured + 0.002, motion);
+    std::printf(
+        "estimated %.3f s, run %.3f s on the servo clock, %.3f s (daemon, wall), %.3f s "
+        "(program.run to idle), %s servo overruns\n",
+        estimated, motion, elapsed, measured, done["rt"]["overruns"].dump().c_str());
   }
   // Polls every 5 ms until the program is idle; returns the last status.
   json poll_until_idle() {
