@@ -27,6 +27,7 @@
 #include "cncd/interp/rs274_printer.hpp"
 #include "plan_sim.hpp"
 #include "program_check.hpp"
+#include "start_checks.hpp"
 
 namespace {
 
@@ -209,6 +210,14 @@ int main(int argc, char** argv) {
         std::cerr << problem.to_string() << '\n';
       std::cerr << "cncd-check: " << loaded->problems.size() << " problem"
                 << (loaded->problems.size() == 1 ? "" : "s") << " in " << ini << '\n';
+      return config::kExitConfig;
+    }
+    // Every program starts with the machine's start-up code: a broken one fails them all.
+    if (const auto problems = daemon::check_startup_code(*loaded->config); !problems.empty()) {
+      for (const auto& problem : problems)
+        std::cerr << problem.to_string() << '\n';
+      std::cerr << "cncd-check: " << problems.size() << " problem"
+                << (problems.size() == 1 ? "" : "s") << " in " << ini << '\n';
       return config::kExitConfig;
     }
     options.machine = &*loaded->config;

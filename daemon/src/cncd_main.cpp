@@ -10,6 +10,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -18,6 +19,7 @@
 #include "logging.hpp"
 #include "methods.hpp"
 #include "server.hpp"
+#include "start_checks.hpp"
 #include "state_files.hpp"
 #include "task.hpp"
 #include "version.hpp"
@@ -203,6 +205,16 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   return 0;
 }
 
+// Lists the problems and returns the exit status for an invalid configuration.
+int refuse(const std::vector<cncd::config::Problem>& problems, const std::string& ini) {
+  for (const auto& problem : problems) {
+    std::fprintf(stderr, "%s\n", problem.to_string().c_str());
+  }
+  std::fprintf(stderr, "cncd: %zu problem%s in %s\n", problems.size(),
+               problems.size() == 1 ? "" : "s", ini.c_str());
+  return cncd::config::kExitConfig;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -212,15 +224,14 @@ int main(int argc, char** argv) {
   cncd::config::LoadOptions load_options;
   load_options.state_dir = options.state_dir;
   const auto loaded = cncd::config::load_machine_config(options.ini, load_options);
-  if (!loaded.ok()) {
-    for (const auto& problem : loaded.problems) {
-      std::fprintf(stderr, "%s\n", problem.to_string().c_str());
-    }
-    std::fprintf(stderr, "cncd: %zu problem%s in %s\n", loaded.problems.size(),
-                 loaded.problems.size() == 1 ? "" : "s", options.ini.c_str());
-    return cncd::config::kExitConfig;
-  }
+  if (!loaded.ok()) return refuse(loaded.problems, options.ini);
   const auto& config = *loaded.config;
+  // A configuration that loads must also be able to run here: its start-up code and the
+  // places of its state files.
+  auto problems = cncd::daemon::check_state_directories(config);
+  for (auto& problem : cncd::daemon::check_startup_code(config))
+    problems.push_back(std::move(problem));
+  if (!problems.empty()) return refuse(problems, options.ini);
   if (options.check_only) {
     for (const auto& warning : loaded.warnings) {
       std::fprintf(stderr, "warning: %s\n", warning.to_string().c_str());

@@ -1,0 +1,144 @@
+// The real cncd refuses, with exit status 78 and the INI line, a configuration that loads but
+// cannot work here: start-up code that the interpreter rejects or that moves the machine, and
+// state files it could not write. cncd-check refuses the start-up code too.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "daemon_process.hpp"
+
+namespace cncd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Lines of config/examples/sim_mm.ini.
+constexpr int kStartupCodeLine = 25;
+constexpr int kToolTableLine = 29;
+
+class StartChecksTest : public ::testing::Test {
+ protected:
+  // The example machine with the line `KEY = ...` replaced by `KEY = value`.
+  fs::path machine_with(const std::string& key, const std::string& value) {
+    const fs::path ini = copy_example_machine(dir_.path());
+    std::ifstream in(ini);
+    std::ostringstream out;
+    std::string line;
+    bool replaced = false;
+    while (std::getline(in, line)) {
+      if (line.starts_with(key + " ")) {
+        line = key + " = " + value;
+        replaced = true;
+      }
+      out << line << '\n';
+    }
+    EXPECT_TRUE(replaced) << key;
+    std::ofstream(ini) << out.str();
+    return ini;
+  }
+  CommandResult check_config(const fs::path& ini, const fs::path& state_dir) {
+    return run_command(
+        {CNCD_BINARY, "--check-config", ini.string(), "--state-dir", state_dir.string()});
+  }
+  // The daemon itself: "" when it started (it is stopped again), else its exit status and
+  // log. It must stop before it serves anything.
+  std::string start_daemon(const fs::path& ini, const fs::path& state_dir) {
+    DaemonProcess daemon;
+    const std::string error =
+        daemon.start(dir_.path(), {"--ini", ini.string(), "--state-dir", state_dir.string()});
+    if (error.empty()) daemon.stop();
+    return error.empty() ? "cncd started" : error;
+  }
+  // Both ways of starting refuse with `expected` on stderr.
+  void expect_refused(const fs::path& ini, const fs::path& state_dir, const std::string& expected) {
+    const auto checked = check_config(ini, state_dir);
+    EXPECT_EQ(checked.exit_status, 78) << checked.err;
+    EXPECT_NE(checked.err.find(expected), std::string::npos) << checked.err;
+    const std::string started = start_daemon(ini, state_dir);
+    EXPECT_NE(started.find("exited with status 78"), std::string::npos) << started;
+    EXPECT_NE(started.find(expected), std::string::npos) << started;
+  }
+  std::string at(int line) const {
+    return (dir_.path() / "sim_mm.ini").string() + ":" + std::to_string(line) + ": ";
+  }
+
+  TempDir dir_;
+};
+
+TEST_F(StartChecksTest, StartupCodeThatMovesIsRefused) {
+  const std::string expected = at(kStartupCodeLine) +
+                               "[RS274NGC] RS274NGC_STARTUP_CODE: it makes a rapid move, and it "
+                               "runs before every program and MDI command";
+  expect_refused(machine_with("RS274NGC_STARTUP_CODE", "G21 G90 G0 X10"), dir_.path(), expected);
+  const auto feed = check_config(machine_with("RS274NGC_STARTUP_CODE", "G1 Z-1 F100"), dir_.path());
+  EXPECT_EQ(feed.exit_status, 78);
+  EXPECT_NE(feed.err.find("it makes a feed move"), std::string::npos) << feed.err;
+  // Modes only: accepted, as the examples' own start-up code is.
+  const auto modes = check_config(
+      machine_with("RS274NGC_STARTUP_CODE", "G17 G21 G40 G49 G55 G80 G90 G94 F300"), dir_.path());
+  EXPECT_EQ(modes.exit_status, 0) << modes.err;
+}
+
+TEST_F(StartChecksTest, StartupCodeTheInterpreterRejectsIsRefused) {
+  const fs::path ini = machine_with("RS274NGC_STARTUP_CODE", "G17 G21 G99.7");
+  const std::string expected =
+      at(kStartupCodeLine) + "[RS274NGC] RS274NGC_STARTUP_CODE: the interpreter rejects it: ";
+  expect_refused(ini, dir_.path(), expected);
+  const auto checked =
+      run_command({CNCD_CHECK_BINARY, "--ini", ini.string(), "--state-dir", dir_.path().string(),
+                   std::string(CNCD_SOURCE_DIR) + "/examples/g81_example1.ngc"});
+  EXPECT_EQ(checked.exit_status, 78) << checked.err;
+  EXPECT_NE(checked.err.find(expected), std::string::npos) << checked.err;
+}
+
+TEST_F(StartChecksTest, StateFileInADirectoryThatDoesNotExistIsRefused) {
+  const fs::path missing = dir_.path() / "no/such/dir";
+  const fs::path ini = machine_with("TOOL_TABLE", (missing / "tools.tbl").string());
+  expect_refused(ini, dir_.path(),
+                 at(kToolTableLine) + "[EMCIO] TOOL_TABLE: directory '" + missing.string() +
+                     "' does not exist");
+}
+
+TEST_F(StartChecksTest, StateDirectoryThatCncdWillCreateIsAccepted) {
+  const fs::path ini = copy_example_machine(dir_.path());
+  const fs::path state = dir_.path() / "state/of/the/mill";
+  const auto r = check_config(ini, state);
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_.path() / "state"));  // checking writes nothing
+}
+
+TEST_F(StartChecksTest, StateDirectoryThatCannotBeCreatedIsRefused) {
+  // A regular file where the state directory's parent would have to be.
+  std::ofstream(dir_.path() / "plain") << "not a directory\n";
+  const fs::path ini = copy_example_machine(dir_.path());
+  const fs::path state = dir_.path() / "plain/state";
+  expect_refused(ini, state,
+                 at(22) + "[RS274NGC] PARAMETER_FILE: cannot create the state directory '" +
+                     state.string() + "' (--state-dir): '" + (dir_.path() / "plain").string() +
+                     "' is not a directory");
+  EXPECT_NE(
+      check_config(ini, state).err.find(at(kToolTableLine) + "[EMCIO] TOOL_TABLE: cannot create"),
+      std::string::npos);
+}
+
+TEST_F(StartChecksTest, StateDirectoryThatIsNotWritableIsRefused) {
+  const fs::path state = dir_.path() / "locked";
+  fs::create_directory(state);
+  ASSERT_EQ(chmod(state.c_str(), 0555), 0);
+  if (access(state.c_str(), W_OK) == 0) {
+    chmod(state.c_str(), 0755);
+    GTEST_SKIP() << "this process may write in a mode 0555 directory (root): the check, "
+                    "access(W_OK), cannot fail here";
+  }
+  expect_refused(copy_example_machine(dir_.path()), state,
+                 "[EMCIO] TOOL_TABLE: the state directory '" + state.string() +
+                     "' (--state-dir) is not writable");
+  chmod(state.c_str(), 0755);
+}
+
+}  // namespace
+}  // namespace cncd::test
