@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string_view>
 
@@ -205,21 +207,36 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
              out_of_range_message("parameter #" + std::to_string(number), value);
     }
   }
-  {
-    std::FILE* out = std::fopen(temp.c_str(), "w");
-    if (out == nullptr) return "Unable to write parameter file: " + temp.string();
-    for (int number = 1; number < kMaxParameter; ++number) {
-      if (!is_persistent_parameter(number)) continue;
-      std::fprintf(out, "%d\t%f\n", number, numbered_[static_cast<std::size_t>(number)]);
-    }
-    // On disk before the rename, so that a crash leaves the old file or the new one.
-    const bool ok = std::fflush(out) == 0 && ::fsync(::fileno(out)) == 0;
-    std::fclose(out);
-    if (!ok) return "Unable to write parameter file: " + temp.string();
+  // Whatever fails, the temporary file goes: a full disk must not be left fuller, nor a
+  // truncated copy lie beside the file.
+  const auto fail = [&](const std::string& what) {
+    const std::string reason = std::strerror(errno);
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    return what + ": " + reason;
+  };
+  errno = 0;
+  std::FILE* out = std::fopen(temp.c_str(), "w");
+  if (out == nullptr) return fail("Unable to write parameter file " + temp.string());
+  for (int number = 1; number < kMaxParameter; ++number) {
+    if (!is_persistent_parameter(number)) continue;
+    std::fprintf(out, "%d\t%f\n", number, numbered_[static_cast<std::size_t>(number)]);
   }
-  std::error_code error;
-  std::filesystem::rename(temp, path, error);
-  if (error) return "Unable to replace parameter file: " + error.message();
+  // On disk before the rename, so that a crash leaves the old file or the new one.
+  int error = 0;
+  if (std::fflush(out) != 0 || std::ferror(out) != 0) {
+    error = errno != 0 ? errno : EIO;
+  } else if (::fsync(::fileno(out)) != 0) {
+    error = errno;
+  }
+  if (std::fclose(out) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    errno = error;
+    return fail("Unable to write parameter file " + temp.string());
+  }
+  if (::rename(temp.c_str(), path.c_str()) != 0) {
+    return fail("Unable to replace parameter file " + path.string());
+  }
   const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd >= 0) {

@@ -139,6 +139,24 @@ TEST(InterpreterApi, ParametersPersistThroughTheVarFile) {
   std::filesystem::remove(var);
 }
 
+// The parameter file's place is taken by a directory: the rename fails, and the temporary
+// file it would have replaced the file with is gone too.
+TEST(InterpreterApi, AFailedParameterSaveLeavesNoTemporaryFile) {
+  const auto dir = temp_file("blocked", "");
+  std::filesystem::remove(dir);
+  const auto var = dir / "params.var";
+  std::filesystem::create_directories(var / "in_the_way");
+  InterpOptions options;
+  options.parameter_file = var;
+  Interpreter interp(options);
+  const auto error = interp.save_parameters();
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->message.find("Unable to replace parameter file"), std::string::npos)
+      << error->to_string();
+  EXPECT_FALSE(std::filesystem::exists(var.string() + ".tmp"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(InterpreterApi, MachinePositionIsSeenThroughTheOffsets) {
   // G54 X offset 10 mm on an inch program: machine X 35.4 mm is program X 1 inch.
   const auto vars = temp_file("machine_pos.var", "5221\t10.000000\n");
