@@ -230,6 +230,7 @@ struct Interpreter::Impl {
   bool skipping_percent_ = false;
   bool seen_percent_ = false;
   bool resend_g5x_ = false;  // set_coord_system_origin() changed the active system's origin
+  bool resend_g92_ = false;  // restore_persistent_parameters() may have changed the G92 offset
 
   ModalState modal_;
   int previous_motion_ = -1;  // the motion mode before the current block

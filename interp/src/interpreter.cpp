@@ -148,9 +148,11 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     } else if (resend_g5x_) {
       // The active origin was changed between programs: the canon layer learns it first.
       emit_g5x();
+      if (resend_g92_) emit_g92();
       emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
     }
     resend_g5x_ = false;
+    resend_g92_ = false;
     LineSource& source = sources_.back();
     line_offset_ = source.tell();
     line_before_ = source.line_number();

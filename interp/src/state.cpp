@@ -145,4 +145,34 @@ std::optional<std::string> Interpreter::set_tool(const ToolEntry& entry) {
   return impl_->tools_.set(entry);
 }
 
+void Interpreter::set_tools(const std::vector<ToolEntry>& tools) {
+  impl_->tools_.clear();
+  for (const auto& entry : tools)
+    impl_->tools_.set(entry);
+}
+
+std::vector<double> Interpreter::persistent_parameters() const {
+  std::vector<double> out;
+  for (int number = 1; number < kMaxParameter; ++number) {
+    if (is_persistent_parameter(number)) out.push_back(impl_->parameters_.get(number));
+  }
+  return out;
+}
+
+void Interpreter::restore_persistent_parameters(const std::vector<double>& values) {
+  Impl& s = *impl_;
+  const Pose machine = s.program_to_machine(s.pos_);
+  std::size_t next = 0;
+  for (int number = 1; number < kMaxParameter && next < values.size(); ++number) {
+    if (is_persistent_parameter(number)) s.parameters_.set(number, values[next++]);
+  }
+  const int system = to_int(s.parameters_.get(5220));
+  s.modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
+  s.load_coord_system(s.modal_.coord_system);
+  s.g92_offset_ = s.parameters_.get(5210) != 0.0 ? s.read_offset_parameters(kG92Base) : Pose{};
+  s.pos_ = s.machine_to_program(machine);
+  s.resend_g5x_ = true;
+  s.resend_g92_ = true;
+}
+
 }  // namespace cncd::interp

@@ -20,6 +20,7 @@ class ToolTable {
   // Adds or replaces the entry; refuses (returns why, changes nothing) one that is not
   // storable (stored_values.hpp). Every entry comes in here or through load().
   std::optional<std::string> set(const ToolEntry& entry);
+  void clear() { tools_.clear(); }
   const std::map<int, ToolEntry>& entries() const { return tools_; }
 
  private:

@@ -157,6 +157,46 @@ TEST(InterpreterApi, AFailedParameterSaveLeavesNoTemporaryFile) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(InterpreterApi, RestoredParametersPutTheOffsetsAndCoordinateSystemBack) {
+  Interpreter interp;
+  NullSink sink;
+  const std::vector<double> saved = interp.persistent_parameters();
+  for (const char* line : {"G10 L2 P1 X5", "G92 X1", "G55"}) {
+    ASSERT_FALSE(interp.open_mdi(line));
+    ASSERT_FALSE(run_program(interp, sink));
+  }
+  EXPECT_NE(interp.persistent_parameters(), saved);
+  EXPECT_EQ(interp.state().coord_system, 2);
+  interp.restore_persistent_parameters(saved);
+  EXPECT_EQ(interp.persistent_parameters(), saved);
+  const InterpState st = interp.state();
+  EXPECT_EQ(st.coord_system, 1);
+  EXPECT_EQ(st.g5x_offset[0], 0.0);
+  EXPECT_EQ(st.g92_offset[0], 0.0);
+  // The canon layer learns the offsets again before the next move.
+  ASSERT_FALSE(interp.open_mdi("G0 X2"));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  ASSERT_FALSE(run_program(interp, printer));
+  EXPECT_NE(out.str().find("SET_G5X_OFFSET(1, 0.0000"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("SET_G92_OFFSET(0.0000"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(2.0000"), std::string::npos) << out.str();
+}
+
+TEST(InterpreterApi, SetToolsReplacesTheWholeTable) {
+  Interpreter interp;
+  ToolEntry three;
+  three.number = 3;
+  three.offset[2] = 7;
+  interp.set_tool(three);
+  ToolEntry five;
+  five.number = 5;
+  interp.set_tools({five});
+  EXPECT_FALSE(interp.tool(3));
+  ASSERT_TRUE(interp.tool(5));
+  EXPECT_EQ(interp.tools().size(), 1u);
+}
+
 TEST(InterpreterApi, MachinePositionIsSeenThroughTheOffsets) {
   // G54 X offset 10 mm on an inch program: machine X 35.4 mm is program X 1 inch.
   const auto vars = temp_file("machine_pos.var", "5221\t10.000000\n");

@@ -123,6 +123,18 @@ class Interpreter {
   // (tool_entry_problem()): returns why, and nothing changes.
   std::optional<std::string> set_tool(const ToolEntry& entry);
 
+  // Replaces the whole tool table (a copy tools() gave), e.g. to put back what its file holds
+  // when it could not be written. Call between programs only.
+  void set_tools(const std::vector<ToolEntry>& tools);
+
+  // The persistent parameters (those save_parameters() writes), in number order: a copy of
+  // what the parameter file holds for a caller that wants to know whether they changed.
+  std::vector<double> persistent_parameters() const;
+  // Puts back a copy persistent_parameters() gave (when the file could not be written): the
+  // active coordinate system (#5220), its origin and rotation and the G92 offset follow them,
+  // and the machine stays where it is. Call between programs only.
+  void restore_persistent_parameters(const std::vector<double>& values);
+
   // Writes the persistent parameters (coordinate systems, G28/G30 points, G92 offsets) to
   // InterpOptions::parameter_file, as LinuxCNC does when its interpreter shuts down: temp file,
   // flush, rename. Does nothing without a parameter file. Never writes over a file that was
