@@ -44,7 +44,12 @@ std::string atomic_write_file(const std::filesystem::path& path, const std::stri
     ::unlink(temp.c_str());
     return error;
   }
-  ::close(fd);
+  // Some file systems (NFS) report a failed write only at close.
+  if (::close(fd) != 0) {
+    const std::string error = os_error("cannot write", temp);
+    ::unlink(temp.c_str());
+    return error;
+  }
   if (::rename(temp.c_str(), path.c_str()) != 0) {
     const std::string error = os_error("cannot replace", path);
     ::unlink(temp.c_str());
