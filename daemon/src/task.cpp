@@ -45,6 +45,7 @@ Task::Task(const config::MachineConfig& config, EventLog& events, Completions& c
       feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
       interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))),
       saved_tools_(interp_->tools()),
+      saved_parameters_(interp_->persistent_parameters()),
       estimator_(config) {}
 
 Task::~Task() {
@@ -83,16 +84,13 @@ void Task::shutdown() {
   motion_.machine_off();
   motion_.stop();
   if (files_corrupt_) return;
-  save_parameters();
-  save_positions();
-  started_ = false;
-}
-
-void Task::save_parameters() {
-  if (files_corrupt_) return;
+  // Also when nothing changed: a parameter file that did not exist yet is created.
   if (const auto error = interp_->save_parameters()) {
     events_.add("error", "parameters", error->to_string());
+    spdlog::error("{}", error->to_string());
   }
+  save_positions();
+  started_ = false;
 }
 
 void Task::estop() {
@@ -273,16 +271,30 @@ void Task::abort(std::uint64_t token) {
   if (token != 0) abort_tokens_.push_back(token);
 }
 
-void Task::finish_program(const std::string& result, const std::string& error) {
+void Task::finish_program(const std::string& ended, const std::string& why) {
   // Offsets and tool data set by the program or MDI (G10, G92 ...) survive a crash or power
-  // loss.
-  save_parameters();
-  save_tools_if_changed();
+  // loss; those that cannot be saved are not kept, and the run says so.
+  std::string result = ended;
+  std::string error = why;
+  if (const std::string unsaved = save_setup_files(); !unsaved.empty()) {
+    const std::string text = "could not save the offsets or tools " +
+                             std::string(mode_ == Mode::mdi ? "the block" : "the program") +
+                             " set, so they are undone: " + unsaved;
+    if (result == "done") {
+      result = "error";
+      error = text;
+    } else {
+      error += (error.empty() ? "" : "; ") + text;
+    }
+  }
   if (mode_ == Mode::mdi) {
     set_exec(ExecState::idle);
     mode_ = Mode::manual;
     if (result == "done") {
       completions_.complete(mdi_token_, nlohmann::json{{"ok", true}});
+    } else if (ended == "done") {
+      events_.add("error", "mdi", error);
+      completions_.fail(mdi_token_, kFileError, error);
     } else {
       events_.add(result == "error" ? "error" : "warning", "mdi",
                   error.empty() ? result : result + ": " + error);

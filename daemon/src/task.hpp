@@ -116,12 +116,14 @@ class Task {
   // Servo periods run since the servo thread had run `cycles`, in seconds.
   double servo_seconds_since(std::uint64_t cycles) const;
   void drain_servo_events();
-  void save_parameters();
+  // Rewrites the parameter file and the tool table where they differ from what the interpreter
+  // holds (G10, G92, G5x, offsets.set). One that cannot be written is put back in the
+  // interpreter as its file holds it, so that what is in force is what a restart would load.
+  // Returns "" or what could not be written (task_setup.cpp).
+  std::string save_setup_files();
   void save_positions();
   // Each joint's limits, for the position file (task_persist.cpp).
   std::vector<JointRange> joint_ranges() const;
-  // Rewrites the tool table when G10 L1/L10/L11 changed it (task_setup.cpp).
-  void save_tools_if_changed();
   void finish_program(const std::string& result, const std::string& error);
   void check_limits(const std::string& path);
   bool all_homed(const motion::Status& status) const;
@@ -138,6 +140,7 @@ class Task {
   std::unique_ptr<ProgramFeeder> feeder_;
   std::unique_ptr<interp::Interpreter> interp_;
   std::vector<interp::ToolEntry> saved_tools_;  // the tool table as its file holds it
+  std::vector<double> saved_parameters_;        // the persistent parameters as the file holds them
   ExecState exec_ = ExecState::idle;
   Mode mode_ = Mode::manual;
   std::uint64_t mdi_token_ = 0;

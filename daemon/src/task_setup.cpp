@@ -68,16 +68,30 @@ void Task::set_tool(const interp::ToolEntry& entry) {
   events_.add("info", "tools", "tool " + std::to_string(entry.number) + " changed");
 }
 
-void Task::save_tools_if_changed() {
-  if (config_.tool_table.empty()) return;
-  auto tools = interp_->tools();
-  if (tools == saved_tools_) return;
-  const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
-  if (!error.empty()) {
-    events_.add("error", "tools", error);
-    return;
+std::string Task::save_setup_files() {
+  std::string problems;
+  auto parameters = interp_->persistent_parameters();
+  if (parameters != saved_parameters_) {
+    if (const auto error = interp_->save_parameters()) {
+      interp_->restore_persistent_parameters(saved_parameters_);
+      problems = error->to_string();
+      events_.add("error", "parameters", problems);
+    } else {
+      saved_parameters_ = std::move(parameters);
+    }
   }
-  saved_tools_ = std::move(tools);
+  auto tools = interp_->tools();
+  if (!config_.tool_table.empty() && tools != saved_tools_) {
+    if (const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
+        !error.empty()) {
+      interp_->set_tools(saved_tools_);
+      problems += (problems.empty() ? "" : "; ") + error;
+      events_.add("error", "tools", error);
+    } else {
+      saved_tools_ = std::move(tools);
+    }
+  }
+  return problems;
 }
 
 json Task::offsets() const {
@@ -103,9 +117,9 @@ void Task::set_offsets(int system, const interp::Pose& origin, std::uint32_t axe
   if (auto problem = interp_->set_coord_system_origin(system, origin, axes, rotation_deg)) {
     throw RpcError(kInvalidParams, *problem);
   }
-  if (const auto error = interp_->save_parameters()) {
-    events_.add("error", "parameters", error->to_string());
-    throw RpcError(kFileError, error->to_string());
+  // Saved before the answer; when the file cannot be written the old origin is put back.
+  if (const std::string error = save_setup_files(); !error.empty()) {
+    throw RpcError(kFileError, error + "; " + coord_system_name(system) + " is unchanged");
   }
   events_.add("info", "offsets", coord_system_name(system) + " origin changed");
 }

@@ -1,0 +1,196 @@
+// Saves that fail: the real daemon with its state directory on a tiny tmpfs that is then filled
+// up or made read-only. What cannot be saved is answered as an error and not kept, and no
+// temporary file is left behind.
+#include <sys/mount.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <set>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class SaveFailureTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (geteuid() != 0) GTEST_SKIP() << "mounting a tmpfs as the state directory needs root";
+    state_ = dir_.path() / "state";
+    fs::create_directories(state_);
+    // Room for the seeds, the marker and the position file, and a little more.
+    if (mount("tmpfs", state_.c_str(), "tmpfs", 0, "size=64k") != 0) {
+      GTEST_SKIP() << "cannot mount a tmpfs on " << state_ << ": " << std::strerror(errno);
+    }
+    mounted_ = true;
+    ini_ = copy_example_machine(dir_.path());
+    ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini_.string(), "--state-dir", state_.string()}),
+              "");
+    ASSERT_EQ(client_.connect(daemon_.socket()), "");
+  }
+
+  void TearDown() override {
+    if (!mounted_) return;
+    daemon_.kill_hard();
+    umount2(state_.c_str(), MNT_DETACH);
+  }
+
+  json call(const std::string& method, const json& params = nullptr) {
+    return client_.call(method, params, 30000);
+  }
+
+  // Takes every free block of the tmpfs.
+  void fill_disk() {
+    std::ofstream filler(state_ / "filler", std::ios::binary);
+    const std::string block(4096, 'x');
+    for (int i = 0; i < 1000 && filler.write(block.data(), block.size()); ++i) {
+      filler.flush();
+    }
+    // One more small file for whatever a partial block left.
+    std::ofstream(state_ / "filler2") << std::string(4096, 'y');
+    ASSERT_FALSE(std::ofstream(state_ / "probe") << std::string(4096, 'z') << std::flush)
+        << "the tmpfs is not full";
+    fs::remove(state_ / "probe");
+  }
+
+  void make_read_only() {
+    ASSERT_EQ(mount("tmpfs", state_.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, "size=64k"), 0)
+        << std::strerror(errno);
+  }
+
+  // The files in the state directory that are neither the state files nor the filler: a
+  // temporary file left behind.
+  std::vector<std::string> strays() const {
+    const std::set<std::string> known = {"sim_mm.var",      "sim_mm.tbl",
+                                         "sim_mm.position", "sim_mm.position.running",
+                                         "filler",          "filler2"};
+    std::vector<std::string> out;
+    for (const auto& entry : fs::directory_iterator(state_)) {
+      if (!known.contains(entry.path().filename().string()))
+        out.push_back(entry.path().filename().string());
+    }
+    return out;
+  }
+
+  json origin(const std::string& system) {
+    const json offsets = result_of(call("offsets.get"));
+    for (const auto& s : offsets["systems"]) {
+      if (s["name"] == system) return s["origin"];
+    }
+    ADD_FAILURE() << "no " << system;
+    return json();
+  }
+
+  void ready_machine() {
+    result_of(call("machine.reset"));
+    result_of(call("machine.on"));
+    result_of(call("machine.home"));
+    for (int i = 0; i < 3000; ++i) {
+      const json s = result_of(call("status.get"));
+      bool homed = s["motion"] == "idle";
+      for (const auto& h : s["homed"])
+        homed = homed && h.get<bool>();
+      if (homed) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    FAIL() << "the machine did not home";
+  }
+
+  TempDir dir_;
+  fs::path state_;
+  fs::path ini_;
+  bool mounted_ = false;
+  DaemonProcess daemon_;
+  daemon::Client client_;
+};
+
+TEST_F(SaveFailureTest, OffsetsSetOnAFullDiskAnswers1007AndKeepsTheOldOrigin) {
+  const json before = origin("G55");
+  fill_disk();
+  const json r = call("offsets.set", {{"system", "G55"}, {"origin", {{"x", 123.5}}}});
+  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  EXPECT_NE(r.dump().find("No space left on device"), std::string::npos) << r.dump();
+  EXPECT_EQ(origin("G55"), before);
+  EXPECT_EQ(strays(), std::vector<std::string>{});
+  // Room again: the same request is saved and kept.
+  fs::remove(state_ / "filler");
+  result_of(call("offsets.set", {{"system", "G55"}, {"origin", {{"x", 123.5}}}}));
+  EXPECT_EQ(origin("G55")["x"], 123.5);
+}
+
+TEST_F(SaveFailureTest, OffsetsSetOnAReadOnlyDiskAnswers1007AndKeepsTheOldOrigin) {
+  const json before = origin("G54");
+  make_read_only();
+  // The active system: the work position would move with it.
+  const json status_before = result_of(call("status.get"));
+  const json r = call("offsets.set", {{"system", "G54"}, {"origin", {{"x", -7}, {"z", 2}}}});
+  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  EXPECT_EQ(origin("G54"), before);
+  const json status_after = result_of(call("status.get"));
+  EXPECT_EQ(status_after["work_position"], status_before["work_position"]);
+  EXPECT_EQ(status_after["offsets"]["g5x"], status_before["offsets"]["g5x"]);
+  EXPECT_EQ(strays(), std::vector<std::string>{});
+}
+
+TEST_F(SaveFailureTest, ToolSetOnAFullDiskAnswers1007AndKeepsTheOldEntry) {
+  const json before = result_of(call("tool.list"))["tools"];
+  fill_disk();
+  const json r = call("tool.set", {{"number", 2}, {"offset", {{"z", 42}}}});
+  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  EXPECT_EQ(result_of(call("tool.list"))["tools"], before);
+  EXPECT_EQ(strays(), std::vector<std::string>{});
+}
+
+TEST_F(SaveFailureTest, MdiThatChangesOffsetsOrToolsOnAFullDiskFailsAndIsUndone) {
+  ready_machine();
+  const json g54 = origin("G54");
+  const json tools = result_of(call("tool.list"))["tools"];
+  fill_disk();
+  // Nothing to save: a move works on a full disk.
+  result_of(call("mdi.execute", {{"line", "G0 X1"}}));
+  for (const char* line : {"G10 L2 P1 X7", "G10 L20 P1 X0", "G92 X3", "G55"}) {
+    SCOPED_TRACE(line);
+    const json r = call("mdi.execute", {{"line", line}});
+    EXPECT_EQ(error_code(r), 1007) << r.dump();
+    EXPECT_NE(r.dump().find("undone"), std::string::npos) << r.dump();
+    const json s = result_of(call("status.get"));
+    EXPECT_EQ(origin("G54"), g54);
+    EXPECT_EQ(s["offsets"]["coord_system"], "G54");
+    EXPECT_EQ(s["offsets"]["g92"]["x"], 0.0);
+    EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 1.0 - g54["x"].get<double>(),
+                1e-9);
+  }
+  const json r = call("mdi.execute", {{"line", "G10 L1 P2 Z55"}});
+  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  EXPECT_EQ(result_of(call("tool.list"))["tools"], tools);
+  EXPECT_EQ(strays(), std::vector<std::string>{});
+}
+
+TEST_F(SaveFailureTest, ProgramThatSetsAnOffsetOnAFullDiskEndsInErrorAndIsUndone) {
+  ready_machine();
+  const json g56 = origin("G56");
+  const fs::path program = dir_.write("g10.ngc", "G10 L2 P3 X11 Y12\nG0 X2\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  fill_disk();
+  result_of(call("program.run"));
+  json s;
+  for (int i = 0; i < 3000; ++i) {
+    s = result_of(call("status.get"));
+    if (s["exec"] == "idle") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(s["program"]["result"], "error") << s.dump();
+  const std::string error = s["program"]["error"];
+  EXPECT_NE(error.find("sim_mm.var"), std::string::npos) << error;
+  EXPECT_NE(error.find("No space left on device"), std::string::npos) << error;
+  EXPECT_EQ(origin("G56"), g56);
+  EXPECT_EQ(strays(), std::vector<std::string>{});
+}
+
+}  // namespace
+}  // namespace cncd::test
