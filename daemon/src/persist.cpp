@@ -80,9 +80,9 @@ std::string position_problem(int joint, double value, const JointRange& range) {
          show_number(range.max) + "] by more than 10 % of its travel";
 }
 
-std::string write_position_file(const std::filesystem::path& path,
-                                const std::vector<double>& joints,
-                                const std::vector<JointRange>& ranges) {
+std::string position_file_problem(const std::filesystem::path& path,
+                                  const std::vector<double>& joints,
+                                  const std::vector<JointRange>& ranges) {
   for (std::size_t j = 0; j < joints.size(); ++j) {
     const std::string problem = position_problem(static_cast<int>(j), joints[j],
                                                  j < ranges.size() ? ranges[j] : JointRange{});
@@ -90,6 +90,13 @@ std::string write_position_file(const std::filesystem::path& path,
       return path.string() + ": not written (the positions saved before stay): " + problem;
     }
   }
+  return "";
+}
+
+std::string write_position_file(const std::filesystem::path& path,
+                                const std::vector<double>& joints,
+                                const std::vector<JointRange>& ranges) {
+  if (auto problem = position_file_problem(path, joints, ranges); !problem.empty()) return problem;
   return atomic_write_file(path, format_position_file(joints));
 }
 

@@ -28,8 +28,13 @@ std::string position_problem(int joint, double value, const JointRange& range);
 
 // LinuxCNC's [TRAJ] POSITION_FILE: one joint position a line.
 std::string format_position_file(const std::vector<double>& joints);
-// Writes the file atomically when every position passes position_problem(); otherwise leaves
-// the old file alone. Returns "" or an error naming the file.
+// "" when every position passes position_problem(), else an error naming the file and saying
+// that it is not written.
+std::string position_file_problem(const std::filesystem::path& path,
+                                  const std::vector<double>& joints,
+                                  const std::vector<JointRange>& ranges);
+// Writes the file atomically when position_file_problem() finds nothing; otherwise leaves the
+// old file alone. Returns "" or an error naming the file.
 std::string write_position_file(const std::filesystem::path& path,
                                 const std::vector<double>& joints,
                                 const std::vector<JointRange>& ranges);

@@ -43,11 +43,11 @@ std::string prepare_state_files(const config::MachineConfig& config,
                                 std::vector<StateNote>& notes) {
   const StateFile files[] = {
       {"parameter file", config.parameter_file, config.parameter_file_seed,
-       "default parameters are used, and the file is written when a program or MDI ends"},
+       "default parameters are used, and the file is written when they change and on shutdown"},
       {"tool table", config.tool_table, config.tool_table_seed,
        "the table is empty until a tool is set"},
       {"position file", config.position_file, config.position_file_seed,
-       "the joints start at 0, and the file is written on shutdown"},
+       "the joints start at 0, and the file is written as the machine moves and on shutdown"},
   };
   for (const auto& f : files) {
     if (f.file.empty()) continue;

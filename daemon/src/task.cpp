@@ -55,6 +55,7 @@ Task::~Task() {
 std::string Task::start() {
   std::string error = motion_.start();
   started_ = error.empty();
+  if (started_) mark_running();
   for (const auto& warning : motion_.start_warnings())
     events_.add("warning", "servo", warning);
   return error;
@@ -366,6 +367,7 @@ void Task::feed() {
 void Task::poll() {
   drain_servo_events();
   const auto status = motion_.status();
+  keep_positions(status);
   // program.abort answers once the machine has come to rest.
   if (!abort_tokens_.empty() && status.motion == motion::MotionState::idle && status.queued == 0) {
     for (const auto token : abort_tokens_)

@@ -121,6 +121,15 @@ class Task {
   // interpreter as its file holds it, so that what is in force is what a restart would load.
   // Returns "" or what could not be written (task_setup.cpp).
   std::string save_setup_files();
+  // [TRAJ] POSITION_FILE (task_persist.cpp). The marker beside it says, while cncd runs, that
+  // the file is kept up to date and the final save has not been made yet.
+  void mark_running();
+  // Saves the joint positions when the machine comes to rest, twice more while it settles,
+  // and every two seconds while it moves, when they changed: a crash loses little.
+  void keep_positions(const motion::Status& status);
+  // Writes the joints' actual positions unless the file already holds them: "" or an error.
+  std::string write_positions(const motion::Status& status);
+  // The final save at shutdown, which also removes the marker.
   void save_positions();
   // Each joint's limits, for the position file (task_persist.cpp).
   std::vector<JointRange> joint_ranges() const;
@@ -174,6 +183,15 @@ class Task {
   double paused_s_ = 0;         // time the current run has spent paused, up to paused_since_
   bool files_corrupt_ = false;  // load_files() failed: keep them as they are for the user
   bool started_ = false;        // motion started: its joint positions are worth saving
+  // Where the joints started: "clean" (the position file of an orderly shutdown), "unclean"
+  // (the positions last saved by a run that did not shut down) or "none".
+  std::string position_restored_ = "none";
+  std::string positions_written_;  // what this run last wrote to the position file
+  std::chrono::steady_clock::time_point next_position_save_{};
+  std::optional<std::chrono::steady_clock::time_point> settle_save_at_;
+  int settle_saves_left_ = 0;
+  bool was_moving_ = false;
+  bool position_save_failing_ = false;  // the failure has been logged; quiet until a success
 };
 
 }  // namespace cncd::daemon

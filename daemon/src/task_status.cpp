@@ -257,6 +257,7 @@ json Task::status() const {
       {"position",
        {{"commanded", axes_object(config_, s.commanded)},
         {"actual", axes_object(config_, s.actual)}}},
+      {"position_restored", position_restored_},
       {"work_position",
        {{"commanded", axes_object(config_, work_pose(s.commanded, st))},
         {"actual", axes_object(config_, work_pose(s.actual, st))}}},

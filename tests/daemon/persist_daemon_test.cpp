@@ -75,6 +75,7 @@ class PersistDaemonTest : public ::testing::Test {
 
 TEST_F(PersistDaemonTest, SigtermSavesBothFilesAndARestartStandsThereUnhomed) {
   ASSERT_EQ(start(), "");
+  EXPECT_EQ(result_of(call("status.get"))["position_restored"], "none");
   ready_and_move(12.5, 30.25, -4);
   result_of(call("mdi.execute", {{"line", "G10 L2 P2 X7.5"}}));
   EXPECT_EQ(daemon_.stop(), 0);
@@ -88,6 +89,7 @@ TEST_F(PersistDaemonTest, SigtermSavesBothFilesAndARestartStandsThereUnhomed) {
 
   ASSERT_EQ(start(), "");
   const auto s = result_of(call("status.get"));
+  EXPECT_EQ(s["position_restored"], "clean");
   EXPECT_NEAR(s["position"]["actual"]["x"].get<double>(), 12.5, 1e-6) << s.dump();
   EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), 30.25, 1e-6);
   EXPECT_NEAR(s["position"]["actual"]["z"].get<double>(), -4, 1e-6);
@@ -101,6 +103,66 @@ TEST_F(PersistDaemonTest, SigtermSavesBothFilesAndARestartStandsThereUnhomed) {
   EXPECT_EQ(on["fault"], "");
   EXPECT_NEAR(on["position"]["actual"]["x"].get<double>(), 12.5, 1e-6);
   EXPECT_EQ(daemon_.stop(), 0);
+}
+
+// The position file is kept up to date while the machine moves: kill -9 in the middle of a
+// long move, and the restart stands where the machine was at most a couple of seconds before,
+// saying that the positions come from a run that did not shut down.
+TEST_F(PersistDaemonTest, KillNineWhileMovingRestartsNearTheLastPositionFlaggedUnclean) {
+  ASSERT_EQ(start(), "");
+  result_of(call("machine.reset"));
+  result_of(call("machine.on"));
+  result_of(call("machine.home"));
+  wait_idle();
+  // 6 mm/s along X: 40 s to the end, killed after about 5.
+  const fs::path program = dir_.write("slow.ngc", "G90 G1 F360 X240\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run"));
+  const auto started = std::chrono::steady_clock::now();
+  json last;
+  while (std::chrono::steady_clock::now() - started < std::chrono::milliseconds(5200)) {
+    last = result_of(call("status.get"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(last["exec"], "running") << last.dump();
+  daemon_.kill_hard();
+  const double x_last = last["position"]["actual"]["x"].get<double>();
+  ASSERT_GT(x_last, 20.0) << last.dump();
+
+  ASSERT_EQ(start(), "");
+  const auto s = result_of(call("status.get"));
+  EXPECT_EQ(s["position_restored"], "unclean") << s.dump();
+  const double x = s["position"]["actual"]["x"].get<double>();
+  // Saved every 2 s while moving: no further back than that, with a margin for a loaded
+  // machine, and never ahead of the last status seen.
+  EXPECT_LE(x, x_last + 1.0) << s.dump();
+  EXPECT_GE(x, x_last - 6.0 * 3.0) << "restored X " << x << ", last seen " << x_last;
+  EXPECT_NEAR(s["position"]["actual"]["y"].get<double>(), 0.0, 1e-6);
+  for (const auto& homed : s["homed"])
+    EXPECT_FALSE(homed.get<bool>());
+  // An orderly stop after that: clean again.
+  EXPECT_EQ(daemon_.stop(), 0);
+  ASSERT_EQ(start(), "");
+  EXPECT_EQ(result_of(call("status.get"))["position_restored"], "clean");
+}
+
+// At rest the file is written at once, so that a kill -9 right after a move keeps its end.
+TEST_F(PersistDaemonTest, KillNineAfterAMoveRestartsWhereTheMoveEnded) {
+  ASSERT_EQ(start(), "");
+  ready_and_move(33.25, 44.5, -5);
+  // Saved at rest, and again once the feedback has settled (a quarter of a second).
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  daemon_.kill_hard();
+  const auto positions = numbers(slurp(position_file()), 1, "position file");
+  ASSERT_EQ(positions.size(), 3u);
+  EXPECT_NEAR(positions[0][0], 33.25, 1e-6);
+  EXPECT_NEAR(positions[1][0], 44.5, 1e-6);
+  EXPECT_NEAR(positions[2][0], -5, 1e-6);
+  EXPECT_TRUE(fs::exists(position_file().string() + ".running"));
+  ASSERT_EQ(start(), "");
+  const auto s = result_of(call("status.get"));
+  EXPECT_EQ(s["position_restored"], "unclean");
+  EXPECT_NEAR(s["position"]["actual"]["x"].get<double>(), 33.25, 1e-6) << s.dump();
 }
 
 TEST_F(PersistDaemonTest, CorruptPositionFileIsNamedWithItsLineAndStopsTheStart) {
