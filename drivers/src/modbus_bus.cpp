@@ -236,7 +236,12 @@ void ModbusBus::loop() {
         s.reset_ack = setpoint.reset_request;
         if (s.latched) s.pulse_reset = true;
         s.latched = false;
-        reason_.clear();
+        // Once per reset, not once per drive: the reason then names the first drive that
+        // fails again, not the last.
+        if (setpoint.reset_request != reason_reset_) {
+          reason_reset_ = setpoint.reset_request;
+          reason_.clear();
+        }
       }
       if (!connected) {
         if (!s.latched) {

@@ -126,7 +126,8 @@ class ModbusBus {
   std::unique_ptr<Seqlock<Readback>[]> readbacks_;
   std::vector<DriveState> state_;  // I/O thread only
   FaultReason reason_;
-  void* ctx_ = nullptr;  // modbus_t*, I/O thread only once started
+  std::uint32_t reason_reset_ = 0;  // the reset request that last cleared reason_
+  void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
   bool link_failed_ = false;
   std::atomic<std::uint64_t> cycles_{0};
   std::atomic<bool> running_{false};
