@@ -399,6 +399,13 @@ void MotionController::jog_stop(int axis) {
   impl_->send(command);
 }
 
+std::int64_t MotionController::feedback_deadline_ns() const {
+  std::int64_t deadline = 0;
+  for (const auto& driver : impl_->drivers)
+    deadline = std::max(deadline, driver->feedback_deadline_ns());
+  return deadline;
+}
+
 Status MotionController::status() const {
   if (!impl_->loop) {
     Status idle;

@@ -38,7 +38,7 @@ void ServoLoop::check_joints() noexcept {
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback_[k];
-    char text[200];  // latch_fault() keeps what fits in Status::fault_reason
+    char text[240];  // latch_fault() keeps what fits in Status::fault_reason
     if (!std::isfinite(fb.position)) {
       status_.joint_fault[k] = true;
       std::snprintf(text, sizeof text, "joint %d: feedback position is not a number", j);
@@ -47,11 +47,9 @@ void ServoLoop::check_joints() noexcept {
     }
     if (fb.fault || fb.stale) {
       status_.joint_fault[k] = true;
-      // The driver may know more (which drive, register or line).
-      char detail[96] = {};
-      if (fb.fault && joint_driver_[k] != nullptr) {
-        joint_driver_[k]->fault_reason(detail, sizeof detail);
-      }
+      // The driver may know more (which drive, register or line; why a bus went quiet).
+      char detail[160] = {};
+      if (joint_driver_[k] != nullptr) joint_driver_[k]->fault_reason(detail, sizeof detail);
       std::snprintf(text, sizeof text, "joint %d: %s%s%s", j,
                     fb.fault ? "drive fault" : "feedback is stale", detail[0] ? ": " : "", detail);
       latch_fault(text);

@@ -81,6 +81,11 @@ class MotionController {
   std::string jog_increment(int axis, double distance, double speed_per_s);
   void jog_stop(int axis);  // controlled stop
 
+  // After start(): how long a driver may take to report a drive that does not answer or has
+  // faulted (the longest Driver::feedback_deadline_ns), 0 when every driver answers each
+  // period.
+  std::int64_t feedback_deadline_ns() const;
+
   // Lock-free copy of the latest status.
   Status status() const;
   // Takes the next event the servo thread posted (faults, warnings); false when none.

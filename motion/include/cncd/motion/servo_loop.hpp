@@ -47,7 +47,7 @@ struct Command {
 struct Event {
   enum class Level : std::uint8_t { info, warning, fault };
   Level level = Level::info;
-  char text[120] = {};
+  char text[240] = {};  // room for a fault_reason with the driver's own words
 };
 
 // One joint's place in a driver: the servo loop hands each driver its joints' commands as a

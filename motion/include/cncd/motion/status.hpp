@@ -57,7 +57,7 @@ struct Status {
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
   std::uint64_t segments_done = 0;  // segments completed (or dropped by an abort) since start
   std::uint64_t moves_done = 0;     // programmed moves completed (or dropped) since start
-  char fault_reason[120] = {};      // latched fault, "" when none
+  char fault_reason[240] = {};      // latched fault, "" when none
   RtStats rt;
 };
 
