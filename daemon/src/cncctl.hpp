@@ -23,6 +23,7 @@ constexpr int kUnavailable = 69;
 // cncd answered with an error object.
 struct Refused {
   std::string message;
+  int code = 0;  // the JSON-RPC error code
 };
 // The command line is wrong.
 struct UsageError {

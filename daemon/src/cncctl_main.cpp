@@ -58,8 +58,8 @@ void usage(std::FILE* out) {
       "\n"
       "--json prints cncd's answer (or the final status) as JSON.\n"
       "The socket defaults to $CNCD_SOCKET, else /run/cncd/cncd.sock.\n"
-      "Exit status: 0 done, 1 failed (program error, fault), 2 refused (state, permission,\n"
-      "bad value), 64 usage, 69 cncd not reachable or connection lost.\n",
+      "Exit status: 0 done, 1 failed (program error, fault, file not written), 2 refused (state,\n"
+      "permission, bad value), 64 usage, 69 cncd not reachable or connection lost.\n",
       out);
 }
 
@@ -335,8 +335,12 @@ int main(int argc, char** argv) {
   try {
     return run_command(client, args, json_output);
   } catch (const Refused& refused) {
-    std::fprintf(stderr, "cncctl: %s: refused: %s\n", args[0].c_str(), refused.message.c_str());
-    return kRefused;
+    // The machine tried and failed (a drive fault, a file that cannot be written), as against
+    // a request declined in the state it is in.
+    const bool failed = refused.code == 1007 || refused.code == 1008;
+    std::fprintf(stderr, "cncctl: %s: %s: %s\n", args[0].c_str(), failed ? "failed" : "refused",
+                 refused.message.c_str());
+    return failed ? kFailed : kRefused;
   } catch (const UsageError& error) {
     std::fprintf(stderr, "cncctl: %s\n", error.message.c_str());
     return kUsage;

@@ -14,7 +14,8 @@ json result_of(const json& response) {
   if (response.contains("error")) {
     const auto& error = response["error"];
     throw Refused{error.value("message", std::string("error")) + " (code " +
-                  std::to_string(error.value("code", 0)) + ")"};
+                      std::to_string(error.value("code", 0)) + ")",
+                  error.value("code", 0)};
   }
   return response.value("result", json());
 }

@@ -103,9 +103,12 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     task.reset();
     return ok();
   });
-  dispatcher.add("machine.on", [&task](const json&) {
-    task.machine_on();
-    return ok();
+  dispatcher.add("machine.on", [&task, &completions](const json&, Session& session) {
+    // Answered once the drives have had the time to report a fault; a batch waits for it.
+    const auto token = session.in_batch ? 0 : completions.next_token();
+    if (!task.machine_on(token)) return ok();
+    session.defer_token = token;
+    return json();
   });
   dispatcher.add("machine.off", [&task](const json&) {
     task.machine_off();

@@ -30,6 +30,7 @@ enum RpcCode : int {
   kPermissionDenied = 1005,
   kRequestTooLarge = 1006,
   kFileError = 1007,  // a file (tool table, parameter file) could not be written
+  kFault = 1008,      // the machine did not do it: a drive, its feedback or the estop input
 };
 
 class RpcError : public std::runtime_error {

@@ -94,38 +94,6 @@ void Task::shutdown() {
   started_ = false;
 }
 
-void Task::estop() {
-  motion_.estop();
-  if (exec_ != ExecState::idle) finish_program("aborted", "estop");
-}
-
-void Task::reset() {
-  if (motion_.status().machine != motion::MachineState::estop) return;
-  motion_.reset_estop();
-}
-
-void Task::machine_on() {
-  const auto status = motion_.status();
-  if (status.machine == motion::MachineState::estop) {
-    throw RpcError(kWrongState, "machine is in estop: reset it first");
-  }
-  motion_.machine_on();
-}
-
-void Task::machine_off() {
-  if (exec_ != ExecState::idle) finish_program("aborted", "machine turned off");
-  motion_.machine_off();
-}
-
-void Task::home(std::uint32_t joint_mask) {
-  const auto status = motion_.status();
-  if (status.machine != motion::MachineState::on) {
-    throw RpcError(kWrongState, "machine is not on");
-  }
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
-  motion_.home(joint_mask);
-}
-
 void Task::open_program(const std::string& path) {
   if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
   std::error_code ec;
@@ -374,6 +342,7 @@ void Task::poll() {
       completions_.complete(token, nlohmann::json{{"ok", true}});
     abort_tokens_.clear();
   }
+  confirm_machine_on(status);
   if (exec_ == ExecState::idle) return;
   if (status.machine != motion::MachineState::on) {
     finish_program("aborted", status.fault_reason[0] != '\0' ? status.fault_reason
@@ -412,7 +381,8 @@ void Task::poll() {
 }
 
 bool Task::busy() const {
-  return exec_ != ExecState::idle || motion_.status().motion != motion::MotionState::idle;
+  return exec_ != ExecState::idle || !on_tokens_.empty() ||
+         motion_.status().motion != motion::MotionState::idle;
 }
 
 }  // namespace cncd::daemon

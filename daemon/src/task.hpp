@@ -49,10 +49,17 @@ class Task {
   // joint positions to [TRAJ] POSITION_FILE.
   void shutdown();
 
-  // Each command throws RpcError when refused in the current state.
+  // Each command throws RpcError when refused in the current state, and (kFault) when the
+  // machine does not do it: reset with the estop input asserted, homing the servo thread
+  // refuses (task_machine.cpp).
   void estop();
   void reset();
-  void machine_on();
+  // Enables the drives. The machine counts as on once the drivers have had the time to report
+  // a drive that does not answer or has faulted (MotionController::feedback_deadline_ns):
+  // returns true when the answer, under `token`, is posted then (poll()); with token 0 (a
+  // batch) it waits here. Throws kFault naming the joint, drive and reason when the machine
+  // does not come on.
+  bool machine_on(std::uint64_t token);
   void machine_off();
   void home(std::uint32_t joint_mask);
   // Refuses (RpcError) a program that cannot be read or whose moves leave the soft limits.
@@ -116,6 +123,10 @@ class Task {
   // Servo periods run since the servo thread had run `cycles`, in seconds.
   double servo_seconds_since(std::uint64_t cycles) const;
   void drain_servo_events();
+  // Answers the machine.on requests waiting for the drives (task_machine.cpp).
+  void confirm_machine_on(const motion::Status& status);
+  std::chrono::steady_clock::duration on_check_time() const;
+  void wait_servo_periods(int periods) const;
   // Rewrites the parameter file and the tool table where they differ from what the interpreter
   // holds (G10, G92, G5x, offsets.set). One that cannot be written is put back in the
   // interpreter as its file holds it, so that what is in force is what a restart would load.
@@ -183,6 +194,8 @@ class Task {
   double paused_s_ = 0;         // time the current run has spent paused, up to paused_since_
   bool files_corrupt_ = false;  // load_files() failed: keep them as they are for the user
   bool started_ = false;        // motion started: its joint positions are worth saving
+  std::vector<std::uint64_t> on_tokens_;  // machine.on answers waiting for the drives
+  std::chrono::steady_clock::time_point on_check_until_{};
   // Where the joints started: "clean" (the position file of an orderly shutdown), "unclean"
   // (the positions last saved by a run that did not shut down) or "none".
   std::string position_restored_ = "none";

@@ -36,8 +36,8 @@ std::string slurp(const std::string& path) {
 // waiting by the other tests on a busy machine would answer after the bus timeout.
 class DriveSimProcess {
  public:
-  // `port` 0 picks a free one.
-  std::string start(int port = 0) {
+  // `port` 0 picks a free one; `extra` are further options (--fault-after 0).
+  std::string start(int port = 0, const std::vector<std::string>& extra = {}) {
     const std::string port_text = std::to_string(port);
     int out[2];
     if (pipe(out) != 0) return "pipe failed";
@@ -45,8 +45,14 @@ class DriveSimProcess {
     if (pid_ == 0) {
       dup2(out[1], STDOUT_FILENO);
       close(out[0]);
-      execl(DRIVE_SIM_BINARY, DRIVE_SIM_BINARY, "--port", port_text.c_str(), "--drives", "3",
-            "--lag", "0.005", "--rt-priority", "60", static_cast<char*>(nullptr));
+      std::vector<std::string> args = {DRIVE_SIM_BINARY, "--port", port_text,       "--drives", "3",
+                                       "--lag",          "0.005",  "--rt-priority", "60"};
+      args.insert(args.end(), extra.begin(), extra.end());
+      std::vector<char*> argv;
+      for (auto& arg : args)
+        argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(DRIVE_SIM_BINARY, argv.data());
       _exit(127);
     }
     close(out[1]);
@@ -54,7 +60,8 @@ class DriveSimProcess {
     char c = 0;
     while (read(out[0], &c, 1) == 1 && c != '\n')
       line += c;
-    close(out[0]);
+    // Kept open: what it prints later (a fault set or cleared) must not meet a closed pipe.
+    out_fd_ = out[0];
     std::smatch m;
     if (!std::regex_search(line, m, std::regex(":([0-9]+)$"))) {
       stop(SIGTERM);
@@ -71,12 +78,17 @@ class DriveSimProcess {
       waitpid(pid_, nullptr, 0);
       pid_ = -1;
     }
+    if (out_fd_ >= 0) close(out_fd_);
+    out_fd_ = -1;
   }
   int port() const { return port_; }
+  // SIGUSR1 toggles a fault on every drive.
+  void signal(int signal) const { kill(pid_, signal); }
 
  private:
   pid_t pid_ = -1;
   int port_ = 0;
+  int out_fd_ = -1;
 };
 
 json result(const json& response) {
@@ -267,6 +279,39 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   const json done = wait_until([](const json& s) { return s["exec"] == "idle"; });
   EXPECT_EQ(done["program"]["result"], "done") << done.dump();
   EXPECT_EQ(done["position"]["commanded"]["x"], 20.0);
+}
+
+// Drives whose fault bit is set: machine.on answers with the fault, naming the joint, the drive
+// and why, and the machine stays off; once the drives are fine, it comes on.
+TEST(DriversEndToEnd, MachineOnWithAFaultedModbusDriveIsAnErrorNamingIt) {
+  DriveSimProcess sim;
+  ASSERT_EQ(sim.start(0, {"--fault-after", "0"}), "");
+  TempDir dir;
+  const std::string ini = adapt(dir, "modbus_sim.ini", modbus_changes(sim.port()));
+  DaemonProcess daemon;
+  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
+  daemon::Client client;
+  ASSERT_EQ(client.connect(daemon.socket()), "");
+  result(client.call("machine.reset"));
+  const json r = client.call("machine.on");
+  ASSERT_TRUE(r.contains("error")) << r.dump();
+  EXPECT_EQ(r["error"]["code"], 1008);
+  const std::string message = r["error"]["message"];
+  EXPECT_NE(message.find("joint "), std::string::npos) << message;
+  EXPECT_NE(message.find("drive fault"), std::string::npos) << message;
+  EXPECT_NE(message.find("modbus MODBUS_0 slave"), std::string::npos) << message;
+  EXPECT_NE(message.find("drive reports a fault"), std::string::npos) << message;
+  EXPECT_EQ(result(client.call("status.get"))["state"], "off");
+
+  sim.signal(SIGUSR1);  // the fault is cleared
+  json on;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    on = client.call("machine.on");
+    if (on.contains("result")) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(on.contains("result")) << on.dump();
+  EXPECT_EQ(result(client.call("status.get"))["state"], "on");
 }
 
 TEST(DriversEndToEnd, ASimulatedMotorThatLagsTripsTheFollowingError) {
