@@ -162,6 +162,13 @@ int follow_step(cncd::daemon::Client& client, bool json_output) {
   }
 }
 
+// program.run / program.step answered. A run that ended in error before it moved answers with
+// that error (1003); it did run, and the status that follows tells how it ended.
+void started(const json& response) {
+  if (response.contains("error") && response["error"].value("code", 0) == 1003) return;
+  result_of(response);
+}
+
 int run_command(cncd::daemon::Client& client, const std::vector<std::string>& args,
                 bool json_output) {
   const std::string& command = args[0];
@@ -270,7 +277,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     }
     if (file.empty()) throw UsageError{"run needs a program file"};
     open_program(client, file);
-    result_of(client.call("program.run", params));
+    started(client.call("program.run", params));
     return follow_program(client, json_output);
   }
   if (command == "open") {
@@ -282,7 +289,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "step") {
     if (args.size() > 2) throw UsageError{"step takes at most one program file"};
     if (args.size() == 2) open_program(client, args[1]);
-    result_of(client.call("program.step"));
+    started(client.call("program.step"));
     return follow_step(client, json_output);
   }
   if (command == "watch") return watch(client, args, json_output);

@@ -183,6 +183,12 @@ void Task::run_program(int from_line, bool step) {
               program_path_ + (skip_to_line_ > 0 ? " started from line " + std::to_string(from_line)
                                                  : std::string(" started")));
   feed();
+  // Ended in error before any of its moves reached the motion controller (the planner refused
+  // the first one, the machine having been moved since the program was checked; a run from a
+  // line the program never reaches): that is this request's answer, not a success.
+  if (exec_ == ExecState::idle && last_result_ == "error" && moves_enqueued_ == 0) {
+    throw RpcError(kProgramError, last_error_);
+  }
 }
 
 void Task::mdi(const std::string& line, std::uint64_t token) {

@@ -46,7 +46,10 @@ TEST_F(MachineTest, RunFromALineAfterTheProgramEndFails) {
   ready_machine();
   const auto program = dir_.write("ends.ngc", "G21 G90\nM2\nG0 X5\nG0 X6\n");
   result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.run", {{"from_line", 4}}));
+  // It ends before anything moves: the request's answer says so.
+  const json r = call("program.run", {{"from_line", 4}});
+  EXPECT_EQ(error_code(r), 1003) << r.dump();
+  EXPECT_NE(r.dump().find("ends at line 2, before line 4"), std::string::npos) << r.dump();
   const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
   EXPECT_EQ(s["program"]["result"], "error");
   EXPECT_NE(s["program"]["error"].get<std::string>().find("ends at line 2, before line 4"),

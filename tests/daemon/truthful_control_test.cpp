@@ -149,5 +149,21 @@ TEST_F(MachineTruthTest, MachineOnAnswersOnceTheMachineIsOn) {
   result_of(call("machine.on"));
 }
 
+// The program was checked where the machine stood when it was opened; moved since, its first
+// move leaves the soft limits, and the run ends before it starts.
+TEST_F(MachineTruthTest, RunThatEndsBeforeItMovesIsAnError) {
+  ready_machine();
+  const fs::path program = dir_.write("relative.ngc", "G91 G0 X50\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  mdi("G53 G0 X280");
+  const json r = call("program.run");
+  EXPECT_EQ(error_code(r), 1003) << r.dump();
+  EXPECT_NE(r.dump().find("relative.ngc:1"), std::string::npos) << r.dump();
+  const json s = status();
+  EXPECT_EQ(s["exec"], "idle");
+  EXPECT_EQ(s["program"]["result"], "error");
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 280.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace cncd::test
