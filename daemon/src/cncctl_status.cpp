@@ -109,6 +109,9 @@ void print_status(const json& s) {
   std::printf("commanded %s  (%s)\n", axes_text(position.value("commanded", json())).c_str(),
               get<std::string>(s, "units", "").c_str());
   std::printf("actual    %s\n", axes_text(position.value("actual", json())).c_str());
+  if (get<std::string>(s, "position_restored", "") == "unclean") {
+    std::printf("          (started from positions saved before an unclean shutdown)\n");
+  }
   const json offsets = s.value("offsets", json::object());
   if (!work.empty()) {
     std::printf("work      %s  (%s)\n", axes_text(work.value("commanded", json())).c_str(),

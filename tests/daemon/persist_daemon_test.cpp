@@ -163,6 +163,8 @@ TEST_F(PersistDaemonTest, KillNineAfterAMoveRestartsWhereTheMoveEnded) {
   const auto s = result_of(call("status.get"));
   EXPECT_EQ(s["position_restored"], "unclean");
   EXPECT_NEAR(s["position"]["actual"]["x"].get<double>(), 33.25, 1e-6) << s.dump();
+  const CommandResult shown = run_command({CNCCTL_BINARY, "--socket", daemon_.socket(), "status"});
+  EXPECT_NE(shown.out.find("unclean shutdown"), std::string::npos) << shown.out;
 }
 
 TEST_F(PersistDaemonTest, CorruptPositionFileIsNamedWithItsLineAndStopsTheStart) {
