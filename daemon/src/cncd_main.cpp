@@ -199,6 +199,7 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   }
   sd_notify(0, "STOPPING=1");
   task.shutdown();
+  server.flush_answers();
   server.close();
   close(signal_fd);
   spdlog::info("cncd stopped");

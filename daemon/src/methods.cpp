@@ -121,11 +121,16 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                    return ok();
                  },
                  {{"joints", 0, last_joint}});
-  dispatcher.add("program.open", [&task](const json& params) {
+  // Answered once the program has been checked, on a worker thread: the loop serves others
+  // meanwhile.
+  dispatcher.add("program.open", [&task, &completions](const json& params, Session& session) {
+    if (session.in_batch) throw RpcError(kInvalidRequest, "program.open cannot be part of a batch");
     const auto path = params["path"].get<std::string>();
     if (path.empty()) throw RpcError(kInvalidParams, "parameter \"path\" must not be empty");
-    task.open_program(path);
-    return json{{"path", path}};
+    const auto token = completions.next_token();
+    task.open_program(path, token);
+    session.defer_token = token;
+    return json();
   });
   dispatcher.add("program.run", [&task](const json& params) {
     // 0: from the top.

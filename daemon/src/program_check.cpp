@@ -321,6 +321,11 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
   }
   const auto start = std::chrono::steady_clock::now();
   for (;;) {
+    if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
+      report.cancelled = true;
+      report.stopped = CheckProblem{program.string(), interp.current_line(), "check cancelled"};
+      break;
+    }
     if (options.max_seconds > 0 && report.blocks % 4096 == 4095 &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
             options.max_seconds) {

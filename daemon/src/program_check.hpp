@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -41,6 +42,9 @@ struct CheckOptions {
   // The check stops after this long (0 = never) and says so in `stopped`: a program looping
   // forever with moves never ends.
   double max_seconds = 0;
+  // Set from another thread to stop the check early (program.open superseded or cancelled);
+  // CheckReport::cancelled tells.
+  const std::atomic<bool>* cancel = nullptr;
   // Also receives every canonical command as the interpreter emits it (cncd-check --canon).
   interp::CanonSink* trace = nullptr;
 };
@@ -64,6 +68,7 @@ struct CheckReport {
   std::optional<interp::InterpError> error;
   // Set when the check stopped before the end of the program (CheckOptions::max_seconds).
   std::optional<CheckProblem> stopped;
+  bool cancelled = false;  // CheckOptions::cancel stopped it: the report is incomplete
   // Moves beyond a soft limit, in program order.
   std::vector<CheckProblem> problems;
   std::size_t limit_violations = 0;  // all of them, including those not kept

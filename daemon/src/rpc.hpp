@@ -31,6 +31,7 @@ enum RpcCode : int {
   kRequestTooLarge = 1006,
   kFileError = 1007,  // a file (tool table, parameter file) could not be written
   kFault = 1008,      // the machine did not do it: a drive, its feedback or the estop input
+  kCancelled = 1009,  // cancelled before it finished (program.open: a newer open, an estop)
 };
 
 class RpcError : public std::runtime_error {

@@ -49,6 +49,9 @@ class Server {
   // Waits up to timeout_ms for socket activity (and `extra_fd` readability when >= 0), serves
   // it and pushes due status updates.
   void poll_once(int timeout_ms, int extra_fd = -1);
+  // Sends the answers posted since the last poll (at shutdown: the opens it cancelled) as far
+  // as the sockets take them without waiting.
+  void flush_answers() { deliver_completions(); }
   // Closes every connection and removes the socket file (when this server created it).
   void close();
   std::size_t client_count() const { return clients_.size(); }

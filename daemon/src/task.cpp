@@ -1,7 +1,5 @@
 #include "task.hpp"
 
-#include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include <spdlog/spdlog.h>
@@ -19,20 +17,6 @@ interp::Units machine_units(const config::MachineConfig& config) {
   return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
                                                           : interp::Units::mm;
 }
-
-std::uint64_t count_lines(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::uint64_t lines = 0;
-  char buffer[65536];
-  bool last_newline = true;
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-    const auto n = static_cast<std::size_t>(in.gcount());
-    for (std::size_t i = 0; i < n; ++i)
-      lines += buffer[i] == '\n';
-    last_newline = buffer[n - 1] == '\n';
-  }
-  return last_newline ? lines : lines + 1;
-}
 }  // namespace
 
 // One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
@@ -46,7 +30,8 @@ Task::Task(const config::MachineConfig& config, EventLog& events, Completions& c
       interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))),
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
-      estimator_(config) {}
+      estimator_(config),
+      opener_(config) {}
 
 Task::~Task() {
   shutdown();
@@ -72,6 +57,7 @@ void Task::drain_servo_events() {
 }
 
 void Task::shutdown() {
+  cancel_open("cncd is shutting down");
   if (exec_ != ExecState::idle) finish_program("aborted", "daemon shutting down");
   // Come to rest on the path before the drives go off, then keep the offsets.
   const auto status = motion_.status();
@@ -94,54 +80,6 @@ void Task::shutdown() {
   started_ = false;
 }
 
-void Task::open_program(const std::string& path) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw RpcError(kProgramError, "cannot open program '" + path + "': no such file");
-  }
-  std::ifstream probe(path);
-  if (!probe) throw RpcError(kProgramError, "cannot open program '" + path + "': not readable");
-  check_limits(path);
-  interp::Pose start{};
-  const motion::AxisPose here = motion_.status().commanded;
-  std::copy(here.begin(), here.end(), start.begin());
-  estimator_.start(path, interpreter_options(config_), start);
-  program_path_ = path;
-  program_lines_ = count_lines(path);
-  last_result_.clear();
-  last_error_.clear();
-  spdlog::info("program opened: {} ({} lines)", path, program_lines_);
-}
-
-// Refuses a program whose moves leave the soft limits, from where the machine is now and with
-// the offsets and tools saved in the parameter file and tool table, or that the interpreter
-// stops on: the error cncd-check gives, at the same line, and not part-way through a run.
-void Task::check_limits(const std::string& path) {
-  CheckOptions options;
-  options.interp = interpreter_options(config_);
-  options.machine = &config_;
-  options.max_problems = 1;
-  const auto status = motion_.status();
-  interp::Pose start{};
-  std::copy(status.commanded.begin(), status.commanded.end(), start.begin());
-  options.start_machine = start;
-  // The daemon's loop waits meanwhile: a program too long to check in time is checked by the
-  // planner as it runs.
-  options.max_seconds = 5;
-  const CheckReport report = check_program(path, options);
-  if (report.stopped) events_.add("warning", "program", report.stopped->to_string());
-  if (report.limit_violations == 0) {
-    if (report.error) throw RpcError(kProgramError, report.error->to_string());
-    return;
-  }
-  std::string message = report.problems.front().to_string();
-  if (report.limit_violations > 1) {
-    message += " (and " + std::to_string(report.limit_violations - 1) + " more)";
-  }
-  throw RpcError(kProgramError, message);
-}
-
 bool Task::all_homed(const motion::Status& status) const {
   for (int j = 0; j < status.joint_count; ++j) {
     if (!status.homed[static_cast<std::size_t>(j)]) return false;
@@ -150,6 +88,10 @@ bool Task::all_homed(const motion::Status& status) const {
 }
 
 void Task::run_program(int from_line, bool step) {
+  if (opening_) {
+    throw RpcError(kBusy, "'" + opening_->path +
+                              "' is still being checked: run it once program.open has answered");
+  }
   if (program_path_.empty()) throw RpcError(kProgramError, "no program is open");
   if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is already running");
   if (from_line < 0 || static_cast<std::uint64_t>(from_line) > program_lines_) {
@@ -340,6 +282,9 @@ void Task::feed() {
 
 void Task::poll() {
   drain_servo_events();
+  if (opening_) {
+    if (auto outcome = opener_.take()) finish_open(std::move(*outcome));
+  }
   const auto status = motion_.status();
   keep_positions(status);
   // program.abort answers once the machine has come to rest.
@@ -387,7 +332,7 @@ void Task::poll() {
 }
 
 bool Task::busy() const {
-  return exec_ != ExecState::idle || !on_tokens_.empty() ||
+  return exec_ != ExecState::idle || opening_ || !on_tokens_.empty() ||
          motion_.status().motion != motion::MotionState::idle;
 }
 

@@ -1,7 +1,9 @@
 // The task layer: machine state (estop/off/on), program execution, and the glue from the
 // interpreter's canonical commands to the motion controller's queue.
 //
-// Single-threaded: every method is called from the daemon's main loop thread.
+// Single-threaded: every method is called from the daemon's main loop thread; the long work
+// of program.open and the time estimate run on threads of their own (program_open.hpp,
+// plan_estimate.hpp) on copies of what they need.
 #pragma once
 
 #include <chrono>
@@ -21,6 +23,7 @@
 #include "feeder.hpp"
 #include "persist.hpp"
 #include "plan_estimate.hpp"
+#include "program_open.hpp"
 #include "rpc.hpp"
 
 namespace cncd::daemon {
@@ -62,8 +65,12 @@ class Task {
   bool machine_on(std::uint64_t token);
   void machine_off();
   void home(std::uint32_t joint_mask);
-  // Refuses (RpcError) a program that cannot be read or whose moves leave the soft limits.
-  void open_program(const std::string& path);
+  // Opens a program once it has passed the check of the whole program (program_open.hpp),
+  // which runs on a worker thread meanwhile; the answer under `token` is posted then: the
+  // program's path, or why it was refused (cannot be read, leaves the soft limits, stopped
+  // by the interpreter) or cancelled (a newer open, an estop, shutdown). Refuses at once
+  // (RpcError) while a program or MDI block runs or the machine jogs or homes.
+  void open_program(const std::string& path, std::uint64_t token);
   // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
   // `step` runs its first line only, as program.step does.
   void run_program(int from_line = 0, bool step = false);
@@ -90,7 +97,8 @@ class Task {
   // Feeds the planner from the interpreter, notices the end of a program, logs servo events.
   // Called every loop iteration.
   void poll();
-  // True while a program is being fed or motion is under way: the loop should poll often.
+  // True while a program is being fed or checked for opening, or motion is under way: the
+  // loop should poll often.
   bool busy() const;
 
   // Tool table and coordinate systems (task_setup.cpp). The setters throw RpcError while a
@@ -145,7 +153,10 @@ class Task {
   // Each joint's limits, for the position file (task_persist.cpp).
   std::vector<JointRange> joint_ranges() const;
   void finish_program(const std::string& result, const std::string& error);
-  void check_limits(const std::string& path);
+  // The pending open's check has ended (task_open.cpp).
+  void finish_open(OpenOutcome outcome);
+  // Answers the pending open, if any, with error kCancelled and `why`.
+  void cancel_open(const std::string& why);
   bool all_homed(const motion::Status& status) const;
   // Run from line: called after each block while lines before skip_to_line_ are read. Drops
   // their motion (modal state, offsets and tool stay as they left them) and, at the first

@@ -48,6 +48,7 @@ void Task::wait_servo_periods(int periods) const {
 void Task::estop() {
   motion_.estop();
   if (exec_ != ExecState::idle) finish_program("aborted", "estop");
+  cancel_open("cancelled by machine.estop");
 }
 
 void Task::reset() {

@@ -267,6 +267,7 @@ json Task::status() const {
        {{"feed", s.feed_override}, {"rapid", s.rapid_override}, {"spindle", spindle_override_}}},
       {"program",
        {{"path", program_path_},
+        {"opening", opening_ ? opening_->path : std::string()},
         {"line", line},
         {"total_lines", program_lines_},
         {"progress", progress},

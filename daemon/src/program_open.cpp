@@ -1,0 +1,133 @@
+#include "program_open.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "program_check.hpp"
+#include "rpc.hpp"
+
+namespace cncd::daemon {
+namespace {
+
+// Lines of the file, a last line without a newline counted too; 0 when cancelled part-way.
+std::uint64_t count_lines(const std::string& path, const std::atomic<bool>& cancel) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t lines = 0;
+  char buffer[65536];
+  bool last_newline = true;
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    if (cancel.load(std::memory_order_relaxed)) return 0;
+    const auto n = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < n; ++i)
+      lines += buffer[i] == '\n';
+    last_newline = buffer[n - 1] == '\n';
+  }
+  return last_newline ? lines : lines + 1;
+}
+
+// Refuses a program whose moves leave the soft limits, from where the machine stood and with
+// the offsets and tools saved in the parameter file and tool table, or that the interpreter
+// stops on: the error cncd-check gives, at the same line, and not part-way through a run.
+OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
+                           const config::MachineConfig& machine, const std::atomic<bool>& cancel) {
+  OpenOutcome out;
+  out.job = job;
+  out.path = request.path;
+  const auto fail = [&](int code, std::string message) {
+    out.error_code = code;
+    out.error_message = std::move(message);
+    return out;
+  };
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(request.path, ec)) {
+    return fail(kProgramError, "cannot open program '" + request.path + "': no such file");
+  }
+  if (!std::ifstream(request.path)) {
+    return fail(kProgramError, "cannot open program '" + request.path + "': not readable");
+  }
+  CheckOptions options;
+  options.interp = request.interp;
+  options.machine = &machine;
+  options.max_problems = 1;
+  options.start_machine = request.start;
+  options.max_seconds = ProgramOpener::kMaxCheckSeconds;
+  options.cancel = &cancel;
+  const CheckReport report = check_program(request.path, options);
+  if (report.cancelled) return out;  // nobody waits for it
+  if (report.stopped) out.warnings.push_back(report.stopped->to_string());
+  if (report.limit_violations > 0) {
+    std::string message = report.problems.front().to_string();
+    if (report.limit_violations > 1) {
+      message += " (and " + std::to_string(report.limit_violations - 1) + " more)";
+    }
+    return fail(kProgramError, std::move(message));
+  }
+  if (report.error) return fail(kProgramError, report.error->to_string());
+  out.lines = count_lines(request.path, cancel);
+  return out;
+}
+
+}  // namespace
+
+ProgramOpener::ProgramOpener(const config::MachineConfig& machine)
+    : machine_(machine), thread_([this] { work(); }) {}
+
+ProgramOpener::~ProgramOpener() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    next_.reset();
+    wanted_ = 0;
+    cancel_.store(true);
+  }
+  wake_.notify_one();
+  thread_.join();
+}
+
+std::uint64_t ProgramOpener::start(OpenRequest request) {
+  const std::uint64_t job = ++last_job_;
+  {
+    std::lock_guard lock(mutex_);
+    next_.emplace(job, std::move(request));
+    wanted_ = job;
+    done_.reset();
+    cancel_.store(true);
+  }
+  wake_.notify_one();
+  return job;
+}
+
+void ProgramOpener::cancel() {
+  std::lock_guard lock(mutex_);
+  next_.reset();
+  wanted_ = 0;
+  done_.reset();
+  cancel_.store(true);
+}
+
+std::optional<OpenOutcome> ProgramOpener::take() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(done_, std::nullopt);
+}
+
+void ProgramOpener::work() {
+  // The servo thread and the control socket come first.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return stopping_ || next_.has_value(); });
+    if (stopping_) return;
+    auto [job, request] = std::move(*next_);
+    next_.reset();
+    cancel_.store(false);
+    lock.unlock();
+    OpenOutcome outcome = check_for_open(job, request, machine_, cancel_);
+    lock.lock();
+    if (job == wanted_ && !cancel_.load()) done_ = std::move(outcome);
+  }
+}
+
+}  // namespace cncd::daemon

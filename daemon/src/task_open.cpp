@@ -1,0 +1,71 @@
+// program.open: refused at once in the wrong state, else checked on the opener's worker and
+// answered when the check ends (or is cancelled), while the loop goes on serving.
+#include <spdlog/spdlog.h>
+
+#include "program_check.hpp"
+#include "task.hpp"
+
+namespace cncd::daemon {
+
+void Task::open_program(const std::string& path, std::uint64_t token) {
+  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
+  // The check runs from where the machine stands: a position still changing (or, homing,
+  // not yet known) would give it a start the machine is not at.
+  const auto status = motion_.status();
+  switch (status.motion) {
+    case motion::MotionState::idle:
+      break;
+    case motion::MotionState::jogging:
+      throw RpcError(kBusy, "the machine is jogging: stop the jog, then open the program");
+    case motion::MotionState::homing:
+      throw RpcError(kBusy, "the machine is homing: open the program once homing has finished");
+    default:
+      throw RpcError(kBusy, "the machine is moving: open the program once it has stopped");
+  }
+  OpenRequest request;
+  request.path = path;
+  request.interp = interpreter_options(config_);
+  std::copy(status.commanded.begin(), status.commanded.end(), request.start.begin());
+  cancel_open("cancelled: replaced by a newer program.open of '" + path + "'");
+  PendingOpen pending;
+  pending.token = token;
+  pending.path = path;
+  pending.start = request.start;
+  pending.job = opener_.start(std::move(request));
+  opening_ = std::move(pending);
+}
+
+void Task::cancel_open(const std::string& why) {
+  if (!opening_) return;
+  opener_.cancel();
+  completions_.fail(opening_->token, kCancelled, "program.open of '" + opening_->path + "' " + why);
+  spdlog::info("program.open of '{}' {}", opening_->path, why);
+  opening_.reset();
+}
+
+void Task::finish_open(OpenOutcome outcome) {
+  if (!opening_ || outcome.job != opening_->job) return;
+  const PendingOpen pending = std::move(*opening_);
+  opening_.reset();
+  for (const auto& warning : outcome.warnings)
+    events_.add("warning", "program", warning);
+  // program.run waits for the open; an MDI block does not.
+  if (outcome.error_code == 0 && exec_ != ExecState::idle) {
+    outcome.error_code = kBusy;
+    outcome.error_message = "an MDI command started while '" + pending.path +
+                            "' was checked: open it again once it has finished";
+  }
+  if (outcome.error_code != 0) {
+    completions_.fail(pending.token, outcome.error_code, outcome.error_message);
+    return;
+  }
+  estimator_.start(outcome.path, interpreter_options(config_), pending.start);
+  program_path_ = outcome.path;
+  program_lines_ = outcome.lines;
+  last_result_.clear();
+  last_error_.clear();
+  spdlog::info("program opened: {} ({} lines)", program_path_, program_lines_);
+  completions_.complete(pending.token, nlohmann::json{{"path", program_path_}});
+}
+
+}  // namespace cncd::daemon
