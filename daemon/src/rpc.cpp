@@ -220,8 +220,9 @@ class RepeatFinder : public json::json_sax_t {
 
 }  // namespace
 
-std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
-                                                      Session& session) const {
+std::optional<std::string> RpcDispatcher::handle_line(const std::string& line, Session& session,
+                                                      std::size_t* requests) const {
+  if (requests != nullptr) *requests = 1;
   if (nested_too_deep(line)) {
     return error_response(nullptr, kInvalidRequest,
                           "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
@@ -246,6 +247,7 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line,
     return it == finder.repeats.end() ? nullptr : &it->second;
   };
   if (request.is_array()) {
+    if (requests != nullptr) *requests = request.size();
     json responses = json::array();
     session.in_batch = true;
     for (std::size_t i = 0; i < request.size(); ++i) {

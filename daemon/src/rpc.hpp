@@ -107,8 +107,10 @@ class RpcDispatcher {
   // Throws std::logic_error naming the methods of the table that have no handler.
   void require_all_added() const;
   // Handles one line of input from a caller. Returns the serialized response without newline,
-  // or nullopt when nothing is to be sent (notifications).
-  std::optional<std::string> handle_line(const std::string& line, Session& session) const;
+  // or nullopt when nothing is to be sent (notifications). `requests`, when given, receives
+  // how many requests the line held (a batch's length, else 1).
+  std::optional<std::string> handle_line(const std::string& line, Session& session,
+                                         std::size_t* requests = nullptr) const;
 
   static nlohmann::json error_object(int code, const std::string& message);
 

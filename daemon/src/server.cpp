@@ -196,16 +196,24 @@ void Server::read_client(Client& client) {
 
 void Server::serve_lines(Client& client) {
   std::size_t start = 0;
-  for (int served = 0; served < kRequestsPerTurn && client.out.size() <= kMaxBacklogBytes;
-       ++served) {
+  // A batch counts as the requests it holds, so that batches get a client no more work done
+  // in a turn than single requests do.
+  std::size_t served = 0;
+  while (served < kRequestsPerTurn && client.out.size() <= kMaxBacklogBytes) {
     const std::size_t newline = client.in.find('\n', start);
     if (newline == std::string::npos) break;
     std::string line = client.in.substr(start, newline - start);
     start = newline + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    if (line.find_first_not_of(" \t") == std::string::npos) {
+      ++served;
+      continue;
+    }
     requests_handled_ = true;
-    if (auto response = dispatcher_.handle_line(line, client.session)) {
+    std::size_t requests = 1;
+    auto response = dispatcher_.handle_line(line, client.session, &requests);
+    served += requests;
+    if (response) {
       client.out += *response;
       client.out += '\n';
     }

@@ -26,9 +26,10 @@ class Server {
   // Unsent output past which a client that does not read is disconnected.
   static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
   static constexpr int kMinSubscribeIntervalMs = 10;
-  // Requests (lines) served from one client per loop turn, so that a burst from one client
-  // does not hold up the others.
-  static constexpr int kRequestsPerTurn = 32;
+  // Requests served from one client per loop turn (a batch's requests count one by one; the
+  // line that reaches the count is served whole), so that a burst from one client does not
+  // hold up the others.
+  static constexpr std::size_t kRequestsPerTurn = 32;
   // How long a closing connection may take to read what is still owed to it.
   static constexpr std::chrono::seconds kCloseGrace{5};
 

@@ -124,6 +124,20 @@ TEST_F(RpcTest, BatchAnswersEachRequestInOrder) {
   EXPECT_EQ(r[1]["error"]["code"], kMethodNotFound);
 }
 
+// The server counts a batch as the requests it holds when it shares turns between clients.
+TEST_F(RpcTest, ALineTellsHowManyRequestsItHeld) {
+  std::size_t requests = 0;
+  dispatcher_.handle_line(R"({"jsonrpc":"2.0","id":1,"method":"query"})", session_, &requests);
+  EXPECT_EQ(requests, 1u);
+  dispatcher_.handle_line(R"([{"jsonrpc":"2.0","id":1,"method":"query"},)"
+                          R"({"jsonrpc":"2.0","method":"query"},)"
+                          R"({"jsonrpc":"2.0","id":2,"method":"nope"}])",
+                          session_, &requests);
+  EXPECT_EQ(requests, 3u);
+  dispatcher_.handle_line("{not json", session_, &requests);
+  EXPECT_EQ(requests, 1u);
+}
+
 TEST_F(RpcTest, ReaderMayQueryButNotCommand) {
   session_.access = Access::read;
   EXPECT_EQ(call(R"({"jsonrpc":"2.0","id":1,"method":"query"})")["result"], 1);
