@@ -240,9 +240,12 @@ void Task::finish_program(const std::string& ended, const std::string& why) {
 }
 
 void Task::feed() {
-  // Bounded work per call keeps the control socket responsive.
+  // Bounded work per call keeps the control socket responsive: a run from a far line reads
+  // every line before it, thousands a poll when they hardly move.
   constexpr int kMaxBlocksPerPoll = 2000;
+  const auto until = Clock::now() + std::chrono::milliseconds(2);
   for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
+    if ((blocks & 63) == 63 && Clock::now() > until) return;
     while (!feeder_->pending.empty()) {
       if (ProgramFeeder::stop_point(feeder_->pending.front())) {
         motion_.flush();  // what does not fit yet goes out before the next move

@@ -216,6 +216,21 @@ class Task {
   int settle_saves_left_ = 0;
   bool was_moving_ = false;
   bool position_save_failing_ = false;  // the failure has been logged; quiet until a success
+  struct PendingOpen {
+    std::uint64_t job = 0;
+    std::uint64_t token = 0;
+    std::string path;
+    interp::Pose start{};  // where the machine stood: the check and the estimate start there
+  };
+  std::optional<PendingOpen> opening_;  // program.open waiting for its check
+  // Run from line: the index in the estimate of the line's first move (time_estimate()).
+  struct FirstMove {
+    std::shared_ptr<const std::vector<std::int32_t>> lines;  // the estimate's move lines
+    int line = 0;
+    std::uint64_t index = 0;
+  };
+  mutable FirstMove first_move_;
+  ProgramOpener opener_;
 };
 
 }  // namespace cncd::daemon

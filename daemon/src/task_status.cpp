@@ -165,14 +165,20 @@ json Task::time_estimate(std::uint64_t moves_done) const {
   if (!from_top_) {
     // Run from line: the estimate from the line's first move on. The traverse to the line's
     // start was not estimated: until it ends the whole rest of the program remains.
-    const auto& lines = *estimate.move_line;
-    const auto first = std::find_if(lines.begin(), lines.end(),
-                                    [&](std::int32_t line) { return line >= run_from_line_; });
-    if (first == lines.end() || starts.size() != lines.size()) {
+    // Looked up once a run: a status request must not walk millions of moves.
+    if (first_move_.lines != estimate.move_line || first_move_.line != run_from_line_) {
+      const auto& lines = *estimate.move_line;
+      const auto first = std::find_if(lines.begin(), lines.end(),
+                                      [&](std::int32_t line) { return line >= run_from_line_; });
+      first_move_ = {estimate.move_line, run_from_line_,
+                     static_cast<std::uint64_t>(first - lines.begin())};
+    }
+    if (first_move_.index >= estimate.move_line->size() ||
+        starts.size() != estimate.move_line->size()) {
       out["remaining_s"] = 0.0;
       return out;
     }
-    const auto k0 = static_cast<std::uint64_t>(first - lines.begin());
+    const std::uint64_t k0 = first_move_.index;
     if (skip_moved_ && !approach_done_s_) {
       out["remaining_s"] = total - starts[k0];
       return out;
