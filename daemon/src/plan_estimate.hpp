@@ -1,7 +1,8 @@
 // The running time of the open program, estimated in the background with the plan simulation
 // (plan_sim) so that program.open answers at once and the control socket stays responsive.
-// start()/cancel()/get() are called on the daemon's main loop thread; the simulation runs on
-// a thread of its own, at a lower CPU priority, within a time and a move budget.
+// start()/cancel()/get() are called on the daemon's main loop thread and never wait for a
+// simulation; each runs on a thread of its own, at a lower CPU priority, within a time and a
+// move budget.
 #pragma once
 
 #include <atomic>
@@ -35,24 +36,33 @@ class PlanEstimator {
   static constexpr std::size_t kMaxMoves = 4'000'000;
 
   explicit PlanEstimator(const config::MachineConfig& machine) : machine_(machine) {}
-  ~PlanEstimator() { cancel(); }
+  // Waits for the simulations still winding down.
+  ~PlanEstimator();
   PlanEstimator(const PlanEstimator&) = delete;
   PlanEstimator& operator=(const PlanEstimator&) = delete;
 
   // Cancels any estimate under way and starts one for `program` run from machine position
-  // `start` (machine coordinates and units).
+  // `start` (machine coordinates and units). Never waits for the cancelled one to end.
   void start(const std::filesystem::path& program, const interp::InterpOptions& options,
              const interp::Pose& start);
-  // Stops the estimate under way (waits for its thread) and forgets the last one.
+  // Cancels the estimate under way, if any, and forgets the last one; never waits.
   void cancel();
   PlanEstimate get() const;
 
  private:
+  struct Run {
+    std::thread thread;
+    std::shared_ptr<std::atomic<bool>> cancel;
+    std::shared_ptr<std::atomic<bool>> finished;
+  };
+  // Joins the cancelled runs that have ended.
+  void reap();
+
   const config::MachineConfig& machine_;
-  std::thread thread_;
-  std::atomic<bool> cancel_{false};
+  std::vector<Run> runs_;  // the current one last; used on the caller's thread only
   mutable std::mutex mutex_;
-  PlanEstimate estimate_;  // guarded by mutex_
+  std::uint64_t generation_ = 0;  // guarded by mutex_: the run whose result is wanted
+  PlanEstimate estimate_;         // guarded by mutex_
 };
 
 }  // namespace cncd::daemon
