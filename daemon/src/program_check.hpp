@@ -42,6 +42,9 @@ struct CheckOptions {
   // The check stops after this long (0 = never) and says so in `stopped`: a program looping
   // forever with moves never ends.
   double max_seconds = 0;
+  // max_seconds counts the processor time of the checking thread rather than wall time: a
+  // check on a thread of low priority gets as far on a busy machine as on an idle one.
+  bool max_seconds_cpu = false;
   // Set from another thread to stop the check early (program.open superseded or cancelled);
   // CheckReport::cancelled tells.
   const std::atomic<bool>* cancel = nullptr;

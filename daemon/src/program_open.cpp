@@ -54,6 +54,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   options.max_problems = 1;
   options.start_machine = request.start;
   options.max_seconds = ProgramOpener::kMaxCheckSeconds;
+  options.max_seconds_cpu = true;
   options.cancel = &cancel;
   const CheckReport report = check_program(request.path, options);
   if (report.cancelled) return out;  // nobody waits for it
@@ -114,7 +115,8 @@ std::optional<OpenOutcome> ProgramOpener::take() {
 }
 
 void ProgramOpener::work() {
-  // The servo thread and the control socket come first.
+  // The servo thread and the control socket come first; the check's time budget counts this
+  // thread's processor time, so a busy machine makes it slower, not shorter.
   setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
   std::unique_lock lock(mutex_);
   for (;;) {

@@ -41,8 +41,8 @@ struct OpenOutcome {
 
 class ProgramOpener {
  public:
-  // A program that takes longer than this to check is opened with a warning (the planner
-  // still checks each move as it runs); the client waits for its answer meanwhile.
+  // A program that takes longer than this to check (processor time) is opened with a warning
+  // (the planner still checks each move as it runs); the client waits for its answer.
   static constexpr double kMaxCheckSeconds = 5;
 
   explicit ProgramOpener(const config::MachineConfig& machine);
