@@ -290,6 +290,10 @@ void Task::poll() {
   }
   const auto status = motion_.status();
   keep_positions(status);
+  // An estop from the drives or an input, not machine.estop, cancels a pending open too.
+  const bool in_estop = status.machine == motion::MachineState::estop;
+  if (in_estop && !was_estop_) cancel_open("cancelled: the machine went into estop");
+  was_estop_ = in_estop;
   // program.abort answers once the machine has come to rest.
   if (!abort_tokens_.empty() && status.motion == motion::MotionState::idle && status.queued == 0) {
     for (const auto token : abort_tokens_)

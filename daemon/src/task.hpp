@@ -223,6 +223,7 @@ class Task {
     interp::Pose start{};  // where the machine stood: the check and the estimate start there
   };
   std::optional<PendingOpen> opening_;  // program.open waiting for its check
+  bool was_estop_ = true;               // the machine was in estop at the last poll()
   // Run from line: the index in the estimate of the line's first move (time_estimate()).
   struct FirstMove {
     std::shared_ptr<const std::vector<std::int32_t>> lines;  // the estimate's move lines
