@@ -61,6 +61,10 @@ constexpr std::array kKeys{
           "Lowest spindle override an operator may set; 0.5 = 50 %"},
   KeySpec{"DISPLAY", "MAX_SPINDLE_OVERRIDE", real, "1.0", 0, 10, false, "ratio", "",
           "Highest spindle override an operator may set; 1.2 = 120 %"},
+  KeySpec{"DISPLAY", "PROGRAM_PREFIX", path, "", 0, 0, false, "", "",
+          "Directory programs are opened from, relative to this INI's directory (~ is $HOME); "
+          "program.open refuses files outside it and [CNCD] PROGRAM_DIRS. Neither given: this "
+          "INI's own directory"},
   KeySpec{"CNCD", "SOCKET", path, "/run/cncd/cncd.sock", 0, 0, false, "", "",
           "Unix socket that clients connect to"},
   KeySpec{"CNCD", "STATE_DIR", path, "", 0, 0, false, "", "",
@@ -74,6 +78,9 @@ constexpr std::array kKeys{
           "SCHED_FIFO priority of the servo thread"},
   KeySpec{"CNCD", "RT_CPU", integer, "-1", -1, 1023, false, "", "",
           "CPU the servo thread is pinned to; -1 = any"},
+  KeySpec{"CNCD", "PROGRAM_DIRS", path_list, "", 0, 0, false, "", "",
+          "More directories programs may be opened from, colon-separated, relative to this "
+          "INI's directory (~ is $HOME); see [DISPLAY] PROGRAM_PREFIX"},
   KeySpec{"CNCD", "LOG_LEVEL", choice, "info", 0, 0, false, "",
           "trace|debug|info|warn|warning|error|critical|off", "Log verbosity"},
 

@@ -90,6 +90,8 @@ std::string describe(const MachineConfig& c) {
   if (!c.startup_code.empty()) line(out, "Startup code: " + c.startup_code);
   for (const auto& dir : c.subroutine_path)
     line(out, "Subroutines:  " + dir.string());
+  for (const auto& dir : c.program_dirs)
+    line(out, "Programs in:  " + dir.string());
 
   line(out, "Axes:");
   for (std::size_t i = 0; i < c.axes.size(); ++i) {

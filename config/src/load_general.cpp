@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 
 #include "loader.hpp"
@@ -141,7 +143,66 @@ void load_cncd(TypedReader& r, CncdConfig& cncd) {
   }
 }
 
+// `dir` absolute, without "." or ".." and without a trailing slash.
+std::filesystem::path absolute_dir(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::path out = std::filesystem::absolute(dir, ec).lexically_normal();
+  if (!out.has_filename() && out.has_relative_path()) out = out.parent_path();
+  return out;
+}
+
+// A program directory as the INI writes it: relative to the INI's directory, "~" for $HOME as
+// in LinuxCNC's PROGRAM_PREFIX = ~/linuxcnc/nc_files.
+std::optional<std::filesystem::path> program_dir(TypedReader& r, std::string_view section,
+                                                 std::string_view key, std::string_view item,
+                                                 const LoadOptions& options) {
+  std::filesystem::path dir;
+  if (item == "~" || item.starts_with("~/")) {
+    const char* home = options.getenv("HOME");
+    if (home == nullptr || *home == '\0') {
+      r.warning(section, key, "'" + printable(item) + "': $HOME is not set; left out");
+      return std::nullopt;
+    }
+    dir = std::filesystem::path(home) / item.substr(std::min<std::size_t>(2, item.size()));
+  } else {
+    dir = item;
+    if (dir.is_relative()) dir = r.ini().directory() / dir;
+  }
+  dir = absolute_dir(dir);
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    r.warning(section, key,
+              "'" + printable(dir.string()) +
+                  "' is not a directory (yet): no program opens from there until it is one");
+  }
+  return dir;
+}
+
 }  // namespace
+
+void load_program_dirs(TypedReader& r, MachineConfig& c, const LoadOptions& options) {
+  const auto add = [&](std::string_view section, std::string_view key, std::string_view item) {
+    item = trim(item);
+    if (item.empty()) return;
+    if (auto dir = program_dir(r, section, key, item, options)) {
+      c.program_dirs.push_back(std::move(*dir));
+    }
+  };
+  const std::string prefix = r.text("DISPLAY", "PROGRAM_PREFIX").value_or("");
+  const std::string dirs = r.text("CNCD", "PROGRAM_DIRS").value_or("");
+  add("DISPLAY", "PROGRAM_PREFIX", prefix);
+  std::string_view rest = dirs;
+  while (!rest.empty()) {
+    const std::size_t colon = rest.find(':');
+    add("CNCD", "PROGRAM_DIRS", rest.substr(0, colon));
+    if (colon == std::string_view::npos) break;
+    rest.remove_prefix(colon + 1);
+  }
+  // Neither given: programs kept beside the machine's INI, and nothing else on the system.
+  if (trim(prefix).empty() && trim(dirs).empty()) {
+    c.program_dirs.push_back(absolute_dir(r.ini().directory()));
+  }
+}
 
 void load_general(TypedReader& r, MachineConfig& c) {
   c.machine_name = r.text("EMC", "MACHINE").value_or("");

@@ -12,6 +12,8 @@ namespace cncd::config {
 
 // [EMC] [EMCMOT] [TASK] [RS274NGC] [EMCIO] [TRAJ] [DISPLAY] [CNCD]
 void load_general(TypedReader& reader, MachineConfig& config);
+// [DISPLAY] PROGRAM_PREFIX and [CNCD] PROGRAM_DIRS (LoadOptions::getenv gives $HOME for ~).
+void load_program_dirs(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
 // [CNCD] STATE_DIR and where the parameter, tool and position files live.
 void load_state_files(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
 // [KINS], the joint map, [AXIS_L] and [JOINT_n]; fills the [TRAJ] limits left unset.

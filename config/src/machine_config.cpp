@@ -56,6 +56,7 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
   MachineConfig config;
   config.path = ini_path;
   load_general(reader, config);
+  load_program_dirs(reader, config, options);
   load_state_files(reader, config, options);
   if (check_sections(reader)) {
     load_motion(reader, config);

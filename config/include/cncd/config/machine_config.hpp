@@ -141,11 +141,15 @@ struct MachineConfig {
   double max_feed_override = 1.0;  // 1.0 = 100 %
   double min_spindle_override = 1.0;
   double max_spindle_override = 1.0;
+  // The directories program.open opens programs from (and from below): [DISPLAY]
+  // PROGRAM_PREFIX, then [CNCD] PROGRAM_DIRS, absolute; neither given: the INI's own
+  // directory. Symlinks are resolved when a program is opened, not here.
+  std::vector<std::filesystem::path> program_dirs;
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
   // Every key of the file with its source, for lookups of keys this struct does not type
-  // (e.g. [DISPLAY] PROGRAM_PREFIX) and to list unused keys. Null when built by hand.
+  // and to list unused keys. Null when built by hand.
   std::shared_ptr<const IniFile> ini;
 
   const AxisConfig& axis(char letter) const {
