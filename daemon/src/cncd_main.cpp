@@ -135,6 +135,10 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
     spdlog::info("state files in {} ({})", config.cncd.state_dir.string(),
                  config.cncd.state_dir_origin);
   }
+  std::string program_dirs;
+  for (const auto& dir : config.program_dirs)
+    program_dirs += (program_dirs.empty() ? "" : ", ") + dir.string();
+  spdlog::info("programs open from {}", program_dirs.empty() ? "nowhere" : program_dirs);
   for (const auto& note : notes) {
     if (note.warning) {
       spdlog::warn("{}", note.text);

@@ -127,6 +127,10 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     if (session.in_batch) throw RpcError(kInvalidRequest, "program.open cannot be part of a batch");
     const auto path = params["path"].get<std::string>();
     if (path.empty()) throw RpcError(kInvalidParams, "parameter \"path\" must not be empty");
+    // The system calls would see the path end there: another file than the one named.
+    if (path.find('\0') != std::string::npos) {
+      throw RpcError(kInvalidParams, "parameter \"path\" must not contain a NUL character");
+    }
     const auto token = completions.next_token();
     task.open_program(path, token);
     session.defer_token = token;

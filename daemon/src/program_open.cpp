@@ -3,10 +3,10 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <filesystem>
 #include <fstream>
 
 #include "program_check.hpp"
+#include "program_dirs.hpp"
 #include "rpc.hpp"
 
 namespace cncd::daemon {
@@ -41,13 +41,9 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
     out.error_message = std::move(message);
     return out;
   };
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(request.path, ec)) {
-    return fail(kProgramError, "cannot open program '" + request.path + "': no such file");
-  }
-  if (!std::ifstream(request.path)) {
-    return fail(kProgramError, "cannot open program '" + request.path + "': not readable");
-  }
+  const ProgramFile file = find_program(request.path, request.program_dirs);
+  if (!file.error.empty()) return fail(kProgramError, file.error);
+  out.path = file.path;
   CheckOptions options;
   options.interp = request.interp;
   options.machine = &machine;
@@ -56,7 +52,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   options.max_seconds = ProgramOpener::kMaxCheckSeconds;
   options.max_seconds_cpu = true;
   options.cancel = &cancel;
-  const CheckReport report = check_program(request.path, options);
+  const CheckReport report = check_program(file.path, options);
   if (report.cancelled) return out;  // nobody waits for it
   if (report.stopped) out.warnings.push_back(report.stopped->to_string());
   if (report.limit_violations > 0) {
@@ -67,7 +63,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
     return fail(kProgramError, std::move(message));
   }
   if (report.error) return fail(kProgramError, report.error->to_string());
-  out.lines = count_lines(request.path, cancel);
+  out.lines = count_lines(file.path, cancel);
   return out;
 }
 

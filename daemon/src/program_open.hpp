@@ -10,6 +10,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <filesystem>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -22,7 +23,8 @@
 namespace cncd::daemon {
 
 struct OpenRequest {
-  std::string path;  // as the client gave it
+  std::string path;                                 // as the client gave it
+  std::vector<std::filesystem::path> program_dirs;  // MachineConfig::program_dirs
   interp::InterpOptions interp;
   // Where the machine stood when program.open arrived (machine coordinates and units): the
   // check starts there.
@@ -33,7 +35,7 @@ struct OpenOutcome {
   std::uint64_t job = 0;
   int error_code = 0;  // 0: the program passed and may be opened
   std::string error_message;
-  std::string path;  // the program file
+  std::string path;  // the program file, symlinks resolved
   std::uint64_t lines = 0;
   // For the event log: the check stopped before the program's end (its time budget).
   std::vector<std::string> warnings;

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "program_check.hpp"
+#include "program_dirs.hpp"
 #include "rpc.hpp"
 
 namespace cncd::daemon {
@@ -104,7 +105,10 @@ void Task::run_program(int from_line, bool step) {
   if (!config_.no_force_homing && !all_homed(status)) {
     throw RpcError(kNotHomed, "all joints must be homed before running a program");
   }
-  if (auto error = interp_->open(program_path_)) {
+  // Checked again: a directory on the way may have been replaced by a symlink leading out.
+  const ProgramFile file = find_program(program_path_, config_.program_dirs);
+  if (!file.error.empty()) throw RpcError(kProgramError, file.error);
+  if (auto error = interp_->open(file.path)) {
     throw RpcError(kProgramError, error->to_string());
   }
   start_run(Mode::automatic, status);

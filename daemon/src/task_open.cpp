@@ -24,6 +24,7 @@ void Task::open_program(const std::string& path, std::uint64_t token) {
   }
   OpenRequest request;
   request.path = path;
+  request.program_dirs = config_.program_dirs;
   request.interp = interpreter_options(config_);
   std::copy(status.commanded.begin(), status.commanded.end(), request.start.begin());
   cancel_open("cancelled: replaced by a newer program.open of '" + path + "'");

@@ -24,7 +24,7 @@ std::string ini_with_groups() {
   std::ifstream in(std::string(CNCD_SOURCE_DIR) + "/config/examples/sim_mm.ini");
   std::stringstream text;
   text << in.rdbuf();
-  std::string ini = text.str();
+  std::string ini = relocate_example_ini(text.str());
   const std::string lines = "READ_GROUP = users\nCONTROL_GROUP = dialout\n";
   const auto section = ini.find("[CNCD]\n");
   if (section == std::string::npos) {

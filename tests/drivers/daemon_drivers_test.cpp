@@ -148,7 +148,7 @@ json run_example(const TempDir& dir, const std::string& ini) {
 // The example INI with its files redirected into `dir`.
 std::string adapt(const TempDir& dir, const std::string& name,
                   const std::vector<std::pair<std::string, std::string>>& replace) {
-  std::string text = slurp(kExamples + name);
+  std::string text = relocate_example_ini(slurp(kExamples + name));
   for (const auto& [from, to] : replace) {
     auto at = text.find(from);
     EXPECT_NE(at, std::string::npos) << from;

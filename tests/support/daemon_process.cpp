@@ -85,12 +85,30 @@ std::filesystem::path copy_example_machine(const std::filesystem::path& dir,
                                            const std::string& name) {
   const std::filesystem::path examples = std::filesystem::path(CNCD_SOURCE_DIR) / "config/examples";
   for (const auto& entry : std::filesystem::directory_iterator(examples)) {
-    if (entry.path().stem() == name) {
+    if (entry.path().stem() != name) continue;
+    if (entry.path().extension() == ".ini") {
+      std::ofstream(dir / entry.path().filename(), std::ios::trunc)
+          << relocate_example_ini(slurp(entry.path()));
+    } else {
       std::filesystem::copy_file(entry.path(), dir / entry.path().filename(),
                                  std::filesystem::copy_options::overwrite_existing);
     }
   }
   return dir / (name + ".ini");
+}
+
+std::string relocate_example_ini(std::string text) {
+  const std::string prefix = "PROGRAM_PREFIX = ../../examples";
+  if (const auto at = text.find(prefix); at != std::string::npos) {
+    text.replace(at, prefix.size(), "PROGRAM_PREFIX = " CNCD_SOURCE_DIR "/examples");
+  }
+  const std::string section = "[CNCD]\n";
+  if (const auto at = text.find(section); at != std::string::npos) {
+    text.insert(at + section.size(), "PROGRAM_DIRS = .\n");
+  } else {
+    text += "\n[CNCD]\nPROGRAM_DIRS = .\n";
+  }
+  return text;
 }
 
 CommandResult run_command(const std::vector<std::string>& argv) {

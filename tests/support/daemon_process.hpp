@@ -27,9 +27,16 @@ class TempDir {
 std::string slurp(const std::filesystem::path& path);
 
 // Copies config/examples/<name>.* (INI, parameter and tool files) into `dir`, so that a
-// daemon under test writes its state there and not into the source tree. Returns the INI.
+// daemon under test writes its state there and not into the source tree. Returns the INI,
+// made to run from there as relocate_example_ini() does.
 std::filesystem::path copy_example_machine(const std::filesystem::path& dir,
                                            const std::string& name = "sim_mm");
+
+// The text of an example INI made to run from another directory: its program directory
+// ([DISPLAY] PROGRAM_PREFIX, relative to config/examples) is the source tree's examples/
+// again, and the directory the copy is written to is a program directory too ([CNCD]
+// PROGRAM_DIRS = .), for the programs tests write beside it.
+std::string relocate_example_ini(std::string text);
 
 struct CommandResult {
   int exit_status = -1;  // exit code, or 128 + signal
