@@ -16,9 +16,15 @@
 
 #include "cncd/motion/planner.hpp"
 
+// GCC names the sanitizers with macros, clang through __has_feature.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define CNCD_SANITIZED 1
-#else
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define CNCD_SANITIZED 1
+#endif
+#endif
+#ifndef CNCD_SANITIZED
 #define CNCD_SANITIZED 0
 #endif
 
