@@ -53,11 +53,20 @@ Request request_of(const json& value) {
 }
 
 bool known_code(int code) {
-  static const std::set<int> codes = {
-      daemon::kParseError,       daemon::kInvalidRequest,  daemon::kMethodNotFound,
-      daemon::kInvalidParams,    daemon::kInternalError,   daemon::kWrongState,
-      daemon::kNotHomed,         daemon::kProgramError,    daemon::kBusy,
-      daemon::kPermissionDenied, daemon::kRequestTooLarge, daemon::kFileError};
+  static const std::set<int> codes = {daemon::kParseError,
+                                      daemon::kInvalidRequest,
+                                      daemon::kMethodNotFound,
+                                      daemon::kInvalidParams,
+                                      daemon::kInternalError,
+                                      daemon::kWrongState,
+                                      daemon::kNotHomed,
+                                      daemon::kProgramError,
+                                      daemon::kBusy,
+                                      daemon::kPermissionDenied,
+                                      daemon::kRequestTooLarge,
+                                      daemon::kFileError,
+                                      daemon::kFault,
+                                      daemon::kCancelled};
   return codes.contains(code);
 }
 

@@ -145,10 +145,11 @@ TEST(InterpreterApi, AFailedParameterSaveLeavesNoTemporaryFile) {
   const auto dir = temp_file("blocked", "");
   std::filesystem::remove(dir);
   const auto var = dir / "params.var";
-  std::filesystem::create_directories(var / "in_the_way");
+  std::filesystem::create_directories(dir);
   InterpOptions options;
   options.parameter_file = var;
-  Interpreter interp(options);
+  Interpreter interp(options);  // no file yet: the defaults, and the file is made at save
+  std::filesystem::create_directories(var / "in_the_way");
   const auto error = interp.save_parameters();
   ASSERT_TRUE(error);
   EXPECT_NE(error->message.find("Unable to replace parameter file"), std::string::npos)
