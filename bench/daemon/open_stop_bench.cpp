@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
       const std::string answer = read_answer(c, std::chrono::seconds(60));
       if (answer.find("\"result\"") != std::string::npos) {
         opened.fetch_add(1);
-      } else if (answer.find("1008") != std::string::npos) {
+      } else if (answer.find("1009") != std::string::npos) {
         cancelled.fetch_add(1);
       } else {
         if (refused.fetch_add(1) == 0) std::fprintf(stderr, "first refusal: %s\n", answer.c_str());
