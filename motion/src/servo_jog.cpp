@@ -23,7 +23,7 @@ void ServoLoop::apply_jog(const Command& command) noexcept {
   const char* refusal = nullptr;
   if (status_.machine != MachineState::on) {
     refusal = "the machine is not on";
-  } else if (path_pending() || homing_.active()) {
+  } else if (path_.pending() || homing_.active()) {
     refusal = "the machine is moving";
   } else if (command.axis < 0 || command.axis >= kAxes) {
     refusal = "the machine has no such axis";

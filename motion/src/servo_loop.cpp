@@ -38,21 +38,11 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       drivers_(std::move(drivers)),
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
       joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
+      path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config),
       history_(joint_count_, history_depth(drivers_, config.servo_period_ns)) {
   joint_axis_.fill(-1);
-  if (config.scurve) {
-    // The acceleration must take at least kMinRampPeriods servo periods to build up on every
-    // axis: steeper S-curves, which the period-by-period steps cannot follow within the axis
-    // limits, are planned as trapezoids (cncd --check-config says so).
-    double accel = 1e300;
-    for (const auto& axis : config.axes) {
-      if (axis.present && axis.max_acceleration > 0) accel = std::min(accel, axis.max_acceleration);
-    }
-    if (config.max_linear_jerk * period_s_ * kMinRampPeriods <= accel)
-      jerk_ = config.max_linear_jerk;
-  }
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
         config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
@@ -120,30 +110,8 @@ void ServoLoop::latch_fault(const char* reason) noexcept {
            nullptr);
 }
 
-void ServoLoop::flush_queue() noexcept {
-  Segment dropped;
-  has_active_ = false;
-  for (; window_count_ > 0; --window_count_, ++head_seq_) {
-    ++status_.segments_done;
-    status_.moves_done += window_at(head_seq_).moves;
-  }
-  window_length_ = 0;
-  stop_length_ = 0;
-  floor_first_ = floor_end_ = 0;
-  pass_active_ = false;
-  while (segments_.pop(dropped)) {
-    ++status_.segments_done;
-    status_.moves_done += dropped.moves;
-  }
-  path_s_ = 0;
-  path_v_ = 0;
-  path_a_ = 0;
-  pause_requested_ = false;
-  abort_requested_ = false;
-}
-
 void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
-  flush_queue();
+  path_.flush();
   homing_.stop_now();
   jog_.halt();
   // VOLATILE_HOME joints lose their home whenever the drives turn off.
@@ -185,29 +153,26 @@ void ServoLoop::apply(const Command& command) noexcept {
       start_homing(command.joint_mask);
       break;
     case Command::Kind::abort:
-      if (path_pending()) abort_requested_ = true;
+      path_.abort();
       homing_.abort();
       jog_.stop_all();
-      soft_limits_changed();
       break;
     case Command::Kind::pause:
-      pause_requested_ = true;
-      soft_limits_changed();
+      path_.pause();
       break;
     case Command::Kind::resume:
-      pause_requested_ = false;
-      soft_limits_changed();
+      path_.resume();
       break;
     case Command::Kind::feed_override:
       // The controller clamps; a NaN would stall every later move.
       if (std::isfinite(command.velocity))
         status_.feed_override = std::clamp(command.velocity, 0.0, config_.max_feed_override);
-      soft_limits_changed();
+      path_.set_overrides(status_.feed_override, status_.rapid_override);
       break;
     case Command::Kind::rapid_override:
       if (std::isfinite(command.velocity))
         status_.rapid_override = std::clamp(command.velocity, 0.0, 1.0);
-      soft_limits_changed();
+      path_.set_overrides(status_.feed_override, status_.rapid_override);
       break;
     case Command::Kind::jog_start:
     case Command::Kind::jog_increment:
@@ -220,7 +185,7 @@ void ServoLoop::apply(const Command& command) noexcept {
 void ServoLoop::start_homing(std::uint32_t mask) noexcept {
   if (status_.machine != MachineState::on) {
     post(Event::Level::warning, "home ignored: the machine is not on");
-  } else if (path_pending() || homing_.active() || jog_.active()) {
+  } else if (path_.pending() || homing_.active() || jog_.active()) {
     post(Event::Level::warning, "home ignored: the machine is moving");
   } else if (!homing_.start(mask, joints_)) {
     latch_fault(homing_.error());
@@ -249,6 +214,47 @@ void ServoLoop::advance_homing() noexcept {
   }
   // Axes follow their joints while homing (trivkins: the first joint of an axis leads).
   sync_axes_from_joints();
+}
+
+int ServoLoop::joint_apart() const noexcept {
+  for (int j = 0; j < joint_count_; ++j) {
+    const int axis = joint_axis_[static_cast<std::size_t>(j)];
+    if (axis < 0) continue;
+    if (std::abs(joints_.command[static_cast<std::size_t>(j)] -
+                 axis_pose_[static_cast<std::size_t>(axis)]) > 1e-6)
+      return j;
+  }
+  return -1;
+}
+
+void ServoLoop::advance_path() noexcept {
+  // Checked only from rest: while a move runs, the joints follow their axes.
+  const int apart = path_.active() ? -1 : joint_apart();
+  const PathExecutor::Result result = path_.advance(period_s_, axis_pose_, apart >= 0);
+  status_.line = path_.line();
+  status_.velocity = path_.velocity();
+  status_.distance_to_go = path_.distance_to_go();
+  status_.motion = path_.motion();
+  if (result.fault == PathExecutor::Fault::joints_apart) {
+    char text[120];
+    std::snprintf(text, sizeof text,
+                  "joint %d stands apart from axis %c: home the joints of an axis together, "
+                  "to the same HOME",
+                  apart,
+                  config::kAxisLetters[static_cast<std::size_t>(
+                      joint_axis_[static_cast<std::size_t>(apart)])]);
+    latch_fault(text);
+  } else if (result.fault == PathExecutor::Fault::off_path) {
+    latch_fault("a queued move does not start where the machine stands");
+  }
+  // Joints follow the path only while it moves: at rest they keep what homing left (a gantry
+  // joint homed apart is caught, not jumped, when the next move starts).
+  if (!result.moved) return;
+  for (int j = 0; j < joint_count_; ++j) {
+    const int axis = joint_axis_[static_cast<std::size_t>(j)];
+    if (axis >= 0)
+      joints_.command[static_cast<std::size_t>(j)] = axis_pose_[static_cast<std::size_t>(axis)];
+  }
 }
 
 void ServoLoop::sync_axes_from_joints() noexcept {
@@ -291,16 +297,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     } else if (jog_.active()) {
       advance_jog();
     } else {
-      // Joints follow the path only while it moves: at rest they keep what homing left
-      // (a gantry joint homed apart is caught, not jumped, when the next move starts).
-      if (advance_path(period_s_)) {
-        for (int j = 0; j < joint_count_; ++j) {
-          const int axis = joint_axis_[static_cast<std::size_t>(j)];
-          if (axis >= 0)
-            joints_.command[static_cast<std::size_t>(j)] =
-                axis_pose_[static_cast<std::size_t>(axis)];
-        }
-      }
+      advance_path();
     }
   } else {
     // Drives off: the command follows the machine wherever it is pushed.

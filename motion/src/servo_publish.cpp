@@ -10,8 +10,9 @@ constexpr double kAtSoftLimit = 1e-6;
 void ServoLoop::publish() noexcept {
   status_.sequence = status_.rt.cycles;
   status_.commanded = axis_pose_;
-  status_.queued =
-      static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
+  status_.queued = path_.queued();
+  status_.segments_done = path_.segments_done();
+  status_.moves_done = path_.moves_done();
   status_.homed = joints_.homed;
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {

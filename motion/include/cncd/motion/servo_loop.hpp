@@ -12,10 +12,9 @@
 #include "cncd/motion/command_history.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
+#include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/rt_stats.hpp"
-#include "cncd/motion/segment.hpp"
 #include "cncd/motion/seqlock.hpp"
-#include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
 
 namespace cncd::motion {
@@ -59,7 +58,7 @@ struct DriverBinding {
 
 class ServoLoop {
  public:
-  using SegmentRing = SpscRing<Segment, 1024>;
+  using SegmentRing = PathExecutor::SegmentRing;
   using CommandRing = SpscRing<Command, 64>;
   using EventRing = SpscRing<Event, 64>;
 
@@ -71,7 +70,7 @@ class ServoLoop {
   void cycle(std::int64_t wake_error_ns) noexcept;
 
   // Producer: the planner (task thread). Consumer: the servo thread.
-  SegmentRing& segments() noexcept { return segments_; }
+  SegmentRing& segments() noexcept { return path_.segments(); }
   // Producer: the task thread. Consumer: the servo thread.
   CommandRing& commands() noexcept { return commands_; }
   // Producer: the servo thread. Consumer: the task thread.
@@ -89,41 +88,10 @@ class ServoLoop {
   void apply(const Command& command) noexcept;
   void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
-  void flush_queue() noexcept;
-  bool advance_path(double dt) noexcept;                      // true: a move ran this period
-  bool starts_here(const Segment& segment) noexcept;          // false: fault latched
-  bool joints_on_their_axes() noexcept;                       // false: fault latched
-  double speed_limit(const Segment& segment) const noexcept;  // with overrides and holds
-  // Path motion under way or waiting, in the look-ahead window or in the ring.
-  bool path_pending() const noexcept { return window_count_ > 0 || segments_.size() > 0; }
-  Segment& window_at(std::uint64_t seq) noexcept {
-    return window_[static_cast<std::size_t>(seq % kWindow)];
-  }
-  // Takes segments from the ring while the window holds less than the path needs to stop
-  // from its fastest speed, and brings the exit speeds up to date, within this period's work
-  // budget.
-  void fill_window() noexcept;
-  // Continues the backward pass over the exit speeds for up to pass_budget_ steps.
-  void run_pass() noexcept;
-  // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
-  void soft_limits_changed() noexcept;
-  void finish_front() noexcept;          // the window's first segment is done
-  double window_floor_accel() noexcept;  // the smallest acceleration limit in the window
-  // S-curve profiles (servo_scurve.cpp): one period of path motion whose acceleration changes
-  // by at most jerk_ per second, through as many segments as it covers. Spends all of `dt`.
-  void scurve_step(double& dt) noexcept;
-  // The speed limits ahead of the path's position into limits_, as far as the path, `ds`
-  // further on at speed `v` and acceleration `a`, could need to slow down for them.
-  void gather_limits(double ds, double v, double a) noexcept;
-  // Whether a step from `v_before`, `a_before` to speed `v` and acceleration `a`, `ds` further on,
-  // keeps every limit gathered (the hard ones only when `soft` is false): those it passes, and
-  // those ahead it can still slow down for; with `speeds_only`, the speeds alone and not the
-  // coming segments' acceleration limits.
-  bool keeps_limits(double v_before, double a_before, double v, double a, double ds, bool soft,
-                    bool speeds_only = false) const noexcept;
-  // Whether a deceleration `a` at speed `v`, `ds` further on, can ease off to every coming
-  // segment's own acceleration limit before reaching it.
-  bool eases_in_time(double v, double a, double ds) const noexcept;
+  // Path motion for one period; false when the path faulted.
+  void advance_path() noexcept;
+  // The first joint whose command stands apart from its axis's position, or -1.
+  int joint_apart() const noexcept;
   void advance_homing() noexcept;
   void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   void advance_jog() noexcept;
@@ -151,65 +119,15 @@ class ServoLoop {
   std::array<int, kJoints> joint_axis_{};                 // axis index a joint follows, -1 = none
   std::array<drivers::Driver*, kJoints> joint_driver_{};  // the driver a joint belongs to
 
-  SegmentRing segments_;
   CommandRing commands_;
   EventRing events_;
   Seqlock<Status> published_;
 
   Status status_{};
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
-  // Look-ahead window: the segments taken from the ring, oldest first; the first is being
-  // executed once has_active_. Segment sequence number n lives in window_[n % kWindow];
-  // head_seq_ is the first's. exit_hard_ is the fastest speed at a segment's end from which
-  // the path can still stop within the window under the axis limits alone, exit_soft_ the
-  // same with the feed, the overrides and holds: the window's last segment always ends at
-  // rest. Both are kept by an incremental backward pass.
-  static constexpr int kWindow = 2048;
-  static constexpr int kPassBudget = 4096;  // pass steps and ring pops per period
-  static constexpr int kMaxPulls = 256;     // ring pops per period (each copies a segment)
-  bool has_active_ = false;
-  std::array<Segment, kWindow> window_{};
-  std::array<double, kWindow> exit_hard_{};
-  std::array<double, kWindow> exit_soft_{};
-  std::uint64_t head_seq_ = 0;
-  int window_count_ = 0;
-  double window_length_ = 0;  // path length of the window's segments
-  double stop_length_ = 0;    // longest stopping distance of the window's segments
-  // The window's segments (dwells aside) whose acceleration limit is below that of every later
-  // one, oldest first, in a ring indexed by the two counters: the first has the window's
-  // smallest limit (S-curve profiles: how far ahead a limit can bind).
-  std::array<std::uint64_t, kWindow> floor_seq_{};
-  std::uint64_t floor_first_ = 0;
-  std::uint64_t floor_end_ = 0;
-  bool pass_active_ = false;
-  std::uint64_t pass_seq_ = 0;    // next segment whose exit speeds the pass recomputes
-  std::uint64_t pass_floor_ = 0;  // the pass goes at least this far back
-  int pass_budget_ = 0;
-  int pulls_left_ = 0;
-  double path_s_ = 0;
-  double path_v_ = 0;
-  double path_a_ = 0;  // S-curve profiles only
-  // S-curve profiles: the path's jerk limit (0: trapezoidal profiles) and the limits ahead.
-  double jerk_ = 0;
-  static constexpr double kMinRampPeriods = 20;
-  struct SpeedLimit {
-    double distance;  // from the path's position
-    double soft;      // with the feed, the overrides and holds
-    double hard;      // of the axes alone
-    double accel;     // smallest path acceleration limit of the segments up to there
-    double entry;     // the acceleration limit of the segment that starts there
-    bool soft_on;     // whether the soft (hard) speed binds: no nearer limit is as low
-    bool hard_on;
-  };
-  static constexpr int kMaxLimits = 1024;
-  std::array<SpeedLimit, kMaxLimits> limits_{};
-  int limit_count_ = 0;
-  double cap_soft_ = 0, cap_hard_ = 0;  // the active segment's own speed limits
-  double dwell_elapsed_s_ = 0;
-  bool pause_requested_ = false;
-  bool abort_requested_ = false;
   AxisPose axis_pose_{};
   JointIo joints_{};
+  PathExecutor path_;
   Homing homing_;
   Jog jog_;
   // Servo cycles counted from 1 (drivers::JointCommand::cycle), and every joint's motor

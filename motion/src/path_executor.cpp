@@ -1,63 +1,107 @@
-// The path part of the servo loop: taking queued segments and sampling them in time.
-#include "cncd/motion/servo_loop.hpp"
+// Path execution: taking queued segments into the look-ahead window and sampling them in time.
+#include "cncd/motion/path_executor.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "profile.hpp"
 
 namespace cncd::motion {
 
-bool ServoLoop::starts_here(const Segment& segment) noexcept {
+PathExecutor::PathExecutor(const config::MachineConfig& config, double period_s)
+    : period_s_(period_s) {
+  if (config.scurve) {
+    // The acceleration must take at least kMinRampPeriods servo periods to build up on every
+    // axis: steeper S-curves, which the period-by-period steps cannot follow within the axis
+    // limits, are planned as trapezoids (cncd --check-config says so).
+    double accel = 1e300;
+    for (const auto& axis : config.axes) {
+      if (axis.present && axis.max_acceleration > 0) accel = std::min(accel, axis.max_acceleration);
+    }
+    if (config.max_linear_jerk * period_s_ * kMinRampPeriods <= accel)
+      jerk_ = config.max_linear_jerk;
+  }
+}
+
+void PathExecutor::flush() noexcept {
+  Segment dropped;
+  has_active_ = false;
+  for (; window_count_ > 0; --window_count_, ++head_seq_) {
+    ++segments_done_;
+    moves_done_ += window_at(head_seq_).moves;
+  }
+  window_length_ = 0;
+  stop_length_ = 0;
+  floor_first_ = floor_end_ = 0;
+  pass_active_ = false;
+  while (segments_.pop(dropped)) {
+    ++segments_done_;
+    moves_done_ += dropped.moves;
+  }
+  path_s_ = 0;
+  path_v_ = 0;
+  path_a_ = 0;
+  pause_requested_ = false;
+  abort_requested_ = false;
+}
+
+void PathExecutor::fail(Fault fault) noexcept {
+  fault_ = fault;
+  flush();
+  velocity_ = 0;
+  distance_to_go_ = 0;
+  motion_ = MotionState::idle;
+}
+
+void PathExecutor::abort() noexcept {
+  if (pending()) abort_requested_ = true;
+  soft_limits_changed();
+}
+
+void PathExecutor::pause() noexcept {
+  pause_requested_ = true;
+  soft_limits_changed();
+}
+
+void PathExecutor::resume() noexcept {
+  pause_requested_ = false;
+  soft_limits_changed();
+}
+
+void PathExecutor::set_overrides(double feed, double rapid) noexcept {
+  feed_override_ = feed;
+  rapid_override_ = rapid;
+  soft_limits_changed();
+}
+
+bool PathExecutor::starts_here(const Segment& segment, const AxisPose& pose) noexcept {
   for (int i = 0; i < kAxes; ++i) {
-    if (std::abs(segment.start[i] - axis_pose_[i]) > 1e-6) {
+    if (std::abs(segment.start[i] - pose[i]) > 1e-6) {
       // Following it would jump the motors to its start: the planner is out of step.
-      latch_fault("a queued move does not start where the machine stands");
+      fail(Fault::off_path);
       return false;
     }
   }
   return true;
 }
 
-bool ServoLoop::joints_on_their_axes() noexcept {
-  // Path motion drives every joint of an axis to the axis position: a gantry joint homed
-  // apart from its twin (or to another HOME) would jump.
-  for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis < 0) continue;
-    if (std::abs(joints_.command[static_cast<std::size_t>(j)] -
-                 axis_pose_[static_cast<std::size_t>(axis)]) > 1e-6) {
-      char text[120];
-      std::snprintf(text, sizeof text,
-                    "joint %d stands apart from axis %c: home the joints of an axis together, "
-                    "to the same HOME",
-                    j, config::kAxisLetters[static_cast<std::size_t>(axis)]);
-      latch_fault(text);
-      return false;
-    }
-  }
-  return true;
-}
-
-double ServoLoop::speed_limit(const Segment& segment) const noexcept {
+double PathExecutor::speed_limit(const Segment& segment) const noexcept {
   if (pause_requested_ || abort_requested_) return 0.0;
   // Overrides only ever lower the speed below what the axes allow (a feed override above 1
   // raises the feed, never the axis limit); the profile decelerates within the segment's
   // acceleration when the limit drops under the current speed.
-  if (segment.feed > 0)
-    return std::min(segment.axis_velocity, segment.feed * status_.feed_override);
-  return segment.axis_velocity * status_.rapid_override;
+  if (segment.feed > 0) return std::min(segment.axis_velocity, segment.feed * feed_override_);
+  return segment.axis_velocity * rapid_override_;
 }
 
-void ServoLoop::soft_limits_changed() noexcept {
+void PathExecutor::soft_limits_changed() noexcept {
   if (window_count_ < 2) return;
   pass_active_ = true;
   pass_seq_ = head_seq_ + static_cast<std::uint64_t>(window_count_) - 2;
   pass_floor_ = head_seq_;
 }
 
-void ServoLoop::run_pass() noexcept {
+void PathExecutor::run_pass() noexcept {
   // Backwards from the end: a segment's exit speed is what the junction allows (0 unless the
   // planner found the next segment tangent) and what the next segment can slow down from
   // to its own exit speed. Values only rise as the window grows, so a segment whose speeds
@@ -93,7 +137,7 @@ void ServoLoop::run_pass() noexcept {
   }
 }
 
-void ServoLoop::fill_window() noexcept {
+void PathExecutor::fill_window() noexcept {
   for (;;) {
     run_pass();
     if (pass_active_) return;  // out of budget: the exit speeds so far are safe, only low
@@ -144,10 +188,10 @@ void ServoLoop::fill_window() noexcept {
   }
 }
 
-void ServoLoop::finish_front() noexcept {
+void PathExecutor::finish_front() noexcept {
   const Segment& done = window_at(head_seq_);
-  ++status_.segments_done;
-  status_.moves_done += done.moves;
+  ++segments_done_;
+  moves_done_ += done.moves;
   window_length_ = std::max(0.0, window_length_ - done.length);
   if (floor_end_ > floor_first_ && floor_seq_[floor_first_ % kWindow] == head_seq_) ++floor_first_;
   ++head_seq_;
@@ -155,12 +199,13 @@ void ServoLoop::finish_front() noexcept {
   has_active_ = false;
 }
 
-double ServoLoop::window_floor_accel() noexcept {
+double PathExecutor::window_floor_accel() noexcept {
   return floor_end_ > floor_first_ ? window_at(floor_seq_[floor_first_ % kWindow]).max_acceleration
                                    : 0.0;
 }
 
-bool ServoLoop::advance_path(double dt) noexcept {
+PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joints_apart) noexcept {
+  fault_ = Fault::none;
   // Joints and axes agree at the start of a period (not between two moves inside one).
   bool resting = !has_active_;
   bool moved = has_active_;
@@ -175,14 +220,20 @@ bool ServoLoop::advance_path(double dt) noexcept {
       if (window_count_ == 0) fill_window();
       if ((abort_requested_ && path_v_ <= 0) || window_count_ == 0) break;
       has_active_ = true;
-      if ((resting && !joints_on_their_axes()) || !starts_here(window_at(head_seq_))) return false;
+      // Path motion drives every joint of an axis to the axis position: a gantry joint homed
+      // apart from its twin (or to another HOME) would jump.
+      if (resting && joints_apart) {
+        fail(Fault::joints_apart);
+        return {false, fault_};
+      }
+      if (!starts_here(window_at(head_seq_), pose)) return {false, fault_};
       resting = false;
       moved = true;
       path_s_ = 0;
       dwell_elapsed_s_ = 0;
     }
     const Segment& active = window_at(head_seq_);
-    status_.line = active.line;
+    line_ = active.line;
     bool done;
     if (active.kind == Segment::Kind::dwell) {
       if (abort_requested_) {
@@ -199,35 +250,35 @@ bool ServoLoop::advance_path(double dt) noexcept {
       path_v_ = 0;
       path_a_ = 0;
     } else if (jerk_ > 0) {
-      scurve_step(dt);
+      scurve_step(dt, pose);
       break;
     } else {
       const std::size_t i = static_cast<std::size_t>(head_seq_ % kWindow);
       done = advance_profile(path_s_, path_v_, active.length, speed_limit(active),
                              active.max_acceleration, std::min(exit_soft_[i], exit_hard_[i]), dt);
-      axis_pose_ = done ? active.end : active.point_at(path_s_);
+      pose = done ? active.end : active.point_at(path_s_);
       if (done && exit_hard_[i] <= 0) path_v_ = 0;
     }
     if (!done) break;
     finish_front();
   }
-  status_.velocity = path_v_;
-  status_.distance_to_go = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell
-                               ? window_at(head_seq_).length - path_s_
-                               : 0.0;
+  velocity_ = path_v_;
+  distance_to_go_ = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell
+                        ? window_at(head_seq_).length - path_s_
+                        : 0.0;
   if (abort_requested_ && path_v_ == 0) {
-    flush_queue();
-    status_.motion = MotionState::idle;
-    return moved;
+    flush();
+    motion_ = MotionState::idle;
+    return {moved, fault_};
   }
-  if (!path_pending()) {
-    status_.motion = MotionState::idle;
+  if (!pending()) {
+    motion_ = MotionState::idle;
   } else if (pause_requested_) {
-    status_.motion = path_v_ == 0 ? MotionState::paused : MotionState::pausing;
+    motion_ = path_v_ == 0 ? MotionState::paused : MotionState::pausing;
   } else {
-    status_.motion = abort_requested_ ? MotionState::stopping : MotionState::moving;
+    motion_ = abort_requested_ ? MotionState::stopping : MotionState::moving;
   }
-  return moved;
+  return {moved, fault_};
 }
 
 }  // namespace cncd::motion

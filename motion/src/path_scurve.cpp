@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "cncd/motion/servo_loop.hpp"
+#include "cncd/motion/path_executor.hpp"
 #include "scurve.hpp"
 
 namespace cncd::motion {
@@ -39,7 +39,7 @@ constexpr int kSearchSteps = 14;
 //   (settle_speed), from where no braking is needed for m, and until then j comes first.
 //   Whether it is depends on the two speeds alone, never on where the path stands; once j
 //   is passed, m is on again from a state that meets it with nothing to brake.
-void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
+void PathExecutor::gather_limits(double ds, double v, double a) noexcept {
   limit_count_ = 0;
   const double jerk = kPlanJerkShare * jerk_;
   const Segment& head = window_at(head_seq_);
@@ -93,8 +93,8 @@ void ServoLoop::gather_limits(double ds, double v, double a) noexcept {
   }
 }
 
-bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double a, double ds,
-                             bool soft, bool speeds_only) const noexcept {
+bool PathExecutor::keeps_limits(double v_before, double a_before, double v, double a, double ds,
+                                bool soft, bool speeds_only) const noexcept {
   const double jerk = kPlanJerkShare * jerk_;
   const double cap = soft ? cap_soft_ : cap_hard_;
   if (scurve::settle_speed(v, std::max(a, 0.0), jerk) > cap * (1 + 1e-12) + 1e-12) return false;
@@ -134,7 +134,7 @@ bool ServoLoop::keeps_limits(double v_before, double a_before, double v, double 
   return true;
 }
 
-bool ServoLoop::eases_in_time(double v, double a, double ds) const noexcept {
+bool PathExecutor::eases_in_time(double v, double a, double ds) const noexcept {
   const double jerk = kPlanJerkShare * jerk_;
   for (int k = 0; k < limit_count_; ++k) {
     const SpeedLimit& limit = limits_[static_cast<std::size_t>(k)];
@@ -147,7 +147,7 @@ bool ServoLoop::eases_in_time(double v, double a, double ds) const noexcept {
   return true;
 }
 
-void ServoLoop::scurve_step(double& dt) noexcept {
+void PathExecutor::scurve_step(double& dt, AxisPose& pose) noexcept {
   const Segment& head = window_at(head_seq_);
   const double accel = head.max_acceleration;
   const double v = path_v_;
@@ -251,7 +251,7 @@ void ServoLoop::scurve_step(double& dt) noexcept {
     const Segment& active = window_at(head_seq_);
     if (s < active.length - 1e-12) break;
     s = std::max(0.0, s - active.length);
-    axis_pose_ = active.end;
+    pose = active.end;
     finish_front();
     if (window_count_ == 0) {
       path_v_ = path_a_ = 0;
@@ -265,10 +265,10 @@ void ServoLoop::scurve_step(double& dt) noexcept {
       break;  // the dwell starts with the next period
     }
     has_active_ = true;
-    if (!starts_here(next)) return;
+    if (!starts_here(next, pose)) return;
   }
   path_s_ = s;
-  if (has_active_) axis_pose_ = window_at(head_seq_).point_at(path_s_);
+  if (has_active_) pose = window_at(head_seq_).point_at(path_s_);
 }
 
 }  // namespace cncd::motion
