@@ -26,6 +26,16 @@ std::size_t history_depth(const std::vector<DriverBinding>& drivers, std::int64_
   return CommandHistory::depth_for(deadline_ns, period_ns);
 }
 
+FeedbackChecks::JointDrivers joint_drivers(const std::vector<DriverBinding>& drivers) {
+  FeedbackChecks::JointDrivers out{};
+  for (const auto& binding : drivers) {
+    for (int j : binding.joints) {
+      if (j >= 0 && j < kJoints) out[static_cast<std::size_t>(j)] = binding.driver;
+    }
+  }
+  return out;
+}
+
 template <std::size_t N>
 void copy_name(char (&out)[N], const char* name) {
   std::snprintf(out, N, "%s", name);
@@ -41,7 +51,8 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config),
-      history_(joint_count_, history_depth(drivers_, config.servo_period_ns)) {
+      checks_(config, joint_count_, joint_drivers(drivers_),
+              history_depth(drivers_, config.servo_period_ns)) {
   joint_axis_.fill(-1);
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
@@ -50,7 +61,6 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
   for (const auto& binding : drivers_) {
     for (int j : binding.joints) {
       if (j < 0 || j >= kJoints) continue;
-      joint_driver_[static_cast<std::size_t>(j)] = binding.driver;
       copy_name(status_.joints[static_cast<std::size_t>(j)].driver, binding.driver->name());
     }
   }

@@ -9,7 +9,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
-#include "cncd/motion/command_history.hpp"
+#include "cncd/motion/feedback_checks.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
 #include "cncd/motion/path_executor.hpp"
@@ -97,10 +97,8 @@ class ServoLoop {
   void advance_jog() noexcept;
   bool axis_homed(int axis) const noexcept;
   void read_drivers() noexcept;
+  // Feedback judged by checks_; the first joint that fails latches the fault.
   void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
-  // Joint `k`'s command of `cycle` (motor coordinates) as feedback names it: 0 or a cycle not
-  // written yet is the latest one written, one that fell out of the history its oldest.
-  drivers::JointCommand answered_command(std::size_t k, std::uint64_t cycle) const noexcept;
   void write_drivers() noexcept;
   // RT: a joint whose set-point is not a number keeps its last command and the machine
   // faults ("non-finite set-point on joint N"): a drive never sees a NaN or an infinity.
@@ -116,8 +114,7 @@ class ServoLoop {
   std::vector<DriverBinding> drivers_;
   double period_s_;
   int joint_count_;
-  std::array<int, kJoints> joint_axis_{};                 // axis index a joint follows, -1 = none
-  std::array<drivers::Driver*, kJoints> joint_driver_{};  // the driver a joint belongs to
+  std::array<int, kJoints> joint_axis_{};  // axis index a joint follows, -1 = none
 
   CommandRing commands_;
   EventRing events_;
@@ -130,10 +127,9 @@ class ServoLoop {
   PathExecutor path_;
   Homing homing_;
   Jog jog_;
-  // Servo cycles counted from 1 (drivers::JointCommand::cycle), and every joint's motor
-  // commands of the last cycles, for feedback that answers an older one.
+  // Servo cycles counted from 1 (drivers::JointCommand::cycle).
   std::uint64_t cycle_ = 0;
-  CommandHistory history_;
+  FeedbackChecks checks_;
   JointArray last_motor_cmd_{};  // what the drivers were told last period (motor coordinates)
   std::array<drivers::JointCommand, kJoints> commands_out_{};
   std::array<drivers::JointFeedback, kJoints> feedback_{};  // motor coordinates
