@@ -55,7 +55,10 @@ bool advance_profile(double& s, double& v, double length, double v_max, double a
     }
     const double step = std::min(std::max(duration, 0.0), dt);
     s += v * step + 0.5 * accel * step * step;
-    v = std::max(0.0, v + accel * step);
+    // Slowing down to a lowered limit lands on it exactly: v - a ((v - v_max) / a) can leave
+    // 1e-16 over, a speed at which a hold would never count as at rest.
+    const bool lowered = accel < 0 && step == duration;
+    v = lowered ? v_max : std::max(0.0, v + accel * step);
     dt -= step;
     if (s > length) s = length;
   }

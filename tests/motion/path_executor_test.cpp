@@ -280,3 +280,51 @@ TEST(PathExecutor, SteepJerkFallsBackToTrapezoids) {
 
 }  // namespace
 }  // namespace cncd::motion
+
+namespace cncd::motion {
+namespace {
+
+// A lowered limit brakes to the new speed within a period's arithmetic: what is left over
+// must not keep the path "moving" at a speed of 1e-16 forever, never paused, never aborted.
+TEST(PathExecutor, LoweredOverrideThenAbortComesToRest) {
+  const auto config = test::small_mill();
+  for (int percent = 5; percent < 100; ++percent) {
+    const double ratio = percent / 100.0;
+    auto path = make(config);
+    AxisPose pose{};
+    ASSERT_TRUE(path->segments().push(line(at(0), at(137.3, 11.9), 97.1)));
+    for (int k = 0; k < 130; ++k)
+      path->advance(kDt, pose, false);
+    path->set_overrides(ratio, 1.0);
+    for (int k = 0; k < 97; ++k)
+      path->advance(kDt, pose, false);
+    path->abort();
+    const PathRun r = run(*path, pose, 2000);
+    EXPECT_LT(r.periods, 2000) << "override " << ratio;
+    EXPECT_EQ(path->motion(), MotionState::idle) << "override " << ratio;
+    EXPECT_FALSE(path->pending()) << "override " << ratio;
+  }
+}
+
+TEST(PathExecutor, LoweredOverrideThenPauseHolds) {
+  const auto config = test::small_mill();
+  for (int percent = 5; percent < 100; ++percent) {
+    const double ratio = percent / 100.0;
+    auto path = make(config);
+    AxisPose pose{};
+    ASSERT_TRUE(path->segments().push(line(at(0), at(137.3, 11.9), 97.1)));
+    for (int k = 0; k < 130; ++k)
+      path->advance(kDt, pose, false);
+    path->set_overrides(ratio, 1.0);
+    for (int k = 0; k < 97; ++k)
+      path->advance(kDt, pose, false);
+    path->pause();
+    for (int k = 0; k < 300; ++k)
+      path->advance(kDt, pose, false);
+    EXPECT_EQ(path->motion(), MotionState::paused) << "override " << ratio;
+    EXPECT_EQ(path->velocity(), 0.0) << "override " << ratio;
+  }
+}
+
+}  // namespace
+}  // namespace cncd::motion
