@@ -15,6 +15,7 @@
 #include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/rt_stats.hpp"
 #include "cncd/motion/seqlock.hpp"
+#include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
 
 namespace cncd::motion {
@@ -56,6 +57,10 @@ struct DriverBinding {
   std::vector<int> joints;
 };
 
+// The coordinator of the servo period: the machine's state (estop, off, on), the mode (path,
+// homing, jogging), faults and the order of the period (cycle()). The work is done by its
+// units, each usable and tested on its own: PathExecutor (look-ahead and profiles), Homing,
+// Jog and FeedbackChecks.
 class ServoLoop {
  public:
   using SegmentRing = PathExecutor::SegmentRing;
@@ -88,7 +93,8 @@ class ServoLoop {
   void apply(const Command& command) noexcept;
   void start_homing(std::uint32_t mask) noexcept;
   void stop_now(MachineState next, const char* reason) noexcept;
-  // Path motion for one period; false when the path faulted.
+  // One period of path motion: the executor's progress into the status, its fault latched,
+  // the joints moved with their axes.
   void advance_path() noexcept;
   // The first joint whose command stands apart from its axis's position, or -1.
   int joint_apart() const noexcept;
