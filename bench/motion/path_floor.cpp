@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 
-#include "plan_geometry.hpp"
+#include "cncd/pipeline/plan_geometry.hpp"
 
 namespace cncd::bench {
 namespace {
@@ -66,7 +66,7 @@ double floor_s(const config::MachineConfig& machine, const std::vector<Segment>&
       total += move.dwell_s;
       continue;
     }
-    const double velocity = daemon::move_limits(machine, move).velocity;
+    const double velocity = pipeline::move_limits(machine, move).velocity;
     if (!is_line(move)) {
       if (velocity < 1e300) total += move.length / velocity;
       continue;
@@ -109,7 +109,7 @@ PathFloors path_floors(const config::MachineConfig& machine,
       floors.bound_s += move.dwell_s;
       continue;
     }
-    const double velocity = daemon::move_limits(machine, move).velocity;
+    const double velocity = pipeline::move_limits(machine, move).velocity;
     if (move.length > 0 && velocity < 1e300) floors.bound_s += move.length / velocity;
   }
   floors.start_stop_s = floor_s(machine, moves, false);

@@ -33,8 +33,8 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/pipeline/plan_sim.hpp"
 #include "path_floor.hpp"
-#include "plan_sim.hpp"
 #include "planner_programs.hpp"
 
 namespace {
@@ -99,17 +99,17 @@ struct Bench {
   std::string run_sh;
   fs::path lcnc_ini;
 
-  cncd::daemon::PlanSimResult simulate(const fs::path& program,
-                                       std::vector<cncd::motion::Segment>* path_moves = nullptr,
-                                       int first_line = 0, int last_line = 0) const {
-    cncd::daemon::PlanSimOptions options;
-    options.interp = cncd::daemon::interpreter_options(machine);
+  cncd::pipeline::PlanSimResult simulate(const fs::path& program,
+                                         std::vector<cncd::motion::Segment>* path_moves = nullptr,
+                                         int first_line = 0, int last_line = 0) const {
+    cncd::pipeline::PlanSimOptions options;
+    options.interp = cncd::pipeline::interpreter_options(machine);
     options.start_machine = cncd::interp::Pose{};
     if (path_moves != nullptr)
       options.on_move = [&](const cncd::motion::Segment& move) {
         if (move.line >= first_line && move.line <= last_line) path_moves->push_back(move);
       };
-    return cncd::daemon::simulate_plan(machine, program, options);
+    return cncd::pipeline::simulate_plan(machine, program, options);
   }
 
   std::optional<LinuxcncRun> linuxcnc_run(const fs::path& program) const {
@@ -119,7 +119,8 @@ struct Bench {
     return run_linuxcnc(run_sh, lcnc_ini, program, log);
   }
 
-  void whole(const cncd::bench::BenchProgram& program, const cncd::daemon::PlanSimResult& r) const {
+  void whole(const cncd::bench::BenchProgram& program,
+             const cncd::pipeline::PlanSimResult& r) const {
     const double moves = static_cast<double>(r.moves);
     std::printf("  whole program\n    cncd      cycle %.3f s  feed bound %.3f s  ratio %.4f",
                 r.cycle_time_s, r.feed_bound_s, r.cycle_time_s / r.feed_bound_s);
@@ -149,7 +150,7 @@ struct Bench {
   }
 
   // The dense path: within the program (per-move start times) and alone, on both controllers.
-  void path(const cncd::bench::BenchProgram& program, const cncd::daemon::PlanSimResult& r,
+  void path(const cncd::bench::BenchProgram& program, const cncd::pipeline::PlanSimResult& r,
             const std::vector<cncd::motion::Segment>& moves) const {
     std::size_t first = r.move_line.size();
     std::size_t last = 0;

@@ -25,9 +25,10 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/rs274_printer.hpp"
-#include "plan_sim.hpp"
-#include "program_check.hpp"
-#include "start_checks.hpp"
+#include "cncd/pipeline/machine.hpp"
+#include "cncd/pipeline/plan_sim.hpp"
+#include "cncd/pipeline/program_check.hpp"
+#include "cncd/pipeline/startup_code.hpp"
 
 namespace {
 
@@ -107,7 +108,7 @@ class TrajectoryFile {
 };
 
 int check_plan(const cncd::config::MachineConfig& machine, const std::string& program,
-               cncd::daemon::PlanSimOptions options, bool json, const std::string& trajectory) {
+               cncd::pipeline::PlanSimOptions options, bool json, const std::string& trajectory) {
   std::unique_ptr<TrajectoryFile> csv;
   if (!trajectory.empty()) {
     csv = std::make_unique<TrajectoryFile>(trajectory, machine);
@@ -118,12 +119,12 @@ int check_plan(const cncd::config::MachineConfig& machine, const std::string& pr
     }
     options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose) { csv->add(t, pose); };
   }
-  const auto result = cncd::daemon::simulate_plan(machine, program, options);
+  const auto result = cncd::pipeline::simulate_plan(machine, program, options);
   // A program that stopped before it moved has no figures worth a report (JSON always has one).
   if (json) {
-    std::cout << cncd::daemon::plan_json(machine, result) << '\n';
+    std::cout << cncd::pipeline::plan_json(machine, result) << '\n';
   } else if (result.complete() || result.cycles > 0) {
-    std::cout << cncd::daemon::describe_plan(machine, result);
+    std::cout << cncd::pipeline::describe_plan(machine, result);
   }
   std::cout.flush();
   bool ok = result.complete();
@@ -200,7 +201,7 @@ int main(int argc, char** argv) {
   if (!plan && (json || !trajectory.empty()))
     return usage("--json and --trajectory go with --plan");
 
-  daemon::CheckOptions options;
+  pipeline::CheckOptions options;
   options.max_seconds = max_seconds;
   std::optional<config::LoadResult> loaded;
   if (!ini.empty()) {
@@ -213,7 +214,7 @@ int main(int argc, char** argv) {
       return config::kExitConfig;
     }
     // Every program starts with the machine's start-up code: a broken one fails them all.
-    if (const auto problems = daemon::check_startup_code(*loaded->config); !problems.empty()) {
+    if (const auto problems = pipeline::check_startup_code(*loaded->config); !problems.empty()) {
       for (const auto& problem : problems)
         std::cerr << problem.to_string() << '\n';
       std::cerr << "cncd-check: " << problems.size() << " problem"
@@ -221,7 +222,7 @@ int main(int argc, char** argv) {
       return config::kExitConfig;
     }
     options.machine = &*loaded->config;
-    options.interp = daemon::interpreter_options(*loaded->config);
+    options.interp = pipeline::interpreter_options(*loaded->config);
     // Where the daemon would read them: the state directory's copies, else the seeds beside
     // the INI that it would start from. Only read; cncd-check never writes them.
     const auto& machine = *loaded->config;
@@ -243,16 +244,16 @@ int main(int argc, char** argv) {
 
   std::ios::sync_with_stdio(false);
   if (plan) {
-    daemon::PlanSimOptions plan_options;
+    pipeline::PlanSimOptions plan_options;
     plan_options.interp = options.interp;
     plan_options.max_wall_s = max_seconds;
     return check_plan(*loaded->config, program, plan_options, json, trajectory);
   }
   interp::Rs274Printer printer(std::cout);
   if (canon) options.trace = &printer;
-  const daemon::CheckReport report = daemon::check_program(program, options);
+  const pipeline::CheckReport report = pipeline::check_program(program, options);
   // A program that could not even be opened has nothing to summarise.
-  if (!canon && (report.blocks > 0 || !report.error)) std::cout << daemon::describe(report);
+  if (!canon && (report.blocks > 0 || !report.error)) std::cout << pipeline::describe(report);
   std::cout.flush();
   for (const auto& problem : report.problems)
     std::cerr << problem.to_string() << '\n';

@@ -16,6 +16,7 @@
 
 #include "cncd/config/ini_file.hpp"
 #include "cncd/config/machine_config.hpp"
+#include "cncd/pipeline/startup_code.hpp"
 #include "logging.hpp"
 #include "methods.hpp"
 #include "server.hpp"
@@ -234,7 +235,7 @@ int main(int argc, char** argv) {
   // A configuration that loads must also be able to run here: its start-up code and the
   // places of its state files.
   auto problems = cncd::daemon::check_state_directories(config);
-  for (auto& problem : cncd::daemon::check_startup_code(config))
+  for (auto& problem : cncd::pipeline::check_startup_code(config))
     problems.push_back(std::move(problem));
   if (!problems.empty()) return refuse(problems, options.ini);
   if (options.check_only) {

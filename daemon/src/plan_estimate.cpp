@@ -3,7 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include "plan_sim.hpp"
+#include "cncd/pipeline/plan_sim.hpp"
 
 namespace cncd::daemon {
 
@@ -30,14 +30,14 @@ void PlanEstimator::start(const std::filesystem::path& program,
       [this, program, options, start, generation, cancel = run.cancel, finished = run.finished] {
         // The servo thread and the control socket come first.
         setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
-        PlanSimOptions sim;
+        pipeline::PlanSimOptions sim;
         sim.interp = options;
         sim.start_machine = start;
         sim.measure = false;
         sim.max_wall_s = kMaxWallSeconds;
         sim.max_moves = kMaxMoves;
         sim.cancel = cancel.get();
-        PlanSimResult result = simulate_plan(machine_, program, sim);
+        pipeline::PlanSimResult result = pipeline::simulate_plan(machine_, program, sim);
         PlanEstimate estimate;
         if (result.complete()) {
           estimate.state = PlanEstimate::State::done;

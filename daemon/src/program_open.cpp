@@ -5,7 +5,7 @@
 
 #include <fstream>
 
-#include "program_check.hpp"
+#include "cncd/pipeline/program_check.hpp"
 #include "program_dirs.hpp"
 #include "rpc.hpp"
 
@@ -44,7 +44,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   const ProgramFile file = find_program(request.path, request.program_dirs);
   if (!file.error.empty()) return fail(kProgramError, file.error);
   out.path = file.path;
-  CheckOptions options;
+  pipeline::CheckOptions options;
   options.interp = request.interp;
   options.machine = &machine;
   options.max_problems = 1;
@@ -52,7 +52,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   options.max_seconds = ProgramOpener::kMaxCheckSeconds;
   options.max_seconds_cpu = true;
   options.cancel = &cancel;
-  const CheckReport report = check_program(file.path, options);
+  const pipeline::CheckReport report = pipeline::check_program(file.path, options);
   if (report.cancelled) return out;  // nobody waits for it
   if (report.stopped) out.warnings.push_back(report.stopped->to_string());
   if (report.limit_violations > 0) {

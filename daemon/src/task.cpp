@@ -4,7 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "program_check.hpp"
+#include "cncd/pipeline/machine.hpp"
 #include "program_dirs.hpp"
 #include "rpc.hpp"
 
@@ -14,10 +14,31 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-interp::Units machine_units(const config::MachineConfig& config) {
-  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
-                                                          : interp::Units::mm;
-}
+
+// The feed loop's target: the motion controller's queue, counting the moves it takes.
+class ControllerTarget final : public pipeline::MoveTarget {
+ public:
+  ControllerTarget(motion::MotionController& motion, std::uint64_t& enqueued)
+      : motion_(motion), enqueued_(enqueued) {}
+  Push push(const motion::Move& move) override {
+    switch (motion_.enqueue(move)) {
+      case motion::MotionController::EnqueueResult::full:
+        return Push::full;
+      case motion::MotionController::EnqueueResult::refused:
+        return Push::refused;
+      default:
+        ++enqueued_;
+        return Push::accepted;
+    }
+  }
+  // What does not fit yet goes out before the next move.
+  void flush() override { motion_.flush(); }
+
+ private:
+  motion::MotionController& motion_;
+  std::uint64_t& enqueued_;
+};
+
 }  // namespace
 
 // One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
@@ -27,8 +48,12 @@ Task::Task(const config::MachineConfig& config, EventLog& events, Completions& c
       events_(events),
       completions_(completions),
       motion_(config),
-      feeder_(std::make_unique<ProgramFeeder>(machine_units(config), events)),
-      interp_(std::make_unique<interp::Interpreter>(interpreter_options(config))),
+      feeder_(std::make_unique<pipeline::ProgramFeeder>(
+          pipeline::machine_units(config),
+          [&events](int line, const std::string& text) {
+            events.add("info", "message", "line " + std::to_string(line) + ": " + text);
+          })),
+      interp_(std::make_unique<interp::Interpreter>(pipeline::interpreter_options(config))),
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
@@ -250,23 +275,14 @@ void Task::feed() {
   const auto until = Clock::now() + std::chrono::milliseconds(2);
   for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
     if ((blocks & 63) == 63 && Clock::now() > until) return;
-    while (!feeder_->pending.empty()) {
-      if (ProgramFeeder::stop_point(feeder_->pending.front())) {
-        motion_.flush();  // what does not fit yet goes out before the next move
-        feeder_->pending.pop_front();
-        continue;
-      }
-      const auto result = motion_.enqueue(feeder_->pending.front());
-      if (result == motion::MotionController::EnqueueResult::full) return;
-      if (result == motion::MotionController::EnqueueResult::refused) {
-        const int line = feeder_->pending.front().line;
-        motion_.abort();
-        finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
-                                    std::to_string(line) + ": " + motion_.enqueue_error());
-        return;
-      }
-      feeder_->pending.pop_front();
-      ++moves_enqueued_;
+    ControllerTarget target(motion_, moves_enqueued_);
+    const pipeline::Drained drained = feeder_->drain(target);
+    if (drained.result == pipeline::MoveTarget::Push::full) return;
+    if (drained.result == pipeline::MoveTarget::Push::refused) {
+      motion_.abort();
+      finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
+                                  std::to_string(drained.line) + ": " + motion_.enqueue_error());
+      return;
     }
     // The move held back for look-ahead goes out when no more come for now, so that the
     // path ends at rest and the program's end, a stop or a step is seen.

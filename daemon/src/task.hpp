@@ -19,8 +19,8 @@
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/motion/controller.hpp"
+#include "cncd/pipeline/feeder.hpp"
 #include "event_log.hpp"
-#include "feeder.hpp"
 #include "persist.hpp"
 #include "plan_estimate.hpp"
 #include "program_open.hpp"
@@ -168,7 +168,7 @@ class Task {
   EventLog& events_;
   Completions& completions_;
   motion::MotionController motion_;
-  std::unique_ptr<ProgramFeeder> feeder_;
+  std::unique_ptr<pipeline::ProgramFeeder> feeder_;
   std::unique_ptr<interp::Interpreter> interp_;
   std::vector<interp::ToolEntry> saved_tools_;  // the tool table as its file holds it
   std::vector<double> saved_parameters_;        // the persistent parameters as the file holds them

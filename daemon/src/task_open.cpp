@@ -2,7 +2,7 @@
 // answered when the check ends (or is cancelled), while the loop goes on serving.
 #include <spdlog/spdlog.h>
 
-#include "program_check.hpp"
+#include "cncd/pipeline/program_check.hpp"
 #include "task.hpp"
 
 namespace cncd::daemon {
@@ -25,7 +25,7 @@ void Task::open_program(const std::string& path, std::uint64_t token) {
   OpenRequest request;
   request.path = path;
   request.program_dirs = config_.program_dirs;
-  request.interp = interpreter_options(config_);
+  request.interp = pipeline::interpreter_options(config_);
   std::copy(status.commanded.begin(), status.commanded.end(), request.start.begin());
   cancel_open("cancelled: replaced by a newer program.open of '" + path + "'");
   PendingOpen pending;
@@ -60,7 +60,7 @@ void Task::finish_open(OpenOutcome outcome) {
     completions_.fail(pending.token, outcome.error_code, outcome.error_message);
     return;
   }
-  estimator_.start(outcome.path, interpreter_options(config_), pending.start);
+  estimator_.start(outcome.path, pipeline::interpreter_options(config_), pending.start);
   program_path_ = outcome.path;
   program_lines_ = outcome.lines;
   last_result_.clear();

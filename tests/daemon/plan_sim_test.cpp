@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cncd/pipeline/plan_sim.hpp"
 #include "daemon_process.hpp"
-#include "plan_sim.hpp"
 
 namespace cncd::test {
 namespace {
@@ -22,17 +22,17 @@ class PlanSimTest : public ::testing::Test {
     ini_ = copy_example_machine(dir_.path());
     loaded_ = config::load_machine_config(ini_);
     ASSERT_TRUE(loaded_.ok());
-    options_.interp = daemon::interpreter_options(*loaded_.config);
+    options_.interp = pipeline::interpreter_options(*loaded_.config);
   }
   const config::MachineConfig& machine() const { return *loaded_.config; }
-  daemon::PlanSimResult simulate(const std::string& program) {
-    return daemon::simulate_plan(machine(), dir_.write("prog.ngc", program), options_);
+  pipeline::PlanSimResult simulate(const std::string& program) {
+    return pipeline::simulate_plan(machine(), dir_.write("prog.ngc", program), options_);
   }
 
   TempDir dir_;
   std::filesystem::path ini_;
   config::LoadResult loaded_;
-  daemon::PlanSimOptions options_;
+  pipeline::PlanSimOptions options_;
 };
 
 TEST_F(PlanSimTest, AStraightFeedTakesItsTrapezoidAndStaysWithinTheLimits) {

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cncd/pipeline/program_check.hpp"
 #include "daemon_process.hpp"
-#include "program_check.hpp"
 
 namespace cncd::test {
 namespace {
@@ -141,12 +141,12 @@ TEST_F(CncdCheckTest, AProgramThatNeverEndsIsStoppedWithAClearMessage) {
   EXPECT_NE(r.err.find("the program runs too long to check"), std::string::npos) << r.err;
 }
 
-daemon::CheckReport check_text(const TempDir& dir, const config::MachineConfig& machine,
-                               const std::string& program) {
-  daemon::CheckOptions options;
-  options.interp = daemon::interpreter_options(machine);
+pipeline::CheckReport check_text(const TempDir& dir, const config::MachineConfig& machine,
+                                 const std::string& program) {
+  pipeline::CheckOptions options;
+  options.interp = pipeline::interpreter_options(machine);
   options.machine = &machine;
-  return daemon::check_program(dir.write("arc.ngc", program), options);
+  return pipeline::check_program(dir.write("arc.ngc", program), options);
 }
 
 TEST_F(CncdCheckTest, ArcsAreCheckedOverTheirWholeSweep) {

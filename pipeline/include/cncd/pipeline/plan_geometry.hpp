@@ -5,7 +5,7 @@
 #include "cncd/config/machine_config.hpp"
 #include "cncd/motion/segment.hpp"
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 
 struct MoveLimits {
   double velocity = 0;      // fastest path speed the feed and the axes allow (units/s)
@@ -25,4 +25,4 @@ double rest_to_rest_s(double length, double velocity, double acceleration);
 // pitch or the radius change).
 double distance_to_path(const motion::Segment& segment, const motion::AxisPose& point);
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

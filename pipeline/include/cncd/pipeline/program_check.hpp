@@ -15,12 +15,9 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "cncd/pipeline/machine.hpp"
 
-namespace cncd::daemon {
-
-// The interpreter options a machine's INI gives: units, tool table, parameter file, subroutine
-// path, start-up code.
-interp::InterpOptions interpreter_options(const config::MachineConfig& config);
+namespace cncd::pipeline {
 
 struct CheckProblem {
   std::string file;
@@ -85,4 +82,4 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
 // The human summary cncd-check prints: moves by kind, extents per axis, tools, feed length.
 std::string describe(const CheckReport& report);
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

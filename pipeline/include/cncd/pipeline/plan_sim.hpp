@@ -19,9 +19,9 @@
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/types.hpp"
-#include "program_check.hpp"
+#include "cncd/pipeline/program_check.hpp"
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 
 struct PlanSimOptions {
   interp::InterpOptions interp;
@@ -88,4 +88,4 @@ PlanSimResult simulate_plan(const config::MachineConfig& machine,
 std::string describe_plan(const config::MachineConfig& machine, const PlanSimResult& result);
 std::string plan_json(const config::MachineConfig& machine, const PlanSimResult& result);
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

@@ -1,4 +1,4 @@
-#include "program_check.hpp"
+#include "cncd/pipeline/program_check.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,8 +9,9 @@
 #include <string_view>
 
 #include "cncd/interp/to_machine.hpp"
+#include "cncd/pipeline/machine.hpp"
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 
 using interp::CanonCommand;
 using interp::CanonKind;
@@ -23,11 +24,6 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 // Rounding in the offsets and unit conversions must not make a move that ends on a limit
 // a violation.
 constexpr double kLimitSlack = 1e-6;
-
-interp::Units machine_units(const config::MachineConfig& config) {
-  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
-                                                          : interp::Units::mm;
-}
 
 std::string number(double value) {
   char text[64];
@@ -44,18 +40,6 @@ struct ArcFrame {
   Pose u{};
   Pose v{};
 };
-
-std::array<std::size_t, 3> plane_axes(interp::Plane plane) {
-  switch (plane) {
-    case interp::Plane::xz:
-      return {2, 0, 1};
-    case interp::Plane::yz:
-      return {1, 2, 0};
-    case interp::Plane::xy:
-    default:
-      return {0, 1, 2};
-  }
-}
 
 double dot(const Pose& a, const Pose& b) {
   double sum = 0;
@@ -292,16 +276,6 @@ class CheckSink final : public interp::CanonSink {
 
 }  // namespace
 
-interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
-  interp::InterpOptions options;
-  options.machine_units = machine_units(config);
-  options.parameter_file = config.parameter_file;
-  options.tool_table = config.tool_table;
-  options.subroutine_path = config.subroutine_path;
-  options.startup_code = config.startup_code;
-  return options;
-}
-
 std::string CheckProblem::to_string() const {
   return file + ":" + std::to_string(line) + ": " + message;
 }
@@ -388,4 +362,4 @@ std::string describe(const CheckReport& report) {
   return text;
 }
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

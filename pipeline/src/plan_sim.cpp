@@ -1,4 +1,4 @@
-#include "plan_sim.hpp"
+#include "cncd/pipeline/plan_sim.hpp"
 
 #include <time.h>
 
@@ -12,10 +12,11 @@
 #include "cncd/drivers/sim_driver.hpp"
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/servo_loop.hpp"
-#include "feeder.hpp"
-#include "plan_geometry.hpp"
+#include "cncd/pipeline/feeder.hpp"
+#include "cncd/pipeline/machine.hpp"
+#include "cncd/pipeline/plan_geometry.hpp"
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -26,30 +27,10 @@ double thread_cpu_s() {
   return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
 }
 
-// Passes the program's canonical commands to the feeder, except operator messages: the
-// simulation must not log them as if the program ran.
-class QuietSink final : public interp::CanonSink {
- public:
-  explicit QuietSink(ProgramFeeder& feeder) : feeder_(feeder) {}
-  void emit(const interp::CanonCommand& command) override {
-    if (command.kind == interp::CanonKind::message ||
-        command.kind == interp::CanonKind::debug_message)
-      return;
-    feeder_.emit(command);
-  }
-
- private:
-  ProgramFeeder& feeder_;
-};
-
-interp::Units machine_units(const config::MachineConfig& config) {
-  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
-                                                          : interp::Units::mm;
-}
-
 // One simulation run: the interpreter feeding the planner and the servo loop as the daemon's
-// Task::feed() does, the loop stepped in virtual time.
-class Simulation {
+// Task::feed() does, the loop stepped in virtual time. Operator messages are not passed on:
+// the simulation must not log them as if the program ran.
+class Simulation final : MoveTarget {
  public:
   Simulation(const config::MachineConfig& machine, std::string program,
              const PlanSimOptions& options, PlanSimResult& result)
@@ -58,8 +39,7 @@ class Simulation {
         options_(options),
         result_(result),
         interp_(options.interp),
-        feeder_(machine_units(machine), unused_events_),
-        sink_(feeder_),
+        feeder_(machine_units(machine)),
         planner_(machine) {}
 
   void run() {
@@ -155,33 +135,14 @@ class Simulation {
   // flushed at stop points, program stops and the program's end.
   bool feed() {
     for (int blocks = 0;; ++blocks) {
-      while (!feeder_.pending.empty()) {
-        if (!pump()) return true;
-        const motion::Move& move = feeder_.pending.front();
-        if (ProgramFeeder::stop_point(move)) {
-          planner_.flush();
-          feeder_.pending.pop_front();
-          continue;
-        }
-        bound(move);
-        std::string error;
-        const double cpu_start = thread_cpu_s();
-        const bool planned = planner_.push(move, true, error);
-        result_.planner_cpu_s += thread_cpu_s() - cpu_start;
-        if (!planned) {
-          result_.error = CheckProblem{program_, move.line, error};
-          return false;
-        }
-        // Every pushed move is counted once in Status::moves_done, whichever segment (a
-        // blend arc, a merged line) completes it: its line is its own, not that segment's.
-        result_.move_line.push_back(move.line);
-        feeder_.pending.pop_front();
-      }
+      const Drained drained = feeder_.drain(*this);
+      if (drained.result == Push::full) return true;
+      if (drained.result == Push::refused) return false;
       if (interp_done_) planner_.flush();
       if (!pump() || interp_done_) return true;
       // A program reading thousands of blocks without a move still answers the budget.
       if ((blocks & 4095) == 4095 && over_budget(interp_.current_line())) return false;
-      const auto step = interp_.step(sink_);
+      const auto step = interp_.step(feeder_);
       if (step == interp::Interpreter::Step::error) {
         const auto& error = interp_.error();
         result_.error = error ? CheckProblem{error->file, error->line, error->message}
@@ -199,6 +160,27 @@ class Simulation {
       if (step == interp::Interpreter::Step::end) interp_done_ = true;
     }
   }
+
+  // MoveTarget: the next move goes to the planner once its output is in the servo loop's ring.
+  bool ready() override { return pump(); }
+
+  Push push(const motion::Move& move) override {
+    bound(move);
+    std::string error;
+    const double cpu_start = thread_cpu_s();
+    const bool planned = planner_.push(move, true, error);
+    result_.planner_cpu_s += thread_cpu_s() - cpu_start;
+    if (!planned) {
+      result_.error = CheckProblem{program_, move.line, error};
+      return Push::refused;
+    }
+    // Every pushed move is counted once in Status::moves_done, whichever segment (a blend
+    // arc, a merged line) completes it: its line is its own, not that segment's.
+    result_.move_line.push_back(move.line);
+    return Push::accepted;
+  }
+
+  void flush() override { planner_.flush(); }
 
   // Hands the planner's final segments to the servo loop; false when the ring is full.
   bool pump() {
@@ -293,9 +275,7 @@ class Simulation {
   const PlanSimOptions& options_;
   PlanSimResult& result_;
   interp::Interpreter interp_;
-  EventLog unused_events_;  // the feeder's, never written: messages are dropped before it
   ProgramFeeder feeder_;
-  QuietSink sink_;
   motion::Planner planner_;
   drivers::SimDriver sim_;
   std::unique_ptr<motion::ServoLoop> loop_;
@@ -325,4 +305,4 @@ PlanSimResult simulate_plan(const config::MachineConfig& machine,
   return result;
 }
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

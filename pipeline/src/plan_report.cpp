@@ -5,9 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "plan_sim.hpp"
+#include "cncd/pipeline/plan_sim.hpp"
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 namespace {
 
 std::string format(const char* pattern, double value) {
@@ -113,4 +113,4 @@ std::string plan_json(const config::MachineConfig& machine, const PlanSimResult&
   return out.dump();
 }
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

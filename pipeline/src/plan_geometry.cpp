@@ -1,10 +1,10 @@
-#include "plan_geometry.hpp"
+#include "cncd/pipeline/plan_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-namespace cncd::daemon {
+namespace cncd::pipeline {
 namespace {
 
 double xyz_distance(const motion::AxisPose& a, const motion::AxisPose& b) {
@@ -130,4 +130,4 @@ double distance_to_path(const motion::Segment& segment, const motion::AxisPose& 
   return best;
 }
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

@@ -1,25 +1,10 @@
-#include "feeder.hpp"
+#include "cncd/pipeline/feeder.hpp"
 
 #include <algorithm>
 
-namespace cncd::daemon {
-namespace {
+#include "cncd/pipeline/machine.hpp"
 
-// The (first, second, normal) axes of an arc's plane, as LinuxCNC's ARC_FEED orders them.
-std::array<int, 3> plane_axes(interp::Plane plane) {
-  switch (plane) {
-    case interp::Plane::yz:
-      return {1, 2, 0};
-    case interp::Plane::xz:
-      return {2, 0, 1};
-    case interp::Plane::xy:
-    default:
-      return {0, 1, 2};
-  }
-}
-
-}  // namespace
-
+namespace cncd::pipeline {
 void ProgramFeeder::start_program() {
   pending.clear();
   stop_seen = false;
@@ -111,7 +96,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       tool = m.ivalue;
       return;
     case interp::CanonKind::message:
-      events_.add("info", "message", "line " + std::to_string(m.line) + ": " + m.text);
+      if (on_message_) on_message_(m.line, m.text);
       return;
     default:
       return;
@@ -122,6 +107,22 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   pending.push_back(move);
 }
 
+Drained ProgramFeeder::drain(MoveTarget& target) {
+  while (!pending.empty()) {
+    if (!target.ready()) return {MoveTarget::Push::full, 0};
+    const motion::Move& move = pending.front();
+    if (stop_point(move)) {
+      target.flush();
+      pending.pop_front();
+      continue;
+    }
+    const MoveTarget::Push result = target.push(move);
+    if (result != MoveTarget::Push::accepted) return {result, move.line};
+    pending.pop_front();
+  }
+  return {};
+}
+
 void ProgramFeeder::add_stop_point() {
   if (!pending.empty() && stop_point(pending.back())) return;
   motion::Move stop;
@@ -130,4 +131,4 @@ void ProgramFeeder::add_stop_point() {
   pending.push_back(stop);
 }
 
-}  // namespace cncd::daemon
+}  // namespace cncd::pipeline

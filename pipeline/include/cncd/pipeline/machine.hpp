@@ -1,0 +1,25 @@
+// What a machine's configuration tells the path from canonical commands to planned moves: the
+// units the machine works in, the interpreter options its INI gives, and the axes of an arc's
+// plane. One definition for the offline check, the plan simulation and the daemon's task.
+#pragma once
+
+#include <array>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/interp/canon.hpp"
+#include "cncd/interp/interpreter.hpp"
+
+namespace cncd::pipeline {
+
+// [TRAJ] LINEAR_UNITS as the interpreter names them.
+interp::Units machine_units(const config::MachineConfig& config);
+
+// The interpreter options a machine's INI gives: units, tool table, parameter file, subroutine
+// path, start-up code.
+interp::InterpOptions interpreter_options(const config::MachineConfig& config);
+
+// The (first, second, normal) axis indices of an arc's plane, as LinuxCNC's ARC_FEED orders
+// them: XY (0, 1, 2), XZ (2, 0, 1), YZ (1, 2, 0).
+std::array<int, 3> plane_axes(interp::Plane plane);
+
+}  // namespace cncd::pipeline

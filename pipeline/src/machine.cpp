@@ -1,0 +1,32 @@
+#include "cncd/pipeline/machine.hpp"
+
+namespace cncd::pipeline {
+
+interp::Units machine_units(const config::MachineConfig& config) {
+  return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
+                                                          : interp::Units::mm;
+}
+
+interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
+  interp::InterpOptions options;
+  options.machine_units = machine_units(config);
+  options.parameter_file = config.parameter_file;
+  options.tool_table = config.tool_table;
+  options.subroutine_path = config.subroutine_path;
+  options.startup_code = config.startup_code;
+  return options;
+}
+
+std::array<int, 3> plane_axes(interp::Plane plane) {
+  switch (plane) {
+    case interp::Plane::yz:
+      return {1, 2, 0};
+    case interp::Plane::xz:
+      return {2, 0, 1};
+    case interp::Plane::xy:
+    default:
+      return {0, 1, 2};
+  }
+}
+
+}  // namespace cncd::pipeline
