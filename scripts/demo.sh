@@ -7,7 +7,7 @@ scripts/setup.sh
 cmake --preset release >/dev/null
 cmake --build --preset release
 
-bin=build/release/daemon
+bin=build/release/bin
 example=${CNCD_DEMO_INI:-config/examples/sim_mm.ini}
 program=${CNCD_DEMO_PROGRAM:-examples/g81_example1.ngc}
 rundir=$(mktemp -d)
