@@ -148,11 +148,8 @@ void limit_error(std::string& error, int axis, double value, double min, double 
 }  // namespace
 
 bool Planner::within_limits(const Segment& segment, std::string& error) const {
-  // Lines are convex: their ends suffice. Arcs are sampled densely enough that a bulge past a
-  // limit is found (the chord error of 256 steps is below 1e-4 of the radius).
-  const int samples = segment.kind == Segment::Kind::arc ? 256 : 1;
-  for (int k = 0; k <= samples; ++k) {
-    const AxisPose p = segment.point_at(segment.length * k / samples);
+  const auto inside = [&](double s) {
+    const AxisPose p = segment.point_at(s);
     for (int i = 0; i < kAxes; ++i) {
       const auto& axis = config_.axes[static_cast<std::size_t>(i)];
       if (!axis.present) continue;
@@ -162,6 +159,23 @@ bool Planner::within_limits(const Segment& segment, std::string& error) const {
         return false;
       }
     }
+    return true;
+  };
+  // Lines are convex: their ends suffice. Arcs are sampled in 256 steps (a chord error below
+  // 1e-4 of the radius); in its plane an arc reaches farthest where its angle is a multiple
+  // of a quarter turn (a spiral very near there), and a bulge that small between two samples
+  // would be missed: those points are checked too, where the offline check finds them.
+  const bool arc = segment.kind == Segment::Kind::arc;
+  const int samples = arc ? 256 : 1;
+  for (int k = 0; k <= samples; ++k) {
+    if (!inside(segment.length * k / samples)) return false;
+  }
+  if (!arc || segment.sweep == 0) return true;
+  const double quarter = std::numbers::pi / 2;
+  const double from = std::min(segment.start_angle, segment.start_angle + segment.sweep);
+  const double to = std::max(segment.start_angle, segment.start_angle + segment.sweep);
+  for (double angle = std::ceil(from / quarter) * quarter; angle <= to; angle += quarter) {
+    if (!inside(segment.length * (angle - segment.start_angle) / segment.sweep)) return false;
   }
   return true;
 }

@@ -1,0 +1,148 @@
+// Edge-case programs through the three ways a program is judged: cncd-check (the real binary),
+// program.open and program.run on the real daemon. Each gives the same verdict and, for a
+// program in error, the same line: arcs with an end radius off within LinuxCNC's tolerance
+// (run as spirals) and beyond it, full circles, helices, zero-length moves, soft limits
+// touched exactly and passed by a little, by a line or by an arc's bulge.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using nlohmann::json;
+
+struct EdgeCase {
+  const char* name;
+  std::string text;
+  int error_line;  // 0: the program is good and runs to its end
+  // Judged by the interpreter alone, as LinuxCNC's rs274 judges it (no soft limits there).
+  bool interpreter_verdict;
+};
+
+// The sim machine's limits: X -10..300, Y -10..200, Z -100..50 (machine = program
+// coordinates: G54 and G92 are zero in the example's parameter file).
+const std::string kHead = "G21 G90 G17 G94\n";
+
+// A full circle of radius 10 about X290.0002 Y100 bulges 0.2 um past X's MAX_LIMIT at angle
+// 0; it starts half a step of a 256-step sampling of the circle away from there.
+std::string bulging_circle() {
+  const char* at = "[141.328125]";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "#1=%s\nG0 X[290.0002+10*COS[#1]] Y[100+10*SIN[#1]] Z0\n"
+                "G2 X[290.0002+10*COS[#1]] Y[100+10*SIN[#1]] I[-10*COS[#1]] J[-10*SIN[#1]] "
+                "F3000\nM2\n",
+                at);
+  return kHead + text;
+}
+
+std::vector<EdgeCase> edge_cases() {
+  return {
+      {"spiral_within_tolerance", kHead + "G0 X0 Y0 Z0\nG2 X10 Y0 I5.005 J0 F600\nM2\n", 0, true},
+      {"spiral_at_tolerance", kHead + "G0 X0 Y0 Z0\nG2 X10 Y0 I5.014 J0 F3000\nM2\n", 0, true},
+      {"radius_beyond_tolerance", kHead + "G0 X0 Y0 Z0\nG1 Z-1 F600\nG2 X10 Y0 I5.015 J0\nM2\n", 4,
+       true},
+      {"zero_radius_arc", kHead + "G0 X5 Y5 Z0\nG2 X5 Y5 I0 J0 F600\nM2\n", 3, true},
+      {"full_circles", kHead + "G0 X20 Y20 Z0\nG2 X20 Y20 I5 J0 F3000\nG3 X20 Y20 I0 J5\nM2\n", 0,
+       true},
+      {"helices",
+       kHead + "G0 X20 Y20 Z0\nG3 X20 Y20 Z-5 I5 J0 P2 F3000\nG18 G2 X20 Z-5 I0 K2\n"
+               "G19 G2 Y20 Z-5 J0 K2\nM2\n",
+       0, true},
+      {"zero_length_moves", kHead + "G0 X5 Y5 Z0\nG0 X5 Y5\nG1 X5 Y5 F600\nG1 X5\nG4 P0\nM2\n", 0,
+       true},
+      {"limits_touched_by_lines", kHead + "G0 X300 Y200 Z50\nG1 X-10 Y-10 F6000\nG0 Z0\nM2\n", 0,
+       false},
+      {"limits_touched_by_arcs",
+       kHead + "G0 X280 Y100 Z0\nG2 X280 Y100 I10 J0 F6000\nG0 X100 Y10\nG3 X100 Y10 I0 J-10\nM2\n",
+       0, false},
+      {"line_just_beyond_a_limit", kHead + "G0 X10 Y10 Z0\nG0 X300.001\nM2\n", 3, false},
+      {"arc_bulging_just_beyond_a_limit", bulging_circle(), 4, false},
+  };
+}
+
+class PipelineAgreementTest : public MachineTest {
+ protected:
+  // "" when cncd-check passes the program, else the first "FILE:LINE:" it reports.
+  std::string check(const std::filesystem::path& program) {
+    const auto r = run_command({CNCD_CHECK_BINARY, "--ini", ini_.string(), program.string()});
+    if (r.exit_status == 0) return "";
+    EXPECT_EQ(r.exit_status, 1) << r.err;
+    return location(r.err);
+  }
+
+  // "" when program.open takes the program, else the line its error names.
+  std::string open(const std::filesystem::path& program) {
+    const json opened = call("program.open", {{"path", program.string()}});
+    if (opened.contains("result")) return "";
+    return location(opened["error"].value("message", ""));
+  }
+
+  // Runs `text` as `program` (opened while it held a harmless program when program.open
+  // refuses it, as a file changed after it was opened); "" when it ran to its end.
+  std::string run(const std::filesystem::path& program, const std::string& text) {
+    dir_.write(program.filename().string(), "G21 G90\nG0 X1\nM2\n");
+    result_of(call("program.open", {{"path", program.string()}}));
+    dir_.write(program.filename().string(), text);
+    const json ran = call("program.run");
+    if (ran.contains("error")) return location(ran["error"].value("message", ""));
+    const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+    if (s["program"]["result"] == "done") return "";
+    EXPECT_EQ(s["program"]["result"], "error") << s.dump();
+    return location(s["program"].value("error", ""));
+  }
+
+  // "FILE:LINE:" at the start of the first line of `text` that has one.
+  static std::string location(const std::string& text) {
+    const auto colon = text.find(".ngc:");
+    if (colon == std::string::npos) return "?" + text;
+    const auto end = text.find(':', colon + 5);
+    const auto start = text.rfind('\n', colon);
+    return text.substr(start == std::string::npos ? 0 : start + 1,
+                       end == std::string::npos ? std::string::npos : end + 1 - (start + 1));
+  }
+};
+
+TEST_F(PipelineAgreementTest, EveryPathGivesTheSameVerdictAtTheSameLine) {
+  ready_machine();
+  for (const EdgeCase& c : edge_cases()) {
+    SCOPED_TRACE(c.name);
+    const auto program = dir_.write(std::string(c.name) + ".ngc", c.text);
+    const std::string expected =
+        c.error_line == 0 ? "" : program.string() + ":" + std::to_string(c.error_line) + ":";
+    EXPECT_EQ(check(program), expected) << "cncd-check";
+    EXPECT_EQ(open(program), expected) << "program.open";
+    EXPECT_EQ(run(program, c.text), expected) << "program.run";
+  }
+}
+
+// The interpreter's part of the verdicts is LinuxCNC's: rs274 accepts the same programs and
+// stops at the same block.
+TEST(PipelineAgreementOracle, Rs274GivesTheInterpreterVerdicts) {
+  if (!std::filesystem::exists("/usr/bin/rs274")) GTEST_SKIP() << "LinuxCNC's rs274 is absent";
+  TempDir dir;
+  for (const EdgeCase& c : edge_cases()) {
+    if (!c.interpreter_verdict) continue;
+    SCOPED_TRACE(c.name);
+    const auto program = dir.write(std::string(c.name) + ".ngc", c.text);
+    const auto r = run_command({"/usr/bin/rs274", "-g", program.string()});
+    EXPECT_EQ(r.exit_status, c.error_line == 0 ? 0 : 1) << r.out << r.err;
+    if (c.error_line == 0) continue;
+    // rs274 prints the block it stopped at after the error message.
+    std::string block;
+    std::size_t from = 0;
+    for (int line = 1; line <= c.error_line; ++line) {
+      const auto to = c.text.find('\n', from);
+      block = c.text.substr(from, to - from);
+      from = to + 1;
+    }
+    EXPECT_NE((r.out + r.err).find(block), std::string::npos) << r.out << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace cncd::test
