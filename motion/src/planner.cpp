@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "cncd/motion/soft_limits.hpp"
+
 namespace cncd::motion {
 namespace {
 
@@ -154,7 +156,7 @@ bool Planner::within_limits(const Segment& segment, std::string& error) const {
       const auto& axis = config_.axes[static_cast<std::size_t>(i)];
       if (!axis.present) continue;
       // Written so that a NaN is outside.
-      if (!(p[i] >= axis.min_limit - 1e-9 && p[i] <= axis.max_limit + 1e-9)) {
+      if (!(p[i] >= axis.min_limit - kSoftLimitSlack && p[i] <= axis.max_limit + kSoftLimitSlack)) {
         limit_error(error, i, p[i], axis.min_limit, axis.max_limit);
         return false;
       }

@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "cncd/interp/to_machine.hpp"
+#include "cncd/motion/soft_limits.hpp"
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
@@ -21,9 +22,6 @@ using interp::Pose;
 namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
-// Rounding in the offsets and unit conversions must not make a move that ends on a limit
-// a violation.
-constexpr double kLimitSlack = 1e-6;
 
 std::string number(double value) {
   char text[64];
@@ -140,8 +138,8 @@ class CheckSink final : public interp::CanonSink {
     if (machine->coordinates.find(letter) == std::string::npos) return;
     const config::AxisConfig& limits = machine->axes[axis];
     const bool finite = std::isfinite(value);
-    const bool below = value < limits.min_limit - kLimitSlack;
-    const bool above = value > limits.max_limit + kLimitSlack;
+    const bool below = value < limits.min_limit - motion::kSoftLimitSlack;
+    const bool above = value > limits.max_limit + motion::kSoftLimitSlack;
     if (finite && !below && !above) return;
     // One report per axis, side and line: an arc or a cycle may cross the same limit often.
     const Reported key{line, axis, above};

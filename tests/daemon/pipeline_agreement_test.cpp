@@ -61,6 +61,9 @@ std::vector<EdgeCase> edge_cases() {
        kHead + "G0 X280 Y100 Z0\nG2 X280 Y100 I10 J0 F6000\nG0 X100 Y10\nG3 X100 Y10 I0 J-10\nM2\n",
        0, false},
       {"line_just_beyond_a_limit", kHead + "G0 X10 Y10 Z0\nG0 X300.001\nM2\n", 3, false},
+      // 11.81102363 in is 300.0000002 mm: an inch program's rounding past a limit.
+      {"inch_line_beyond_a_limit_by_rounding",
+       "G20 G90 G17 G94\nG0 X1 Y1 Z0\nG0 X11.81102363\nM2\n", 3, false},
       {"arc_bulging_just_beyond_a_limit", bulging_circle(), 4, false},
   };
 }
