@@ -1,9 +1,9 @@
-// Offline plan simulation: runs a program through the interpreter, the daemon's ProgramFeeder,
-// the real Planner and a ServoLoop on simulated drives, cycle by cycle in virtual time (no
-// thread, no sleeping), and measures what the machine would do: the cycle time, its lower
-// bounds, peak axis velocity and acceleration, the deviation from the programmed path and when
-// each move starts. Used by `cncd-check --plan`, the daemon's remaining-time estimate and the
-// planner benchmark. Any thread; no shared state.
+// Offline plan simulation: runs a program through the interpreter, the ProgramFeeder the
+// daemon uses, the real Planner and a ServoLoop on simulated drives, cycle by cycle in virtual
+// time (no thread, no sleeping), and measures what the machine would do: the cycle time, its
+// lower bounds, peak axis velocity and acceleration, the deviation from the programmed path and
+// when each move starts. Used by `cncd-check --plan`, the daemon's remaining-time estimate and
+// the planner benchmark. Any thread; no shared state.
 #pragma once
 
 #include <array>
