@@ -55,7 +55,10 @@ int main(int argc, char** argv) {
   const auto config = bench_mill(period_ns, priority, cpu);
 
   motion::MotionController motion(config);
-  if (const auto error = motion.start(); !error.empty()) {
+  std::string error;
+  auto drivers = drivers::make_drivers(config, error);
+  if (error.empty()) error = motion.start(std::move(drivers));
+  if (!error.empty()) {
     std::fprintf(stderr, "cncd_servo_jitter: %s\n", error.c_str());
     return 1;
   }

@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cncd/drivers/driver.hpp"
 #include "cncd/pipeline/machine.hpp"
 #include "program_dirs.hpp"
 #include "rpc.hpp"
@@ -64,7 +65,10 @@ Task::~Task() {
 }
 
 std::string Task::start() {
-  std::string error = motion_.start();
+  // The machine's parts, built here from the config and handed to motion.
+  std::string error;
+  auto drivers = drivers::make_drivers(config_, error);
+  if (error.empty()) error = motion_.start(std::move(drivers));
   started_ = error.empty();
   if (started_) mark_running();
   for (const auto& warning : motion_.start_warnings())

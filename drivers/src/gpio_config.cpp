@@ -7,11 +7,6 @@
 #include "stepgen.hpp"
 
 namespace cncd::drivers {
-namespace {
-
-constexpr std::int64_t kMaxTimingNs = 100'000'000;
-
-}  // namespace
 
 std::string GpioDriver::configure(const config::MachineConfig& machine,
                                   const std::vector<int>& joints) {
@@ -36,7 +31,7 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     ini.fail("GPIO", "CHIP", error);
     return ini.error();
   }
-  const std::int64_t debounce_ns = ini.integer("GPIO", "DEBOUNCE_NS", 0, 0, 1'000'000'000);
+  const std::int64_t debounce_ns = ini.integer("GPIO", "DEBOUNCE_NS");
   const int debounce_ticks = ticks_for(debounce_ns, base_period_ns_);
 
   std::vector<GpioOutput> outputs;
@@ -66,7 +61,7 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     const int offset = line(section, key, false);
     if (offset < 0) return -1;
     input_lines.push_back(offset);
-    input_specs.emplace_back(ini.boolean(section, low_key, false), offset);
+    input_specs.emplace_back(ini.boolean(section, low_key), offset);
     return static_cast<int>(input_lines.size()) - 1;
   };
 
@@ -93,7 +88,7 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
       jl.enable_output = static_cast<int>(outputs.size());
       outputs.push_back(GpioOutput{o, prefix + "enable"});
     }
-    jl.enable_active_low = ini.boolean(s, "ENABLE_ACTIVE_LOW", false);
+    jl.enable_active_low = ini.boolean(s, "ENABLE_ACTIVE_LOW");
     jl.home = add_input(s, "HOME_SWITCH_LINE", "HOME_SWITCH_ACTIVE_LOW");
     jl.min_limit = add_input(s, "MIN_LIMIT_LINE", "MIN_LIMIT_ACTIVE_LOW");
     jl.max_limit = add_input(s, "MAX_LIMIT_LINE", "MAX_LIMIT_ACTIVE_LOW");
@@ -103,13 +98,13 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     StepgenTiming t;
     t.base_period_s = base_s;
     t.servo_period_s = static_cast<double>(servo_period_ns_) * 1e-9;
-    t.steplen_ticks = ticks_for(ini.integer(s, "STEPLEN", 1, 0, kMaxTimingNs), base_period_ns_);
-    t.stepspace_ticks = ticks_for(ini.integer(s, "STEPSPACE", 1, 0, kMaxTimingNs), base_period_ns_);
-    t.dirsetup_ticks = ticks_for(ini.integer(s, "DIRSETUP", 1, 0, kMaxTimingNs), base_period_ns_);
-    t.dirhold_ticks = ticks_for(ini.integer(s, "DIRHOLD", 1, 0, kMaxTimingNs), base_period_ns_);
+    t.steplen_ticks = ticks_for(ini.integer(s, "STEPLEN"), base_period_ns_);
+    t.stepspace_ticks = ticks_for(ini.integer(s, "STEPSPACE"), base_period_ns_);
+    t.dirsetup_ticks = ticks_for(ini.integer(s, "DIRSETUP"), base_period_ns_);
+    t.dirhold_ticks = ticks_for(ini.integer(s, "DIRHOLD"), base_period_ns_);
     const double scale = std::abs(jl.scale);
-    t.max_velocity_steps = ini.real(s, "STEPGEN_MAXVEL", 0, 0, 1e9) * scale;
-    t.max_acceleration_steps = ini.real(s, "STEPGEN_MAXACCEL", 0, 0, 1e12) * scale;
+    t.max_velocity_steps = ini.real(s, "STEPGEN_MAXVEL") * scale;
+    t.max_acceleration_steps = ini.real(s, "STEPGEN_MAXACCEL") * scale;
     stepgens_[k].setup(t);
   }
   estop_input_ = add_input("GPIO", "ESTOP_LINE", "ESTOP_ACTIVE_LOW");

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace cncd::drivers {
@@ -42,8 +43,39 @@ std::optional<std::string> IniLookup::text(std::string_view section, std::string
   return ini_->value(section, key);
 }
 
-double IniLookup::real(std::string_view section, std::string_view key, double fallback, double min,
-                       double max) {
+const config::KeySpec* IniLookup::spec(std::string_view section, std::string_view key) {
+  const config::KeySpec* found = config::find_key_spec(section, key);
+  if (found == nullptr) fail(section, key, "is not in the config key table");
+  return found;
+}
+
+namespace {
+
+double default_number(const config::KeySpec& spec) {
+  return parse_real(std::string(spec.default_value)).value_or(0.0);
+}
+
+std::string number_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", value);
+  return text;
+}
+
+std::string range_text(const config::KeySpec& spec) {
+  return "outside " + number_text(spec.min) + " .. " + number_text(spec.max);
+}
+
+bool in_range(const config::KeySpec& spec, double value) {
+  const bool above_min = spec.min_exclusive ? value > spec.min : value >= spec.min;
+  return above_min && value <= spec.max;
+}
+
+}  // namespace
+
+double IniLookup::real(std::string_view section, std::string_view key) {
+  const config::KeySpec* s = spec(section, key);
+  if (s == nullptr) return 0.0;
+  const double fallback = default_number(*s);
   const auto raw = text(section, key);
   if (!raw) return fallback;
   const auto value = parse_real(*raw);
@@ -51,15 +83,17 @@ double IniLookup::real(std::string_view section, std::string_view key, double fa
     fail(section, key, "'" + *raw + "' is not a number");
     return fallback;
   }
-  if (*value < min || *value > max) {
-    fail(section, key, *raw + " is outside " + std::to_string(min) + " .. " + std::to_string(max));
+  if (!in_range(*s, *value)) {
+    fail(section, key, *raw + " is " + range_text(*s));
     return fallback;
   }
   return *value;
 }
 
-std::int64_t IniLookup::integer(std::string_view section, std::string_view key,
-                                std::int64_t fallback, std::int64_t min, std::int64_t max) {
+std::int64_t IniLookup::integer(std::string_view section, std::string_view key) {
+  const config::KeySpec* s = spec(section, key);
+  if (s == nullptr) return 0;
+  const auto fallback = static_cast<std::int64_t>(default_number(*s));
   const auto raw = text(section, key);
   if (!raw) return fallback;
   const auto value = parse_real(*raw);
@@ -67,14 +101,17 @@ std::int64_t IniLookup::integer(std::string_view section, std::string_view key,
     fail(section, key, "'" + *raw + "' is not a whole number");
     return fallback;
   }
-  if (*value < static_cast<double>(min) || *value > static_cast<double>(max)) {
-    fail(section, key, *raw + " is outside " + std::to_string(min) + " .. " + std::to_string(max));
+  if (!in_range(*s, *value)) {
+    fail(section, key, *raw + " is " + range_text(*s));
     return fallback;
   }
   return static_cast<std::int64_t>(*value);
 }
 
-bool IniLookup::boolean(std::string_view section, std::string_view key, bool fallback) {
+bool IniLookup::boolean(std::string_view section, std::string_view key) {
+  const config::KeySpec* s = spec(section, key);
+  if (s == nullptr) return false;
+  const bool fallback = s->default_value == "1";
   const auto raw = text(section, key);
   if (!raw) return fallback;
   const std::string u = upper(*raw);
@@ -82,6 +119,22 @@ bool IniLookup::boolean(std::string_view section, std::string_view key, bool fal
   if (u == "0" || u == "FALSE" || u == "NO" || u == "OFF") return false;
   fail(section, key, "'" + *raw + "' is not a boolean (1/0, TRUE/FALSE, YES/NO, ON/OFF)");
   return fallback;
+}
+
+std::string IniLookup::choice(std::string_view section, std::string_view key) {
+  const config::KeySpec* s = spec(section, key);
+  if (s == nullptr) return "";
+  const auto raw = text(section, key);
+  if (!raw) return std::string(s->default_value);
+  const std::string u = upper(*raw);
+  std::string_view rest = s->choices;
+  while (!rest.empty()) {
+    const auto bar = rest.find('|');
+    if (upper(std::string(rest.substr(0, bar))) == u) return *raw;
+    rest = bar == std::string_view::npos ? std::string_view() : rest.substr(bar + 1);
+  }
+  fail(section, key, "'" + *raw + "' must be one of " + std::string(s->choices));
+  return std::string(s->default_value);
 }
 
 void IniLookup::fail(std::string_view section, std::string_view key, const std::string& message) {

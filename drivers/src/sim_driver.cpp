@@ -18,7 +18,7 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
     if (j < 0 || static_cast<std::size_t>(j) >= machine.joints.size()) {
       return "joint " + std::to_string(j) + " is not in the configuration";
     }
-    lag_s_[i].store(ini.real(joint_section(j), "SIM_LAG", 0.0, 0.0, 10.0));
+    lag_s_[i].store(ini.real(joint_section(j), "SIM_LAG"));
     if (!ini.error().empty()) return ini.error();
     const auto& joint = machine.joints[static_cast<std::size_t>(j)];
     const int direction = joint.home_search_vel > 0 ? 1 : joint.home_search_vel < 0 ? -1 : 0;

@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <thread>
 
 #include "cncd/motion/planner.hpp"
@@ -58,8 +57,7 @@ struct MotionController::Impl {
 
   const config::MachineConfig& config;
   Planner planner;
-  std::vector<std::unique_ptr<drivers::Driver>> drivers;
-  drivers::SimDriver* sim = nullptr;
+  std::vector<drivers::DriverInstance> drivers;
   std::unique_ptr<ServoLoop> loop;
   std::thread thread;
   std::atomic<bool> running{false};
@@ -185,29 +183,26 @@ MotionController::~MotionController() {
   stop();
 }
 
-std::string MotionController::start() {
+std::string MotionController::start(std::vector<drivers::DriverInstance> drivers) {
   if (impl_->running.load()) return "";
   const auto& config = impl_->config;
-  // One driver instance per driver name, owning its joints in joint order.
-  std::map<std::string, std::vector<int>> by_driver;
-  for (std::size_t j = 0; j < config.joints.size(); ++j) {
-    by_driver[config.joints[j].driver].push_back(static_cast<int>(j));
-  }
+  std::vector<bool> driven(config.joints.size(), false);
   std::vector<DriverBinding> bindings;
-  impl_->loop.reset();
-  impl_->sim = nullptr;
-  impl_->drivers.clear();
-  for (const auto& [name, joints] : by_driver) {
-    std::string error;
-    auto driver = drivers::make_driver(name, error);
-    if (!driver) return error;
-    if (auto problem = driver->configure(config, joints); !problem.empty()) {
-      return "driver '" + name + "': " + problem;
+  for (const auto& instance : drivers) {
+    if (!instance.driver) return "a driver is missing";
+    for (const int joint : instance.joints) {
+      if (joint < 0 || joint >= static_cast<int>(driven.size()) ||
+          driven[static_cast<std::size_t>(joint)])
+        return "joint " + std::to_string(joint) + " is not a joint a driver may drive";
+      driven[static_cast<std::size_t>(joint)] = true;
     }
-    if (name == "sim") impl_->sim = static_cast<drivers::SimDriver*>(driver.get());
-    bindings.push_back(DriverBinding{driver.get(), joints});
-    impl_->drivers.push_back(std::move(driver));
+    bindings.push_back(DriverBinding{instance.driver.get(), instance.joints});
   }
+  for (std::size_t j = 0; j < driven.size(); ++j) {
+    if (!driven[j]) return "joint " + std::to_string(j) + " has no driver";
+  }
+  impl_->loop.reset();
+  impl_->drivers = std::move(drivers);
   impl_->loop = std::make_unique<ServoLoop>(config, std::move(bindings));
   if (!impl_->start_positions.empty()) {
     JointArray joints{};
@@ -216,8 +211,8 @@ std::string MotionController::start() {
     impl_->loop->set_start_positions(joints);
     impl_->start_positions.clear();
   }
-  for (auto& driver : impl_->drivers)
-    driver->enable();
+  for (auto& instance : impl_->drivers)
+    instance.driver->enable();
 
   impl_->warnings.clear();
   if (CNCD_SANITIZED) {
@@ -245,8 +240,8 @@ void MotionController::set_start_positions(const std::vector<double>& joints) {
 void MotionController::stop() {
   if (!impl_->running.exchange(false)) return;
   impl_->thread.join();
-  for (auto& driver : impl_->drivers)
-    driver->disable();
+  for (auto& instance : impl_->drivers)
+    instance.driver->disable();
   if (impl_->locked) {
     munlockall();
     impl_->locked = false;
@@ -407,8 +402,8 @@ void MotionController::jog_stop(int axis) {
 
 std::int64_t MotionController::feedback_deadline_ns() const {
   std::int64_t deadline = 0;
-  for (const auto& driver : impl_->drivers)
-    deadline = std::max(deadline, driver->feedback_deadline_ns());
+  for (const auto& instance : impl_->drivers)
+    deadline = std::max(deadline, instance.driver->feedback_deadline_ns());
   return deadline;
 }
 
@@ -427,10 +422,6 @@ bool MotionController::poll_event(Event& event) {
 
 const std::vector<std::string>& MotionController::start_warnings() const {
   return impl_->warnings;
-}
-
-drivers::SimDriver* MotionController::sim_driver() {
-  return impl_->sim;
 }
 
 }  // namespace cncd::motion

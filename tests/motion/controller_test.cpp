@@ -14,6 +14,14 @@ namespace {
 using motion::MachineState;
 using Result = motion::MotionController::EnqueueResult;
 
+// The machine's drivers, as the daemon builds them.
+std::vector<drivers::DriverInstance> drivers_of(const config::MachineConfig& config) {
+  std::string error;
+  auto out = drivers::make_drivers(config, error);
+  EXPECT_EQ(error, "");
+  return out;
+}
+
 template <typename Predicate>
 bool wait_for(Predicate done, std::chrono::milliseconds limit = std::chrono::seconds(10)) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
@@ -27,7 +35,7 @@ bool wait_for(Predicate done, std::chrono::milliseconds limit = std::chrono::sec
 TEST(MotionController, RunsAMoveOnItsServoThread) {
   const auto config = small_mill();
   motion::MotionController motion(config);
-  ASSERT_EQ(motion.start(), "");
+  ASSERT_EQ(motion.start(drivers_of(config)), "");
   EXPECT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::refused);
   EXPECT_EQ(motion.enqueue_error(), "machine is not on");
   motion.reset_estop();
@@ -63,7 +71,7 @@ TEST(MotionController, RunsAMoveOnItsServoThread) {
 TEST(MotionController, NextMoveStartsWhereAnAbortLeftTheMachine) {
   const auto config = small_mill();
   motion::MotionController motion(config);
-  ASSERT_EQ(motion.start(), "");
+  ASSERT_EQ(motion.start(drivers_of(config)), "");
   motion.reset_estop();
   motion.machine_on();
   motion.home(0xFFFFFFFFu);
@@ -94,7 +102,7 @@ TEST(MotionController, RunsWithoutWhatTheSystemRefusesAndSaysSoOnce) {
   config.cncd.rt_priority = 0;  // not a SCHED_FIFO priority: refused even for root
   config.cncd.rt_cpu = 1000;    // no such CPU
   motion::MotionController motion(config);
-  ASSERT_EQ(motion.start(), "");
+  ASSERT_EQ(motion.start(drivers_of(config)), "");
   EXPECT_TRUE(has_warning(motion, "SCHED_FIFO priority 0 refused")) << motion.start_warnings()[0];
   EXPECT_TRUE(has_warning(motion, "CPU 1000"));
   EXPECT_FALSE(motion.status().rt.realtime);
@@ -115,7 +123,7 @@ TEST(MotionController, StartsAfreshAfterStop) {
   const auto config = small_mill();
   motion::MotionController motion(config);
   for (int run = 0; run < 2; ++run) {
-    ASSERT_EQ(motion.start(), "");
+    ASSERT_EQ(motion.start(drivers_of(config)), "");
     EXPECT_EQ(motion.status().machine, MachineState::estop);
     EXPECT_FALSE(motion.status().homed[0]);
     motion.reset_estop();
@@ -125,7 +133,6 @@ TEST(MotionController, StartsAfreshAfterStop) {
     ASSERT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 3, 1, 0, 50)), Result::queued);
     ASSERT_TRUE(wait_for([&] { return motion.status().segments_done == 1; })) << "run " << run;
     EXPECT_EQ(motion.status().commanded[1], 1);
-    ASSERT_NE(motion.sim_driver(), nullptr);
     motion.stop();
   }
 }
@@ -136,7 +143,7 @@ TEST(MotionController, RefusesMovesWhileHoming) {
   config.joints[0].home_latch_vel = 10;
   config.joints[0].home_offset = 5;  // the sim's switch: about half a second of homing
   motion::MotionController motion(config);
-  ASSERT_EQ(motion.start(), "");
+  ASSERT_EQ(motion.start(drivers_of(config)), "");
   motion.reset_estop();
   motion.machine_on();
   motion.home(0xFFFFFFFFu);
@@ -153,14 +160,31 @@ TEST(MotionController, RefusesMovesWhileHoming) {
   EXPECT_EQ(motion.status().commanded[0], 1);
 }
 
-TEST(MotionController, UnavailableDriverFailsStart) {
+TEST(MotionController, UnavailableDriverIsNotMade) {
   auto config = small_mill();
   config.joints[1].driver = "teleporter";
+  std::string error;
+  EXPECT_TRUE(drivers::make_drivers(config, error).empty());
+  EXPECT_NE(error.find("'teleporter'"), std::string::npos) << error;
+}
+
+// Every joint needs a driver, and one only: motion refuses to start otherwise.
+TEST(MotionController, AJointWithoutADriverFailsStart) {
+  const auto config = small_mill();
+  auto drivers = drivers_of(config);
+  ASSERT_FALSE(drivers.empty());
+  drivers.front().joints.pop_back();
+  const int left_out = static_cast<int>(config.joints.size()) - 1;
   motion::MotionController motion(config);
-  EXPECT_NE(motion.start().find("'teleporter'"), std::string::npos);
+  EXPECT_EQ(motion.start(std::move(drivers)),
+            "joint " + std::to_string(left_out) + " has no driver");
   EXPECT_EQ(motion.enqueue(line_to(motion::Move::Kind::feed, 1, 0, 0, 10)), Result::refused);
   EXPECT_EQ(motion.status().machine, MachineState::estop);
   motion.estop();  // harmless without a servo thread
+
+  auto twice = drivers_of(config);
+  twice.front().joints.push_back(0);
+  EXPECT_EQ(motion.start(std::move(twice)), "joint 0 is not a joint a driver may drive");
 }
 
 }  // namespace

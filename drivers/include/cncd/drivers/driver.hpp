@@ -97,4 +97,15 @@ class Driver {
 // Non-RT. Creates the driver named by a joint's DRIVER key, or returns nullptr and sets error.
 std::unique_ptr<Driver> make_driver(const std::string& name, std::string& error);
 
+// A configured driver and the joints it drives, in joint order.
+struct DriverInstance {
+  std::unique_ptr<Driver> driver;
+  std::vector<int> joints;
+};
+
+// Non-RT. The machine's drivers: one instance per DRIVER name among the config's joints,
+// configured for its joints. Returns them, or nothing and sets `error` ("driver 'modbus': ...")
+// when one cannot be made or configured.
+std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, std::string& error);
+
 }  // namespace cncd::drivers

@@ -1,4 +1,4 @@
-// MotionController: owns the planner, the servo thread and the drivers.
+// MotionController: owns the planner and the servo thread, and runs the drivers it is given.
 //
 // Threads: the task thread calls every public method; the servo thread is internal. Status is
 // read lock-free (seqlock) from any thread.
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
-#include "cncd/drivers/sim_driver.hpp"
+#include "cncd/drivers/driver.hpp"
 #include "cncd/motion/servo_loop.hpp"
 #include "cncd/motion/status.hpp"
 #include "cncd/motion/types.hpp"
@@ -24,12 +24,13 @@ class MotionController {
   MotionController(const MotionController&) = delete;
   MotionController& operator=(const MotionController&) = delete;
 
-  // Creates and configures the drivers and starts the servo thread at [EMCMOT] SERVO_PERIOD,
-  // SCHED_FIFO priority [CNCD] RT_PRIORITY, pinned to [CNCD] RT_CPU when given, memory locked.
-  // Returns "" or an error. What the OS refuses (SCHED_FIFO, the CPU, mlockall) does not stop
-  // it: start_warnings() then says what, once, for the caller to log. Calling start() again
-  // after stop() starts afresh (estop, unhomed).
-  std::string start();
+  // Takes the machine's configured drivers (drivers::make_drivers, or a test's own), enables
+  // them and starts the servo thread at [EMCMOT] SERVO_PERIOD, SCHED_FIFO priority
+  // [CNCD] RT_PRIORITY, pinned to [CNCD] RT_CPU when given, memory locked. Returns "" or an
+  // error (a joint no driver drives). What the OS refuses (SCHED_FIFO, the CPU, mlockall) does
+  // not stop it: start_warnings() then says what, once, for the caller to log. Calling start()
+  // again after stop() starts afresh (estop, unhomed) with the drivers given then.
+  std::string start(std::vector<drivers::DriverInstance> drivers);
   // Joint positions (machine units, joint order) the next start() begins at instead of where
   // the drives stand, unhomed: LinuxCNC's [TRAJ] POSITION_FILE. Call before start().
   void set_start_positions(const std::vector<double>& joints);
@@ -92,8 +93,6 @@ class MotionController {
   bool poll_event(Event& event);
   // Warnings from start() (real-time scheduling or memory locking refused), for the log.
   const std::vector<std::string>& start_warnings() const;
-  // The simulated driver, when one drives any joint (tests inject lag and faults through it).
-  drivers::SimDriver* sim_driver();
 
  private:
   struct Impl;
