@@ -178,7 +178,10 @@ fs::path write_cncd_ini(const fs::path& dir) {
   std::ofstream out(path);
   out << "# planner bench: a small fast mill, simulated drives\n"
          "[EMC]\nMACHINE = planner bench mill\n[EMCMOT]\nSERVO_PERIOD = 1000000\n"
-         "[EMCIO]\nTOOL_TABLE = bench_mill.tbl\n"
+         // By its full path: a relative one names a file in the machine's state directory.
+         "[EMCIO]\nTOOL_TABLE = "
+      << (dir / "bench_mill.tbl").string()
+      << "\n"
          "[TRAJ]\nCOORDINATES = X Y Z\nLINEAR_UNITS = mm\nANGULAR_UNITS = degree\n"
          "MAX_LINEAR_VELOCITY = "
       << kLinearVelocity << "\nMAX_LINEAR_ACCELERATION = " << kLinearAcceleration
