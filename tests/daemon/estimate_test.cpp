@@ -1,6 +1,7 @@
 // The open program's estimated and remaining time (status.get program.estimated_s and
 // remaining_s) against the real daemon on the simulated mill: a run takes the estimated time
-// within 1 %, remaining time counts down and stands still while paused.
+// within 1 % (plus the loop's notice of start and end), remaining time counts down and stands
+// still while paused.
 #include <fstream>
 #include <sstream>
 
@@ -28,6 +29,11 @@ constexpr const char* kPart =
     "X110\n"
     "G80 G0 Z10\n"
     "M2\n";
+
+// What the servo clock may count beyond the moves themselves: periods between program.run and
+// the first move reaching the servo thread, and between the last one ending and the daemon's
+// loop seeing the run end.
+constexpr double kLoopAllowance = 0.1;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -71,7 +77,9 @@ class EstimateTest : public MachineTest {
     // shared machine, sanitizer builds): printed, not held to the estimate.
     const double motion = done["program"]["motion_s"].get<double>();
     const double elapsed = done["program"]["elapsed_s"].get<double>();
-    EXPECT_NEAR(motion, estimated, 0.01 * estimated) << done.dump();
+    // The daemon's loop notices the start and the end of the run at its own pace: a few ms
+    // each, up to tens of ms on a loaded machine under the sanitizers (74 ms seen in all).
+    EXPECT_NEAR(motion, estimated, 0.01 * estimated + kLoopAllowance) << done.dump();
     EXPECT_GE(elapsed + 0.002, motion) << done.dump();
     EXPECT_GE(measured + 0.002, motion);
     std::printf(

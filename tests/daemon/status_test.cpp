@@ -92,9 +92,11 @@ TEST_F(MachineTest, ProgressAndElapsedTime) {
   EXPECT_GT(s["program"]["elapsed_s"].get<double>(), 1.0);  // 40 mm at 20 mm/s
   // The run took the time estimated at program.open; nothing remains.
   EXPECT_EQ(s["program"]["remaining_s"], 0.0);
-  // On the servo clock: wall time also counts periods a stalled servo thread skipped.
+  // On the servo clock: wall time also counts periods a stalled servo thread skipped. The
+  // servo clock still counts the daemon's loop noticing the start and the end of the run: up to
+  // tens of ms on a loaded machine under the sanitizers.
   EXPECT_NEAR(s["program"]["estimated_s"].get<double>(), s["program"]["motion_s"].get<double>(),
-              0.05);
+              0.1);
   EXPECT_GE(s["program"]["elapsed_s"].get<double>() + 0.002,
             s["program"]["motion_s"].get<double>());
 }
