@@ -111,7 +111,8 @@ std::int64_t IniLookup::integer(std::string_view section, std::string_view key) 
 bool IniLookup::boolean(std::string_view section, std::string_view key) {
   const config::KeySpec* s = spec(section, key);
   if (s == nullptr) return false;
-  const bool fallback = s->default_value == "1";
+  const std::string d = upper(std::string(s->default_value));
+  const bool fallback = d == "1" || d == "TRUE" || d == "YES" || d == "ON";
   const auto raw = text(section, key);
   if (!raw) return fallback;
   const std::string u = upper(*raw);
