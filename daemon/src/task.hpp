@@ -32,6 +32,8 @@ enum class ExecState { idle, running, paused };
 
 // "G54" .. "G59.3" for coordinate system 1..9.
 std::string coord_system_name(int system);
+// "estop", "off" or "on", as status and errors name the machine's state.
+const char* machine_state_name(motion::MachineState state);
 enum class Mode { manual, automatic, mdi };
 
 class Task {

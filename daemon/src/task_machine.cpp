@@ -16,24 +16,12 @@ using Clock = std::chrono::steady_clock;
 constexpr int kJudgedPeriods = 5;
 constexpr auto kMinOnCheck = std::chrono::milliseconds(20);
 
-const char* state_name(motion::MachineState state) {
-  switch (state) {
-    case motion::MachineState::estop:
-      return "estop";
-    case motion::MachineState::off:
-      return "off";
-    case motion::MachineState::on:
-      return "on";
-  }
-  return "estop";
-}
-
 // Why the machine is not in `wanted`: the latched fault, which names the joint, the drive and
 // what went wrong, or the state it is in.
 std::string why_not(const motion::Status& status, motion::MachineState wanted) {
   if (status.fault_reason[0] != '\0') return status.fault_reason;
-  return std::string("the machine is ") + state_name(status.machine) + ", not " +
-         state_name(wanted);
+  return std::string("the machine is ") + machine_state_name(status.machine) + ", not " +
+         machine_state_name(wanted);
 }
 }  // namespace
 

@@ -12,18 +12,6 @@ namespace cncd::daemon {
 using nlohmann::json;
 
 namespace {
-const char* machine_state_name(motion::MachineState state) {
-  switch (state) {
-    case motion::MachineState::estop:
-      return "estop";
-    case motion::MachineState::off:
-      return "off";
-    case motion::MachineState::on:
-      return "on";
-  }
-  return "estop";
-}
-
 const char* motion_state_name(motion::MotionState state) {
   switch (state) {
     case motion::MotionState::idle:
@@ -131,6 +119,18 @@ json active_m_codes(const interp::InterpState& st) {
   return out;
 }
 }  // namespace
+
+const char* machine_state_name(motion::MachineState state) {
+  switch (state) {
+    case motion::MachineState::estop:
+      return "estop";
+    case motion::MachineState::off:
+      return "off";
+    case motion::MachineState::on:
+      return "on";
+  }
+  return "estop";
+}
 
 std::string coord_system_name(int system) {
   return code_name('G', system < 7 ? 530 + 10 * system : 584 + system);
