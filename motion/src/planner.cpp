@@ -167,19 +167,13 @@ bool Planner::within_limits(const Segment& segment, std::string& error) const {
   // 1e-4 of the radius); in its plane an arc reaches farthest where its angle is a multiple
   // of a quarter turn (a spiral very near there), and a bulge that small between two samples
   // would be missed: those points are checked too, where the offline check finds them.
-  const bool arc = segment.kind == Segment::Kind::arc;
-  const int samples = arc ? 256 : 1;
+  const int samples = segment.kind == Segment::Kind::arc ? 256 : 1;
   for (int k = 0; k <= samples; ++k) {
     if (!inside(segment.length * k / samples)) return false;
   }
-  if (!arc || segment.sweep == 0) return true;
-  const double quarter = std::numbers::pi / 2;
-  const double from = std::min(segment.start_angle, segment.start_angle + segment.sweep);
-  const double to = std::max(segment.start_angle, segment.start_angle + segment.sweep);
-  for (double angle = std::ceil(from / quarter) * quarter; angle <= to; angle += quarter) {
-    if (!inside(segment.length * (angle - segment.start_angle) / segment.sweep)) return false;
-  }
-  return true;
+  bool ok = true;
+  for_each_arc_extreme(segment, [&](double s, int) { ok = ok && inside(s); });
+  return ok;
 }
 
 std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bool check_limits,

@@ -5,12 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <numbers>
 #include <string_view>
 
-#include "cncd/interp/to_machine.hpp"
+#include "cncd/motion/planner.hpp"
 #include "cncd/motion/soft_limits.hpp"
-#include "cncd/pipeline/machine.hpp"
+#include "cncd/pipeline/feeder.hpp"
 
 namespace cncd::pipeline {
 
@@ -21,8 +20,6 @@ using interp::Pose;
 
 namespace {
 
-constexpr double kTwoPi = 2 * std::numbers::pi;
-
 std::string number(double value) {
   char text[64];
   // %.4f of an absurd number would print hundreds of digits.
@@ -30,74 +27,77 @@ std::string number(double value) {
   return text;
 }
 
-// The unit vectors of the arc plane's first and second axes (program frame) in machine frame:
-// the tracker's transform is a rotation about Z, a uniform scale and offsets, so their images
-// stay orthogonal with the same orientation.
-struct ArcFrame {
-  Pose center{};
-  Pose u{};
-  Pose v{};
-};
-
-double dot(const Pose& a, const Pose& b) {
-  double sum = 0;
-  for (std::size_t i = 0; i < kAxes; ++i)
-    sum += a[i] * b[i];
-  return sum;
-}
-
-Pose minus(const Pose& a, const Pose& b) {
-  Pose r{};
-  for (std::size_t i = 0; i < kAxes; ++i)
-    r[i] = a[i] - b[i];
-  return r;
-}
-
 double xyz_distance(const Pose& a, const Pose& b) {
   return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
 }
 
+// Without a machine, arcs are still built as the planner builds them, on a machine that has
+// every axis (the soft limits are not checked then).
+config::MachineConfig every_axis(interp::Units units) {
+  config::MachineConfig machine;
+  machine.linear_units =
+      units == interp::Units::inches ? config::LinearUnits::inch : config::LinearUnits::mm;
+  for (auto& axis : machine.axes)
+    axis.present = true;
+  return machine;
+}
+
+// Reads the program as the daemon's task does: the canonical commands go through the same
+// ProgramFeeder into machine moves, and an arc is the planner's own segment, so its reach is
+// judged on the geometry the machine will follow.
 class CheckSink final : public interp::CanonSink {
  public:
   CheckSink(const CheckOptions& options, CheckReport& report, std::string file)
       : options_(options),
         report_(report),
         file_(std::move(file)),
-        tracker_(options.interp.machine_units) {}
+        machine_(options.machine ? *options.machine : every_axis(options.interp.machine_units)),
+        planner_(machine_),
+        feeder_(options.interp.machine_units) {}
 
   void start_at(const Pose& machine) { position_ = machine; }
 
   void emit(const CanonCommand& command) override {
     if (options_.trace) options_.trace->emit(command);
-    if (command.kind == CanonKind::arc_feed) {
-      arc(command);
-      return;
-    }
-    const CanonCommand out = tracker_.to_machine(command);
-    switch (out.kind) {
-      case CanonKind::straight_traverse:
-      case CanonKind::straight_feed: {
-        ensure_start();
-        const bool feed = out.kind == CanonKind::straight_feed;
-        ++(feed ? report_.feeds : report_.traverses);
-        if (feed) report_.feed_length += xyz_distance(position_, out.pos);
-        reach(out.pos, out.line, feed ? "feed move" : "rapid move");
-        position_ = out.pos;
-        break;
-      }
+    switch (command.kind) {
       case CanonKind::dwell:
         ++report_.dwells;
         break;
       case CanonKind::change_tool:
       case CanonKind::change_tool_number:
-        if (out.ivalue > 0) report_.tools.insert(out.ivalue);
+        if (command.ivalue > 0) report_.tools.insert(command.ivalue);
         break;
       default:
         break;
     }
+    feeder_.emit(command);
+    while (!feeder_.pending.empty()) {
+      const motion::Move move = feeder_.pending.front();
+      feeder_.pending.pop_front();
+      switch (move.kind) {
+        case motion::Move::Kind::traverse:
+        case motion::Move::Kind::feed:
+          line(move);
+          break;
+        case motion::Move::Kind::arc:
+          arc(move);
+          break;
+        case motion::Move::Kind::dwell:
+          break;
+      }
+    }
   }
 
  private:
+  void line(const motion::Move& move) {
+    ensure_start();
+    const bool feed = move.kind == motion::Move::Kind::feed;
+    ++(feed ? report_.feeds : report_.traverses);
+    if (feed) report_.feed_length += xyz_distance(position_, move.end);
+    reach(move.end, move.line, feed ? "feed move" : "rapid move");
+    position_ = move.end;
+  }
+
   // A straight move is checked at its end: the limits form a box and the move starts inside
   // it (or was reported when it got out). Until an axis leaves where it started it has not
   // been moved: the start is not a target of the program.
@@ -117,7 +117,7 @@ class CheckSink final : public interp::CanonSink {
   void ensure_start() {
     if (started_) return;
     started_ = true;
-    if (!options_.start_machine) position_ = tracker_.machine_pose(Pose{});
+    if (!options_.start_machine) position_ = feeder_.tracker().machine_pose(Pose{});
     start_ = position_;
   }
 
@@ -131,23 +131,20 @@ class CheckSink final : public interp::CanonSink {
     }
   }
 
+  bool limited(std::size_t axis) const {
+    return options_.machine != nullptr &&
+           options_.machine->coordinates.find(config::kAxisLetters[axis]) != std::string::npos;
+  }
+
   void check(std::size_t axis, double value, int line, const char* what) {
-    const config::MachineConfig* machine = options_.machine;
-    if (!machine) return;
+    if (!limited(axis)) return;
     const char letter = config::kAxisLetters[axis];
-    if (machine->coordinates.find(letter) == std::string::npos) return;
-    const config::AxisConfig& limits = machine->axes[axis];
+    const config::AxisConfig& limits = options_.machine->axes[axis];
     const bool finite = std::isfinite(value);
     const bool below = value < limits.min_limit - motion::kSoftLimitSlack;
     const bool above = value > limits.max_limit + motion::kSoftLimitSlack;
     if (finite && !below && !above) return;
-    // One report per axis, side and line: an arc or a cycle may cross the same limit often.
-    const Reported key{line, axis, above};
-    if (std::find(reported_.begin(), reported_.end(), key) != reported_.end()) return;
-    if (reported_.size() > 64) reported_.erase(reported_.begin());
-    reported_.push_back(key);
-    ++report_.limit_violations;
-    if (report_.problems.size() >= options_.max_problems) return;
+    if (!first_report(line, axis, above)) return;
     std::string message =
         !finite
             ? std::string(what) + ": " + letter + " " + number(value) + " is not a finite number"
@@ -158,94 +155,51 @@ class CheckSink final : public interp::CanonSink {
     report_.problems.push_back({file_, line, std::move(message)});
   }
 
-  // An arc reaches beyond its end points where it crosses the direction of an axis: for each
-  // machine axis k the extremes of center + r (cos t u + sin t v) lie at t = atan2(v_k, u_k)
-  // and opposite. The radius may change along the sweep (LinuxCNC allows a small difference
-  // between start and end radius): it is interpolated, as are the helix axis and A..W.
-  void arc(const CanonCommand& command) {
-    const auto [first, second, normal] = plane_axes(command.plane);
-    Pose end = command.pos;
-    end[first] = command.first_end;
-    end[second] = command.second_end;
-    end[normal] = command.axis_end_point;
-    Pose center = end;
-    center[first] = command.first_axis;
-    center[second] = command.second_axis;
+  // One report per axis, side and line: an arc or a cycle may cross the same limit often.
+  // Counts the violation; false when it is not reported (again, or past max_problems).
+  bool first_report(int line, std::size_t axis, bool above) {
+    const Reported key{line, axis, above};
+    if (std::find(reported_.begin(), reported_.end(), key) != reported_.end()) return false;
+    if (reported_.size() > 64) reported_.erase(reported_.begin());
+    reported_.push_back(key);
+    ++report_.limit_violations;
+    return report_.problems.size() < options_.max_problems;
+  }
+
+  // An arc reaches beyond its end points where it turns back along one of its plane's axes:
+  // the planner's segment names those points (motion::for_each_arc_extreme), and the path
+  // between them is the one the servo loop samples. An arc the planner cannot make (ends not on
+  // one circle, a start at the centre) is reported at its line, as the run would refuse it.
+  void arc(const motion::Move& move) {
     ensure_start();
-    const CanonCommand out = tracker_.to_machine(command);
     ++report_.arcs;
-    ArcFrame frame;
-    frame.center = tracker_.machine_pose(center);
-    const double scale = tracker_.length_factor();
-    Pose step = center;
-    step[first] += 1;
-    frame.u = minus(tracker_.machine_pose(step), frame.center);
-    step = center;
-    step[second] += 1;
-    frame.v = minus(tracker_.machine_pose(step), frame.center);
-    for (std::size_t i = 0; i < kAxes; ++i) {
-      frame.u[i] /= scale;
-      frame.v[i] /= scale;
-    }
-    const Pose machine_end = out.pos;
-    const Pose from_start = minus(position_, frame.center);
-    const Pose from_end = minus(machine_end, frame.center);
-    const double start_angle = std::atan2(dot(from_start, frame.v), dot(from_start, frame.u));
-    const double end_angle = std::atan2(dot(from_end, frame.v), dot(from_end, frame.u));
-    const double start_radius = std::hypot(dot(from_start, frame.u), dot(from_start, frame.v));
-    const double end_radius = std::hypot(dot(from_end, frame.u), dot(from_end, frame.v));
-    // Signed sweep: counterclockwise for positive rotation, |rotation| - 1 extra full turns.
-    double sweep = end_angle - start_angle;
-    const int turns = std::abs(command.rotation);
-    if (command.rotation >= 0) {
-      if (sweep <= 1e-12) sweep += kTwoPi;
-      sweep += kTwoPi * std::max(0, turns - 1);
+    std::string error;
+    const auto segment = planner_.plan(move, position_, false, error);
+    if (!segment) {
+      // Keyed by no axis: one report per line.
+      if (first_report(move.line, kAxes, false))
+        report_.problems.push_back({file_, move.line, "arc: " + error});
     } else {
-      if (sweep >= -1e-12) sweep -= kTwoPi;
-      sweep -= kTwoPi * std::max(0, turns - 1);
-    }
-    // Off-plane part of the start and end (helix axis, rotary and UVW axes), interpolated.
-    auto off_plane = [&](const Pose& p, const Pose& rel) {
-      Pose r = p;
-      const double a = dot(rel, frame.u), b = dot(rel, frame.v);
-      for (std::size_t i = 0; i < kAxes; ++i)
-        r[i] -= frame.center[i] + a * frame.u[i] + b * frame.v[i];
-      return r;
-    };
-    const Pose start_off = off_plane(position_, from_start);
-    const Pose end_off = off_plane(machine_end, from_end);
-    auto point_at = [&](double t) {  // t: angle offset from the start along the sweep
-      const double f = sweep == 0 ? 1 : t / sweep;
-      const double radius = start_radius + f * (end_radius - start_radius);
-      const double angle = start_angle + t;
-      Pose p{};
-      for (std::size_t i = 0; i < kAxes; ++i) {
-        p[i] = frame.center[i] +
-               radius * (std::cos(angle) * frame.u[i] + std::sin(angle) * frame.v[i]) +
-               start_off[i] + f * (end_off[i] - start_off[i]);
-      }
-      return p;
-    };
-    const double mean_radius = (start_radius + end_radius) / 2;
-    report_.feed_length += std::hypot(mean_radius * sweep, end_off[normal] - start_off[normal]);
-    for (std::size_t axis = 0; axis < kAxes; ++axis) {
-      if (frame.u[axis] == 0 && frame.v[axis] == 0) continue;
-      const double base = std::atan2(frame.v[axis], frame.u[axis]);
-      for (double extreme : {base, base + std::numbers::pi}) {
-        // The crossings of this direction inside the sweep, one a turn. The radius changes
-        // linearly along the sweep, so the first and the last crossing are the farthest.
-        double t = std::fmod(extreme - start_angle, kTwoPi);
-        if (sweep > 0 && t < 0) t += kTwoPi;
-        if (sweep < 0 && t > 0) t -= kTwoPi;
-        if (std::abs(t) >= std::abs(sweep)) continue;
-        const double last =
-            t + std::copysign(kTwoPi, sweep) * std::floor((std::abs(sweep) - std::abs(t)) / kTwoPi);
-        reach_axis(axis, point_at(t)[axis], command.line);
-        reach_axis(axis, point_at(last)[axis], command.line);
+      const double mean_radius = segment->radius + segment->radius_change / 2;
+      const auto normal = static_cast<std::size_t>(segment->normal_axis);
+      report_.feed_length +=
+          std::hypot(mean_radius * segment->sweep, move.end[normal] - position_[normal]);
+      // The farthest the arc reaches each way along each axis of its plane is what is judged.
+      Pose low = move.end, high = move.end;
+      for_each_arc_extreme(*segment, [&](double s, int axis) {
+        const auto a = static_cast<std::size_t>(axis);
+        const double value = segment->point_at(s)[a];
+        low[a] = std::min(low[a], value);
+        high[a] = std::max(high[a], value);
+      });
+      for (const int axis : {segment->first_axis, segment->second_axis}) {
+        const auto a = static_cast<std::size_t>(axis);
+        if (low[a] < move.end[a]) reach_axis(a, low[a], move.line);
+        if (high[a] > move.end[a]) reach_axis(a, high[a], move.line);
       }
     }
-    reach(machine_end, command.line, "arc");
-    position_ = machine_end;
+    reach(move.end, move.line, "arc");
+    position_ = move.end;
   }
 
   void reach_axis(std::size_t axis, double value, int line) {
@@ -264,7 +218,9 @@ class CheckSink final : public interp::CanonSink {
   const CheckOptions& options_;
   CheckReport& report_;
   std::string file_;
-  interp::MachineTracker tracker_;
+  config::MachineConfig machine_;
+  motion::Planner planner_;
+  ProgramFeeder feeder_;
   Pose position_{};
   Pose start_{};
   bool started_ = false;

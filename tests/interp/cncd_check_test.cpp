@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cncd/pipeline/plan_sim.hpp"
 #include "cncd/pipeline/program_check.hpp"
 #include "daemon_process.hpp"
 
@@ -190,6 +191,36 @@ TEST_F(CncdCheckTest, ArcsAreCheckedOverTheirWholeSweep) {
   ASSERT_EQ(report.limit_violations, 0u);
   EXPECT_NEAR(report.min[0], -0.0, 1e-9);
   EXPECT_NEAR(report.max[0], 20.0, 1e-9);
+}
+
+TEST_F(CncdCheckTest, AnArcIsJudgedOnThePlannersSegment) {
+  const auto loaded = config::load_machine_config(ini_);
+  ASSERT_TRUE(loaded.ok());
+  const auto& machine = *loaded.config;
+  // A spiral of three turns (the end 0.002 mm off the start's circle) reaches farthest on its
+  // last turn: that is the figure reported, once per side.
+  auto report = check_text(dir_, machine, "G0 X-5 Y195\nG2 X-5.002 Y195 I10 J0 P3 F100\nM2\n");
+  ASSERT_EQ(report.limit_violations, 1u);
+  EXPECT_NE(report.problems[0].message.find("arc: Y 205.00"), std::string::npos)
+      << report.problems[0].message;
+  // G10 L2 R on the system in use leaves the machine where it is, while the interpreter's
+  // current point (the arc's start as its centre words are measured from) moves otherwise: in
+  // machine coordinates the first arc starts on a circle about 1 mm from the one it ends on.
+  // The machine would refuse it at its line; the check says so there too.
+  report = check_text(dir_, machine,
+                      "G0 X8.040\nG92 X3.232\nG0 X1.755 Y-1.348\n"
+                      "G10 L2 P1 X4.525 Y4.647 R-22.5\n"
+                      "G3 I-1.505 J1.653 F100\nG3 I1.920 J-1.786\nM2\n");
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_EQ(report.problems[0].line, 5);
+  EXPECT_NE(report.problems[0].message.find("arc: arc radius differs between start and end"),
+            std::string::npos)
+      << report.problems[0].message;
+  pipeline::PlanSimOptions sim;
+  sim.interp = pipeline::interpreter_options(machine);
+  const auto plan = pipeline::simulate_plan(machine, dir_.path() / "arc.ngc", sim);
+  ASSERT_TRUE(plan.error.has_value());
+  EXPECT_EQ(plan.error->line, 5);
 }
 
 }  // namespace

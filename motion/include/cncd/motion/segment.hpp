@@ -3,7 +3,10 @@
 // Trivially copyable: it crosses the planner -> servo ring.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 
 #include "cncd/motion/types.hpp"
 
@@ -63,5 +66,22 @@ struct Segment {
   // Point at path distance s in [0, length]. RT-safe.
   AxisPose point_at(double s) const noexcept;
 };
+
+// Calls `visit(s, axis)` for every point of an arc where its angle is a multiple of a quarter
+// turn, in order: s is the path distance there and `axis` the plane axis that reaches farthest
+// there (for a spiral, very near there). Nothing for other segments. The one model of how far
+// an arc reaches, shared by the planner's soft-limit check and the offline check of a program.
+template <typename Visit>
+void for_each_arc_extreme(const Segment& segment, Visit&& visit) {
+  if (segment.kind != Segment::Kind::arc || segment.sweep == 0) return;
+  const double quarter = std::numbers::pi / 2;
+  const double end_angle = segment.start_angle + segment.sweep;
+  const double from = std::min(segment.start_angle, end_angle);
+  const double to = std::max(segment.start_angle, end_angle);
+  for (double k = std::ceil(from / quarter); k * quarter <= to; k += 1) {
+    const int axis = std::fmod(std::abs(k), 2.0) == 0 ? segment.first_axis : segment.second_axis;
+    visit(segment.length * (k * quarter - segment.start_angle) / segment.sweep, axis);
+  }
+}
 
 }  // namespace cncd::motion

@@ -50,6 +50,8 @@ class ProgramFeeder final : public interp::CanonSink {
   // Hands the pending moves to `target` in order, flushing it at stop points, until none is
   // left, the target has no room, or it refuses one (which stays pending).
   Drained drain(MoveTarget& target);
+  // Offsets, units and feed as the commands so far left them.
+  const interp::MachineTracker& tracker() const { return tracker_; }
 
   std::deque<motion::Move> pending;  // moves the planner had no room for yet
   bool stop_seen = false;            // M0/M1/M60 reached in the stream
