@@ -22,6 +22,7 @@
 #include "server.hpp"
 #include "start_checks.hpp"
 #include "state_files.hpp"
+#include "status_json.hpp"
 #include "task.hpp"
 #include "version.hpp"
 #include "watchdog_gate.hpp"
@@ -161,7 +162,8 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   RpcDispatcher dispatcher;
   register_methods(dispatcher, task, config, events, completions);
   Server server(
-      dispatcher, policy, [&task] { return task.status(); }, events, completions);
+      dispatcher, policy, [&task, &config] { return status_json(task.status(), config); }, events,
+      completions);
   std::string serving = socket_path;
   // Socket activation: systemd hands over the listening socket of cncd.socket.
   if (sd_listen_fds(1) == 1 &&

@@ -20,18 +20,10 @@ void EventLog::add(std::string level, std::string kind, std::string message) {
   if (events_.size() > kCapacity) events_.pop_front();
 }
 
-nlohmann::json EventLog::to_json(const Event& event) {
-  return {{"seq", event.seq},
-          {"time", event.time},
-          {"level", event.level},
-          {"kind", event.kind},
-          {"message", event.message}};
-}
-
-nlohmann::json EventLog::since(std::uint64_t since) const {
-  nlohmann::json out = nlohmann::json::array();
+std::vector<Event> EventLog::since(std::uint64_t since) const {
+  std::vector<Event> out;
   for (const auto& event : events_) {
-    if (event.seq > since) out.push_back(to_json(event));
+    if (event.seq > since) out.push_back(event);
   }
   return out;
 }

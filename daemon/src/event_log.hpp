@@ -7,8 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
-
-#include <nlohmann/json.hpp>
+#include <vector>
 
 namespace cncd::daemon {
 
@@ -27,10 +26,8 @@ class EventLog {
   // Records an event (and logs it through spdlog at the matching level).
   void add(std::string level, std::string kind, std::string message);
   // Events with seq > since, oldest first.
-  nlohmann::json since(std::uint64_t since) const;
+  std::vector<Event> since(std::uint64_t since) const;
   std::uint64_t last_seq() const { return next_seq_ - 1; }
-
-  static nlohmann::json to_json(const Event& event);
 
  private:
   std::deque<Event> events_;

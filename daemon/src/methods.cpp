@@ -8,6 +8,7 @@
 #include "override_methods.hpp"
 #include "server.hpp"
 #include "setup_methods.hpp"
+#include "status_json.hpp"
 #include "version.hpp"
 
 namespace cncd::daemon {
@@ -49,7 +50,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                       const EventLog& events, Completions& completions) {
   dispatcher.add("errors.list", [&events](const json& params) {
     const auto since = params.value("since", std::uint64_t{0});
-    return json{{"last_seq", events.last_seq()}, {"events", events.since(since)}};
+    return json{{"last_seq", events.last_seq()}, {"events", events_json(events.since(since))}};
   });
   dispatcher.add("system.info", [&config](const json&) {
     json axes = json::array();
@@ -70,9 +71,9 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                   {"drivers", drivers},
                   {"servo_period_ns", config.servo_period_ns}}}};
   });
-  dispatcher.add("status.get", [&task](const json& params) {
+  dispatcher.add("status.get", [&task, &config](const json& params) {
     const auto fields = field_list(params);
-    const json status = task.status();
+    const json status = status_json(task.status(), config);
     if (fields.empty()) return status;
     check_fields(fields, status);
     json out = json::object();
@@ -81,10 +82,10 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     return out;
   });
   dispatcher.add("status.subscribe",
-                 [&task](const json& params, Session& session) {
+                 [&task, &config](const json& params, Session& session) {
                    const int interval = params.value("interval_ms", 100);
                    const auto fields = field_list(params);
-                   check_fields(fields, task.status());
+                   check_fields(fields, status_json(task.status(), config));
                    session.subscribe_interval_ms = interval;
                    session.fields = fields;
                    return json{{"interval_ms", interval}, {"fields", fields}};

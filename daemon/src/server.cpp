@@ -14,6 +14,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "status_json.hpp"
+
 namespace cncd::daemon {
 namespace {
 
@@ -344,7 +346,8 @@ void Server::push_events() {
   for (auto& client : clients_) {
     if (client.closing || client.event_seq >= last) continue;
     for (const auto& event : events_.since(client.event_seq)) {
-      const nlohmann::json note = {{"jsonrpc", "2.0"}, {"method", "event"}, {"params", event}};
+      const nlohmann::json note = {
+          {"jsonrpc", "2.0"}, {"method", "event"}, {"params", event_json(event)}};
       client.out += note.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
       client.out += '\n';
     }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cncd/interp/stored_values.hpp"
+#include "status_json.hpp"
 
 namespace cncd::daemon {
 
@@ -95,13 +96,15 @@ interp::ToolEntry tool_from_params(const json& p, const Task& task,
 
 void register_setup_methods(RpcDispatcher& dispatcher, Task& task,
                             const config::MachineConfig& config) {
-  dispatcher.add("tool.list", [&task](const json&) { return task.tool_list(); });
+  dispatcher.add("tool.list",
+                 [&task, &config](const json&) { return tool_list_json(task.tools(), config); });
   dispatcher.add("tool.set", [&task, &config](const json& params) {
     const interp::ToolEntry entry = tool_from_params(params, task, config);
     task.set_tool(entry);
     return json{{"number", entry.number}};
   });
-  dispatcher.add("offsets.get", [&task](const json&) { return task.offsets(); });
+  dispatcher.add("offsets.get",
+                 [&task, &config](const json&) { return offsets_json(task.offsets(), config); });
   dispatcher.add("offsets.set", [&task, &config](const json& p) {
     const int system = coord_system(p["system"]);
     interp::Pose origin{};

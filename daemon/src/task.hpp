@@ -14,8 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/motion/controller.hpp"
@@ -25,16 +23,9 @@
 #include "plan_estimate.hpp"
 #include "program_open.hpp"
 #include "rpc.hpp"
+#include "task_report.hpp"
 
 namespace cncd::daemon {
-
-enum class ExecState { idle, running, paused };
-
-// "G54" .. "G59.3" for coordinate system 1..9.
-std::string coord_system_name(int system);
-// "estop", "off" or "on", as status and errors name the machine's state.
-const char* machine_state_name(motion::MachineState state);
-enum class Mode { manual, automatic, mdi };
 
 class Task {
  public:
@@ -105,17 +96,17 @@ class Task {
 
   // Tool table and coordinate systems (task_setup.cpp). The setters throw RpcError while a
   // program or MDI command runs, and when the file cannot be written (nothing changes then).
-  nlohmann::json tool_list() const;
+  std::vector<interp::ToolEntry> tools() const;
   std::optional<interp::ToolEntry> find_tool(int number) const;
   // Replaces or adds the entry and rewrites [EMCIO] TOOL_TABLE atomically.
   void set_tool(const interp::ToolEntry& entry);
-  nlohmann::json offsets() const;
+  OffsetsReport offsets() const;
   // Sets the origin of coordinate system `system` (1..9 = G54..G59.3) for the axes in `axes`
   // (bit 0 = X), machine units, as G10 L2 does, and saves the parameter file.
   void set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,
                    std::optional<double> rotation_deg);
 
-  nlohmann::json status() const;
+  TaskStatus status() const;
   // The servo thread's cycle counter: it advances while the servo loop is alive.
   std::uint64_t servo_heartbeat() const { return motion_.status().sequence; }
   // One line for systemd's STATUS=, e.g. "on, running part.ngc line 12".
@@ -126,8 +117,9 @@ class Task {
   void start_run(Mode mode, const motion::Status& status);
   // Changes exec_, keeping count of the time spent paused (task_status.cpp).
   void set_exec(ExecState next);
-  // The program's remaining_s and estimated_s (null when unknown) and why (task_status.cpp).
-  nlohmann::json time_estimate(std::uint64_t moves_done) const;
+  // Sets the program's remaining_s and estimated_s (none when unknown) and why
+  // (task_status.cpp).
+  void time_estimate(std::uint64_t moves_done, ProgramReport& out) const;
   // Time the current run has spent moving: since it started, without its pauses.
   double moving_s() const;
   // Servo periods run since the servo thread had run `cycles`, in seconds.

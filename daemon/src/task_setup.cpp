@@ -9,34 +9,8 @@
 
 namespace cncd::daemon {
 
-using nlohmann::json;
-
-namespace {
-json pose_object(const config::MachineConfig& config, const interp::Pose& pose) {
-  json out = json::object();
-  for (std::size_t i = 0; i < config::kAxisLetters.size() && i < pose.size(); ++i) {
-    if (!config.axes[i].present) continue;
-    out[std::string(1, static_cast<char>(config::kAxisLetters[i] - 'A' + 'a'))] = pose[i];
-  }
-  return out;
-}
-}  // namespace
-
-json Task::tool_list() const {
-  json tools = json::array();
-  for (const auto& tool : interp_->tools()) {
-    tools.push_back({{"number", tool.number},
-                     {"pocket", tool.pocket},
-                     {"offset", pose_object(config_, tool.offset)},
-                     {"diameter", tool.diameter},
-                     {"front_angle", tool.front_angle},
-                     {"back_angle", tool.back_angle},
-                     {"orientation", tool.orientation},
-                     {"comment", tool.comment}});
-  }
-  return json{{"path", config_.tool_table.string()},
-              {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
-              {"tools", tools}};
+std::vector<interp::ToolEntry> Task::tools() const {
+  return interp_->tools();
 }
 
 std::optional<interp::ToolEntry> Task::find_tool(int number) const {
@@ -94,21 +68,17 @@ std::string Task::save_setup_files() {
   return problems;
 }
 
-json Task::offsets() const {
+OffsetsReport Task::offsets() const {
   const interp::InterpState st = interp_->state();
-  json systems = json::array();
+  OffsetsReport out;
+  out.active = st.coord_system;
   for (int system = 1; system <= 9; ++system) {
-    double rotation = 0;
-    const interp::Pose origin = interp_->coord_system_origin(system, &rotation);
-    systems.push_back({{"name", coord_system_name(system)},
-                       {"index", system},
-                       {"origin", pose_object(config_, origin)},
-                       {"rotation", rotation}});
+    CoordSystemReport& report = out.systems[static_cast<std::size_t>(system - 1)];
+    report.index = system;
+    report.origin = interp_->coord_system_origin(system, &report.rotation_deg);
   }
-  return json{{"active", coord_system_name(st.coord_system)},
-              {"units", config_.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
-              {"systems", systems},
-              {"g92", pose_object(config_, st.g92_offset)}};
+  out.g92 = st.g92_offset;
+  return out;
 }
 
 void Task::set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,

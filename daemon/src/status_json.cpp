@@ -1,0 +1,214 @@
+#include "status_json.hpp"
+
+#include <string>
+
+namespace cncd::daemon {
+
+using nlohmann::json;
+
+namespace {
+
+const char* motion_state_name(motion::MotionState state) {
+  switch (state) {
+    case motion::MotionState::idle:
+      return "idle";
+    case motion::MotionState::moving:
+      return "moving";
+    case motion::MotionState::pausing:
+      return "pausing";
+    case motion::MotionState::paused:
+      return "paused";
+    case motion::MotionState::stopping:
+      return "stopping";
+    case motion::MotionState::homing:
+      return "homing";
+    case motion::MotionState::jogging:
+      return "jogging";
+  }
+  return "idle";
+}
+
+const char* mode_name(Mode mode) {
+  switch (mode) {
+    case Mode::mdi:
+      return "mdi";
+    case Mode::automatic:
+      return "auto";
+    case Mode::manual:
+      return "manual";
+  }
+  return "manual";
+}
+
+const char* units_name(const config::MachineConfig& config) {
+  return config.linear_units == config::LinearUnits::inch ? "inch" : "mm";
+}
+
+// {"x": 1.5, "y": 0, "z": -2} for the machine's axes.
+template <typename Pose>
+json axes_object(const config::MachineConfig& config, const Pose& pose) {
+  json out = json::object();
+  for (std::size_t i = 0; i < config::kAxisLetters.size() && i < pose.size(); ++i) {
+    if (!config.axes[i].present) continue;
+    const char letter = static_cast<char>(config::kAxisLetters[i] - 'A' + 'a');
+    out[std::string(1, letter)] = pose[i];
+  }
+  return out;
+}
+
+json joints_array(const std::vector<JointReport>& joints) {
+  json out = json::array();
+  for (const JointReport& joint : joints) {
+    out.push_back({{"homed", joint.homed},
+                   {"fault", joint.fault},
+                   {"min_limit", joint.io.min_limit},
+                   {"max_limit", joint.io.max_limit},
+                   {"home_switch", joint.io.home_switch},
+                   {"at_min_soft_limit", joint.io.at_min_soft_limit},
+                   {"at_max_soft_limit", joint.io.at_max_soft_limit},
+                   {"driver", std::string(joint.io.driver)},
+                   {"enabled", joint.io.enabled},
+                   {"drive_fault", joint.io.drive_fault},
+                   {"stale", joint.io.stale}});
+  }
+  return out;
+}
+
+json optional_number(const std::optional<double>& value) {
+  return value ? json(*value) : json(nullptr);
+}
+
+json program_object(const ProgramReport& p) {
+  return {{"path", p.path},
+          {"opening", p.opening},
+          {"line", p.line},
+          {"total_lines", p.total_lines},
+          {"progress", p.progress},
+          {"stepping", p.stepping},
+          {"moves", p.moves},
+          {"elapsed_s", p.elapsed_s},
+          {"motion_s", p.motion_s},
+          {"estimated_s", optional_number(p.estimated_s)},
+          {"remaining_s", optional_number(p.remaining_s)},
+          {"remaining_reason", p.remaining_reason},
+          {"result", p.result},
+          {"error", p.error}};
+}
+
+json rt_object(const motion::RtStats& rt) {
+  return {{"cycles", rt.cycles},
+          {"overruns", rt.overruns},
+          {"wake_error_p50_ns", rt.wake_error_p50_ns},
+          {"wake_error_p99_ns", rt.wake_error_p99_ns},
+          {"wake_error_p999_ns", rt.wake_error_p999_ns},
+          {"wake_error_max_ns", rt.wake_error_max_ns},
+          {"realtime", rt.realtime},
+          {"memory_locked", rt.memory_locked}};
+}
+
+}  // namespace
+
+json status_json(const TaskStatus& s, const config::MachineConfig& config) {
+  json homed = json::array();
+  json joint_fault = json::array();
+  for (const JointReport& joint : s.joints) {
+    homed.push_back(joint.homed);
+    joint_fault.push_back(joint.fault);
+  }
+  json tool_entry = nullptr;
+  if (s.tool.entry)
+    tool_entry = {{"diameter", s.tool.entry->diameter}, {"comment", s.tool.entry->comment}};
+  return json{
+      {"state", machine_state_name(s.machine)},
+      {"exec", exec_state_name(s.exec)},
+      {"mode", mode_name(s.mode)},
+      {"motion", motion_state_name(s.motion)},
+      {"units", units_name(config)},
+      {"homed", homed},
+      {"joint_fault", joint_fault},
+      {"joints", joints_array(s.joints)},
+      {"fault", s.fault},
+      {"position",
+       {{"commanded", axes_object(config, s.commanded)},
+        {"actual", axes_object(config, s.actual)}}},
+      {"position_restored", s.position_restored},
+      {"work_position",
+       {{"commanded", axes_object(config, s.work_commanded)},
+        {"actual", axes_object(config, s.work_actual)}}},
+      {"velocity", s.velocity},
+      {"distance_to_go", s.distance_to_go},
+      {"overrides",
+       {{"feed", s.feed_override},
+        {"rapid", s.rapid_override},
+        {"spindle", s.spindle.override_ratio}}},
+      {"program", program_object(s.program)},
+      {"spindle",
+       {{"direction", s.spindle.direction},
+        {"speed", s.spindle.speed},
+        {"programmed_speed", s.spindle.programmed_speed},
+        {"override", s.spindle.override_ratio}}},
+      {"coolant", {{"mist", s.mist}, {"flood", s.flood}}},
+      {"tool",
+       {{"number", s.tool.number},
+        {"prepared", s.tool.prepared},
+        {"length_offset", axes_object(config, s.tool.length_offset)},
+        {"entry", tool_entry}}},
+      {"offsets",
+       {{"coord_system", coord_system_name(s.offsets.coord_system)},
+        {"index", s.offsets.coord_system},
+        {"g5x", axes_object(config, s.offsets.g5x)},
+        {"rotation", s.offsets.rotation_deg},
+        {"g92", axes_object(config, s.offsets.g92)}}},
+      {"gcodes", s.gcodes},
+      {"mcodes", s.mcodes},
+      {"feed_rate", s.feed_rate},
+      {"rt", rt_object(s.rt)},
+  };
+}
+
+json tool_list_json(const std::vector<interp::ToolEntry>& tools,
+                    const config::MachineConfig& config) {
+  json list = json::array();
+  for (const auto& tool : tools) {
+    list.push_back({{"number", tool.number},
+                    {"pocket", tool.pocket},
+                    {"offset", axes_object(config, tool.offset)},
+                    {"diameter", tool.diameter},
+                    {"front_angle", tool.front_angle},
+                    {"back_angle", tool.back_angle},
+                    {"orientation", tool.orientation},
+                    {"comment", tool.comment}});
+  }
+  return json{{"path", config.tool_table.string()}, {"units", units_name(config)}, {"tools", list}};
+}
+
+json offsets_json(const OffsetsReport& offsets, const config::MachineConfig& config) {
+  json systems = json::array();
+  for (const CoordSystemReport& system : offsets.systems) {
+    systems.push_back({{"name", coord_system_name(system.index)},
+                       {"index", system.index},
+                       {"origin", axes_object(config, system.origin)},
+                       {"rotation", system.rotation_deg}});
+  }
+  return json{{"active", coord_system_name(offsets.active)},
+              {"units", units_name(config)},
+              {"systems", systems},
+              {"g92", axes_object(config, offsets.g92)}};
+}
+
+json event_json(const Event& event) {
+  return {{"seq", event.seq},
+          {"time", event.time},
+          {"level", event.level},
+          {"kind", event.kind},
+          {"message", event.message}};
+}
+
+json events_json(const std::vector<Event>& events) {
+  json out = json::array();
+  for (const auto& event : events)
+    out.push_back(event_json(event));
+  return out;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,114 @@
+// What the task reports: the status snapshot (status.get and the status updates) and the
+// coordinate systems (offsets.get), as plain values in machine units. The server turns them
+// into the control protocol's JSON (status_json.hpp); docs/protocol.md says what each means.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cncd/interp/canon.hpp"
+#include "cncd/interp/tool_entry.hpp"
+#include "cncd/motion/status.hpp"
+
+namespace cncd::daemon {
+
+enum class ExecState { idle, running, paused };
+enum class Mode { manual, automatic, mdi };
+
+// "G54" .. "G59.3" for coordinate system 1..9.
+std::string coord_system_name(int system);
+// "estop", "off" or "on", as status and errors name the machine's state.
+const char* machine_state_name(motion::MachineState state);
+const char* exec_state_name(ExecState state);
+
+struct JointReport {
+  bool homed = false;
+  bool fault = false;
+  motion::JointStatus io;  // switches and drive, as the servo thread read them last
+};
+
+struct ProgramReport {
+  std::string path;     // the open program, "" when none
+  std::string opening;  // the program being checked for program.open, "" when none
+  int line = 0;
+  std::uint64_t total_lines = 0;
+  double progress = 0;  // 0 .. 1
+  bool stepping = false;
+  std::uint64_t moves = 0;
+  double elapsed_s = 0;
+  double motion_s = 0;
+  std::optional<double> estimated_s;  // unknown: see remaining_reason
+  std::optional<double> remaining_s;
+  std::string remaining_reason;
+  std::string result;  // "done" | "aborted" | "error" | "" (never ran)
+  std::string error;
+};
+
+struct SpindleReport {
+  int direction = 0;  // 1 cw, -1 ccw, 0 stopped
+  double speed = 0;   // rpm, with the override
+  double programmed_speed = 0;
+  double override_ratio = 1.0;
+};
+
+struct ToolReport {
+  int number = 0;     // in the spindle, 0 = none
+  int prepared = -1;  // -1 = none
+  interp::Pose length_offset{};
+  std::optional<interp::ToolEntry> entry;  // the table's entry for the tool in the spindle
+};
+
+// The offsets in force.
+struct ActiveOffsets {
+  int coord_system = 1;  // 1..9 = G54..G59.3
+  interp::Pose g5x{};
+  double rotation_deg = 0;
+  interp::Pose g92{};
+};
+
+struct TaskStatus {
+  motion::MachineState machine = motion::MachineState::estop;
+  ExecState exec = ExecState::idle;
+  Mode mode = Mode::manual;
+  motion::MotionState motion = motion::MotionState::idle;
+  std::vector<JointReport> joints;  // the configured joints
+  std::string fault;                // latched fault, "" when none
+  motion::AxisPose commanded{};     // machine coordinates
+  motion::AxisPose actual{};
+  // "clean", "unclean" or "none": where the joints started (Task::load_files).
+  std::string position_restored;
+  motion::AxisPose work_commanded{};  // work coordinates
+  motion::AxisPose work_actual{};
+  double velocity = 0;
+  double distance_to_go = 0;
+  double feed_override = 1.0;
+  double rapid_override = 1.0;
+  ProgramReport program;
+  SpindleReport spindle;
+  bool mist = false;
+  bool flood = false;
+  ToolReport tool;
+  ActiveOffsets offsets;
+  std::vector<std::string> gcodes;  // active, in modal-group order: "G1", "G17" ...
+  std::vector<std::string> mcodes;
+  double feed_rate = 0;  // program units per minute
+  motion::RtStats rt;
+};
+
+// offsets.get: every coordinate system's origin and the G92 offset.
+struct CoordSystemReport {
+  int index = 1;  // 1..9 = G54..G59.3
+  interp::Pose origin{};
+  double rotation_deg = 0;
+};
+
+struct OffsetsReport {
+  int active = 1;
+  std::array<CoordSystemReport, 9> systems{};
+  interp::Pose g92{};
+};
+
+}  // namespace cncd::daemon
