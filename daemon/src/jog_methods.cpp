@@ -8,11 +8,6 @@ using nlohmann::json;
 
 namespace {
 
-RpcError jog_refused(const std::string& reason) {
-  const bool busy = reason == "the machine is moving" || reason == "the machine is jogging";
-  return RpcError(busy ? kBusy : kWrongState, reason);
-}
-
 // The "axis" parameter: one of the machine's axis letters.
 int axis_param(const json& params, const config::MachineConfig& config) {
   const auto& name = params["axis"].get_ref<const std::string&>();
@@ -32,22 +27,6 @@ json ok() {
 }
 
 }  // namespace
-
-void Task::jog_start(int axis, double velocity) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI block is running");
-  if (const auto error = motion_.jog_start(axis, velocity); !error.empty())
-    throw jog_refused(error);
-}
-
-void Task::jog_increment(int axis, double distance, double velocity) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI block is running");
-  if (const auto error = motion_.jog_increment(axis, distance, velocity); !error.empty())
-    throw jog_refused(error);
-}
-
-void Task::jog_stop(int axis) {
-  motion_.jog_stop(axis);
-}
 
 void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
                           const config::MachineConfig& config) {

@@ -4,10 +4,10 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <utility>
 
 #include "cncd/pipeline/program_check.hpp"
 #include "program_dirs.hpp"
-#include "rpc.hpp"
 
 namespace cncd::daemon {
 namespace {
@@ -36,13 +36,13 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   OpenOutcome out;
   out.job = job;
   out.path = request.path;
-  const auto fail = [&](int code, std::string message) {
-    out.error_code = code;
-    out.error_message = std::move(message);
+  // Every refusal here is the program's.
+  const auto fail = [&](const std::string& message) {
+    out.error = TaskError(TaskErrorKind::program, message);
     return out;
   };
   const ProgramFile file = find_program(request.path, request.program_dirs);
-  if (!file.error.empty()) return fail(kProgramError, file.error);
+  if (!file.error.empty()) return fail(file.error);
   out.path = file.path;
   pipeline::CheckOptions options;
   options.interp = request.interp;
@@ -60,9 +60,9 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
     if (report.limit_violations > 1) {
       message += " (and " + std::to_string(report.limit_violations - 1) + " more)";
     }
-    return fail(kProgramError, std::move(message));
+    return fail(message);
   }
-  if (report.error) return fail(kProgramError, report.error->to_string());
+  if (report.error) return fail(report.error->to_string());
   out.lines = count_lines(file.path, cancel);
   return out;
 }

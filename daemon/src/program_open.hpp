@@ -19,6 +19,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "task_outcome.hpp"
 
 namespace cncd::daemon {
 
@@ -33,9 +34,8 @@ struct OpenRequest {
 
 struct OpenOutcome {
   std::uint64_t job = 0;
-  int error_code = 0;  // 0: the program passed and may be opened
-  std::string error_message;
-  std::string path;  // the program file, symlinks resolved
+  std::optional<TaskError> error;  // none: the program passed and may be opened
+  std::string path;                // the program file, symlinks resolved
   std::uint64_t lines = 0;
   // For the event log: the check stopped before the program's end (its time budget).
   std::vector<std::string> warnings;

@@ -153,6 +153,8 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
     return json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}};
   } catch (const RpcError& e) {
     return reply_error(e.code(), e.what());
+  } catch (const TaskError& e) {
+    return reply_error(rpc_code(e.kind()), e.what());
   } catch (const std::exception& e) {
     // The params were checked against the table: what is left is a fault of cncd's own, to be
     // found in the log rather than in a library's words to the client.
@@ -261,6 +263,41 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& line, S
   auto response = handle_one(request, session, repeated(0));
   if (!response) return std::nullopt;
   return response->dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+int rpc_code(TaskErrorKind kind) {
+  switch (kind) {
+    case TaskErrorKind::wrong_state:
+      return kWrongState;
+    case TaskErrorKind::not_homed:
+      return kNotHomed;
+    case TaskErrorKind::program:
+      return kProgramError;
+    case TaskErrorKind::busy:
+      return kBusy;
+    case TaskErrorKind::bad_value:
+      return kInvalidParams;
+    case TaskErrorKind::save_failed:
+      return kFileError;
+    case TaskErrorKind::fault:
+      return kFault;
+    case TaskErrorKind::cancelled:
+      return kCancelled;
+  }
+  return kInternalError;
+}
+
+void Completions::post(std::uint64_t token, TaskOutcome outcome) {
+  Completion done{token, nullptr, 0, {}};
+  if (const auto* error = std::get_if<TaskError>(&outcome)) {
+    done.error_code = rpc_code(error->kind());
+    done.error_message = error->what();
+  } else if (const auto* opened = std::get_if<ProgramOpened>(&outcome)) {
+    done.result = json{{"path", opened->path}};
+  } else {
+    done.result = json{{"ok", true}};
+  }
+  done_.push_back(std::move(done));
 }
 
 }  // namespace cncd::daemon

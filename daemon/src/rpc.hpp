@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rpc_params.hpp"
+#include "task_outcome.hpp"
 
 namespace cncd::daemon {
 
@@ -43,11 +44,14 @@ class RpcError : public std::runtime_error {
   int code_;
 };
 
-// Per-connection state a method may read or change.
+// The code a refusal or failure of the task's is answered with.
+int rpc_code(TaskErrorKind kind);
+
 // Answers to requests that finish later (mdi.execute, program.abort): the handler takes a
-// token with defer(), the server keeps the request open, and whoever finishes the work posts
-// the answer with complete(); the server sends it to the client that asked.
-class Completions {
+// token with next_token() and sets it as the session's defer_token, the server keeps the
+// request open, and the task posts the outcome with post(); the server sends it to the client
+// that asked.
+class Completions final : public TaskAnswers {
  public:
   struct Completion {
     std::uint64_t token = 0;
@@ -56,12 +60,8 @@ class Completions {
     std::string error_message;
   };
   std::uint64_t next_token() { return ++last_token_; }
-  void complete(std::uint64_t token, nlohmann::json result) {
-    done_.push_back(Completion{token, std::move(result), 0, {}});
-  }
-  void fail(std::uint64_t token, int code, std::string message) {
-    done_.push_back(Completion{token, nullptr, code, std::move(message)});
-  }
+  // {"ok": true}, {"path": ...} or the error's code and message.
+  void post(std::uint64_t token, TaskOutcome outcome) override;
   std::vector<Completion> take() { return std::exchange(done_, {}); }
 
  private:
@@ -86,7 +86,8 @@ class RpcDispatcher {
   // A handler gets the params as checked against its method's entry in the table (always an
   // object, holding only declared parameters of the declared types, optional ones left out
   // when absent or null) and the caller's session, and returns the result; it reports failure
-  // by throwing RpcError. Called on the server's thread.
+  // by throwing RpcError, or TaskError (answered with rpc_code()). Called on the server's
+  // thread.
   using Handler = std::function<nlohmann::json(const nlohmann::json& params, Session& session)>;
   using SimpleHandler = std::function<nlohmann::json(const nlohmann::json& params)>;
   // A range for a number parameter known only from the machine's configuration.

@@ -7,11 +7,9 @@
 #include "cncd/drivers/driver.hpp"
 #include "cncd/pipeline/machine.hpp"
 #include "program_dirs.hpp"
-#include "rpc.hpp"
 
 namespace cncd::daemon {
 
-using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
@@ -44,10 +42,10 @@ class ControllerTarget final : public pipeline::MoveTarget {
 
 // One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
 // from one program to the next.
-Task::Task(const config::MachineConfig& config, EventLog& events, Completions& completions)
+Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& answers)
     : config_(config),
       events_(events),
-      completions_(completions),
+      answers_(answers),
       motion_(config),
       feeder_(std::make_unique<pipeline::ProgramFeeder>(
           pipeline::machine_units(config),
@@ -119,26 +117,31 @@ bool Task::all_homed(const motion::Status& status) const {
 
 void Task::run_program(int from_line, bool step) {
   if (opening_) {
-    throw RpcError(kBusy, "'" + opening_->path +
-                              "' is still being checked: run it once program.open has answered");
+    throw TaskError(
+        TaskErrorKind::busy,
+        "'" + opening_->path + "' is still being checked: run it once program.open has answered");
   }
-  if (program_path_.empty()) throw RpcError(kProgramError, "no program is open");
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is already running");
+  if (program_path_.empty()) throw TaskError(TaskErrorKind::program, "no program is open");
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program is already running");
   if (from_line < 0 || static_cast<std::uint64_t>(from_line) > program_lines_) {
-    throw RpcError(kInvalidParams, "\"from_line\" must be from 1 to " +
-                                       std::to_string(program_lines_) + ", the program's length");
+    throw TaskError(TaskErrorKind::bad_value, "\"from_line\" must be from 1 to " +
+                                                  std::to_string(program_lines_) +
+                                                  ", the program's length");
   }
   const auto status = motion_.status();
-  if (status.machine != motion::MachineState::on) throw RpcError(kWrongState, "machine is not on");
-  if (status.motion != motion::MotionState::idle) throw RpcError(kBusy, "the machine is moving");
+  if (status.machine != motion::MachineState::on)
+    throw TaskError(TaskErrorKind::wrong_state, "machine is not on");
+  if (status.motion != motion::MotionState::idle)
+    throw TaskError(TaskErrorKind::busy, "the machine is moving");
   if (!config_.no_force_homing && !all_homed(status)) {
-    throw RpcError(kNotHomed, "all joints must be homed before running a program");
+    throw TaskError(TaskErrorKind::not_homed, "all joints must be homed before running a program");
   }
   // Checked again: a directory on the way may have been replaced by a symlink leading out.
   const ProgramFile file = find_program(program_path_, config_.program_dirs);
-  if (!file.error.empty()) throw RpcError(kProgramError, file.error);
+  if (!file.error.empty()) throw TaskError(TaskErrorKind::program, file.error);
   if (auto error = interp_->open(file.path)) {
-    throw RpcError(kProgramError, error->to_string());
+    throw TaskError(TaskErrorKind::program, error->to_string());
   }
   start_run(Mode::automatic, status);
   skip_to_line_ = from_line > 1 ? from_line : 0;
@@ -162,23 +165,27 @@ void Task::run_program(int from_line, bool step) {
   // the first one, the machine having been moved since the program was checked; a run from a
   // line the program never reaches): that is this request's answer, not a success.
   if (exec_ == ExecState::idle && last_result_ == "error" && moves_enqueued_ == 0) {
-    throw RpcError(kProgramError, last_error_);
+    throw TaskError(TaskErrorKind::program, last_error_);
   }
 }
 
 void Task::mdi(const std::string& line, std::uint64_t token) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
   const auto status = motion_.status();
-  if (status.machine != motion::MachineState::on) throw RpcError(kWrongState, "machine is not on");
-  if (status.motion != motion::MotionState::idle) throw RpcError(kBusy, "the machine is moving");
+  if (status.machine != motion::MachineState::on)
+    throw TaskError(TaskErrorKind::wrong_state, "machine is not on");
+  if (status.motion != motion::MotionState::idle)
+    throw TaskError(TaskErrorKind::busy, "the machine is moving");
   if (!config_.no_force_homing && !all_homed(status)) {
-    throw RpcError(kNotHomed, "all joints must be homed before MDI");
+    throw TaskError(TaskErrorKind::not_homed, "all joints must be homed before MDI");
   }
   if (line.find('\n') != std::string::npos || line.size() > 4096) {
-    throw RpcError(kInvalidParams, "\"line\" must be one block of at most 4096 characters");
+    throw TaskError(TaskErrorKind::bad_value,
+                    "\"line\" must be one block of at most 4096 characters");
   }
   if (auto error = interp_->open_mdi(line)) {
-    throw RpcError(kProgramError, error->to_string());
+    throw TaskError(TaskErrorKind::program, error->to_string());
   }
   start_run(Mode::mdi, status);
   mdi_token_ = token;
@@ -203,13 +210,15 @@ void Task::start_run(Mode mode, const motion::Status& status) {
 }
 
 void Task::pause() {
-  if (exec_ != ExecState::running) throw RpcError(kWrongState, "no program is running");
+  if (exec_ != ExecState::running)
+    throw TaskError(TaskErrorKind::wrong_state, "no program is running");
   motion_.pause();
   set_exec(ExecState::paused);
 }
 
 void Task::resume() {
-  if (exec_ != ExecState::paused) throw RpcError(kWrongState, "the program is not paused");
+  if (exec_ != ExecState::paused)
+    throw TaskError(TaskErrorKind::wrong_state, "the program is not paused");
   stepping_ = false;
   motion_.resume();
   set_exec(ExecState::running);
@@ -241,15 +250,16 @@ void Task::finish_program(const std::string& ended, const std::string& why) {
     set_exec(ExecState::idle);
     mode_ = Mode::manual;
     if (result == "done") {
-      completions_.complete(mdi_token_, nlohmann::json{{"ok", true}});
+      answers_.post(mdi_token_, CommandDone{});
     } else if (ended == "done") {
       events_.add("error", "mdi", error);
-      completions_.fail(mdi_token_, kFileError, error);
+      answers_.post(mdi_token_, TaskError(TaskErrorKind::save_failed, error));
     } else {
       events_.add(result == "error" ? "error" : "warning", "mdi",
                   error.empty() ? result : result + ": " + error);
-      completions_.fail(mdi_token_, result == "error" ? kProgramError : kWrongState,
-                        result + (error.empty() ? "" : ": " + error));
+      answers_.post(mdi_token_, TaskError(result == "error" ? TaskErrorKind::program
+                                                            : TaskErrorKind::wrong_state,
+                                          result + (error.empty() ? "" : ": " + error)));
     }
     mdi_token_ = 0;
     return;
@@ -321,7 +331,7 @@ void Task::poll() {
   // program.abort answers once the machine has come to rest.
   if (!abort_tokens_.empty() && status.motion == motion::MotionState::idle && status.queued == 0) {
     for (const auto token : abort_tokens_)
-      completions_.complete(token, nlohmann::json{{"ok", true}});
+      answers_.post(token, CommandDone{});
     abort_tokens_.clear();
   }
   confirm_machine_on(status);

@@ -22,15 +22,16 @@
 #include "persist.hpp"
 #include "plan_estimate.hpp"
 #include "program_open.hpp"
-#include "rpc.hpp"
+#include "task_outcome.hpp"
 #include "task_report.hpp"
 
 namespace cncd::daemon {
 
 class Task {
  public:
-  // `completions` receives the answers of mdi.execute and program.abort once they finish.
-  Task(const config::MachineConfig& config, EventLog& events, Completions& completions);
+  // `answers` receives the outcomes of machine.on, program.open, program.abort and mdi.execute
+  // once they are known.
+  Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& answers);
   ~Task();
   Task(const Task&) = delete;
   Task& operator=(const Task&) = delete;
@@ -45,7 +46,7 @@ class Task {
   // joint positions to [TRAJ] POSITION_FILE.
   void shutdown();
 
-  // Each command throws RpcError when refused in the current state, and (kFault) when the
+  // Each command throws TaskError when refused in the current state, and (kind fault) when the
   // machine does not do it: reset with the estop input asserted, homing the servo thread
   // refuses (task_machine.cpp).
   void estop();
@@ -53,7 +54,7 @@ class Task {
   // Enables the drives. The machine counts as on once the drivers have had the time to report
   // a drive that does not answer or has faulted (MotionController::feedback_deadline_ns):
   // returns true when the answer, under `token`, is posted then (poll()); with token 0 (a
-  // batch) it waits here. Throws kFault naming the joint, drive and reason when the machine
+  // batch) it waits here. Throws a fault naming the joint, drive and reason when the machine
   // does not come on.
   bool machine_on(std::uint64_t token);
   void machine_off();
@@ -62,7 +63,7 @@ class Task {
   // which runs on a worker thread meanwhile; the answer under `token` is posted then: the
   // program's path, or why it was refused (cannot be read, leaves the soft limits, stopped
   // by the interpreter) or cancelled (a newer open, an estop, shutdown). Refuses at once
-  // (RpcError) while a program or MDI block runs or the machine jogs or homes.
+  // (TaskError) while a program or MDI block runs or the machine jogs or homes.
   void open_program(const std::string& path, std::uint64_t token);
   // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
   // `step` runs its first line only, as program.step does.
@@ -74,7 +75,7 @@ class Task {
   // Stops under control; the answer under `token` (if not 0) is posted once at rest.
   void abort(std::uint64_t token = 0);
   // Jogs of one axis (config::axis_index), velocities in machine units per second (see
-  // MotionController::jog_start); refused while a program or MDI block runs (jog_methods.cpp).
+  // MotionController::jog_start); refused while a program or MDI block runs (task_manual.cpp).
   void jog_start(int axis, double velocity);
   void jog_increment(int axis, double distance, double velocity);
   void jog_stop(int axis);
@@ -94,7 +95,7 @@ class Task {
   // loop should poll often.
   bool busy() const;
 
-  // Tool table and coordinate systems (task_setup.cpp). The setters throw RpcError while a
+  // Tool table and coordinate systems (task_setup.cpp). The setters throw TaskError while a
   // program or MDI command runs, and when the file cannot be written (nothing changes then).
   std::vector<interp::ToolEntry> tools() const;
   std::optional<interp::ToolEntry> find_tool(int number) const;
@@ -149,7 +150,7 @@ class Task {
   void finish_program(const std::string& result, const std::string& error);
   // The pending open's check has ended (task_open.cpp).
   void finish_open(OpenOutcome outcome);
-  // Answers the pending open, if any, with error kCancelled and `why`.
+  // Answers the pending open, if any, with a cancelled error and `why`.
   void cancel_open(const std::string& why);
   bool all_homed(const motion::Status& status) const;
   // Run from line: called after each block while lines before skip_to_line_ are read. Drops
@@ -160,7 +161,7 @@ class Task {
 
   const config::MachineConfig& config_;
   EventLog& events_;
-  Completions& completions_;
+  TaskAnswers& answers_;
   motion::MotionController motion_;
   std::unique_ptr<pipeline::ProgramFeeder> feeder_;
   std::unique_ptr<interp::Interpreter> interp_;

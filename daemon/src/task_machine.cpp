@@ -46,8 +46,8 @@ void Task::reset() {
   wait_servo_periods(kJudgedPeriods);
   const auto status = motion_.status();
   if (status.machine == motion::MachineState::estop) {
-    throw RpcError(kFault,
-                   "the machine stays in estop: " + why_not(status, motion::MachineState::off));
+    throw TaskError(TaskErrorKind::fault,
+                    "the machine stays in estop: " + why_not(status, motion::MachineState::off));
   }
 }
 
@@ -61,7 +61,7 @@ std::chrono::steady_clock::duration Task::on_check_time() const {
 bool Task::machine_on(std::uint64_t token) {
   const auto status = motion_.status();
   if (status.machine == motion::MachineState::estop) {
-    throw RpcError(kWrongState, "machine is in estop: reset it first");
+    throw TaskError(TaskErrorKind::wrong_state, "machine is in estop: reset it first");
   }
   if (status.machine == motion::MachineState::on && on_tokens_.empty()) return false;
   if (status.machine != motion::MachineState::on) {
@@ -79,8 +79,8 @@ bool Task::machine_on(std::uint64_t token) {
   }
   const auto now_status = motion_.status();
   if (now_status.machine != motion::MachineState::on) {
-    throw RpcError(kFault,
-                   "the machine did not come on: " + why_not(now_status, motion::MachineState::on));
+    throw TaskError(TaskErrorKind::fault, "the machine did not come on: " +
+                                              why_not(now_status, motion::MachineState::on));
   }
   return false;
 }
@@ -90,11 +90,11 @@ void Task::confirm_machine_on(const motion::Status& status) {
   if (status.machine == motion::MachineState::on && Clock::now() < on_check_until_) return;
   for (const auto token : on_tokens_) {
     if (status.machine == motion::MachineState::on) {
-      completions_.complete(token, nlohmann::json{{"ok", true}});
+      answers_.post(token, CommandDone{});
     } else {
-      completions_.fail(
-          token, kFault,
-          "the machine did not come on: " + why_not(status, motion::MachineState::on));
+      answers_.post(token,
+                    TaskError(TaskErrorKind::fault, "the machine did not come on: " +
+                                                        why_not(status, motion::MachineState::on)));
     }
   }
   on_tokens_.clear();
@@ -108,21 +108,22 @@ void Task::machine_off() {
 void Task::home(std::uint32_t joint_mask) {
   const auto status = motion_.status();
   if (status.machine != motion::MachineState::on) {
-    throw RpcError(kWrongState, "machine is not on");
+    throw TaskError(TaskErrorKind::wrong_state, "machine is not on");
   }
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
+  if (exec_ != ExecState::idle) throw TaskError(TaskErrorKind::busy, "a program is running");
   // The servo thread would ignore the command (and say so only in the event log).
   if (status.motion == motion::MotionState::homing) {
-    throw RpcError(kBusy, "homing is already under way");
+    throw TaskError(TaskErrorKind::busy, "homing is already under way");
   }
   if (status.motion != motion::MotionState::idle || status.queued != 0) {
-    throw RpcError(kBusy, "the machine is moving");
+    throw TaskError(TaskErrorKind::busy, "the machine is moving");
   }
   motion_.home(joint_mask);
   // A homing configuration the servo thread refuses latches a fault and turns the machine off.
   const auto after = motion_.status();
   if (after.machine != motion::MachineState::on) {
-    throw RpcError(kFault, "homing did not start: " + why_not(after, motion::MachineState::on));
+    throw TaskError(TaskErrorKind::fault,
+                    "homing did not start: " + why_not(after, motion::MachineState::on));
   }
 }
 

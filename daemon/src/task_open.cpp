@@ -8,7 +8,7 @@
 namespace cncd::daemon {
 
 void Task::open_program(const std::string& path, std::uint64_t token) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program is running");
+  if (exec_ != ExecState::idle) throw TaskError(TaskErrorKind::busy, "a program is running");
   // The check runs from where the machine stands: a position still changing (or, homing,
   // not yet known) would give it a start the machine is not at.
   const auto status = motion_.status();
@@ -16,11 +16,14 @@ void Task::open_program(const std::string& path, std::uint64_t token) {
     case motion::MotionState::idle:
       break;
     case motion::MotionState::jogging:
-      throw RpcError(kBusy, "the machine is jogging: stop the jog, then open the program");
+      throw TaskError(TaskErrorKind::busy,
+                      "the machine is jogging: stop the jog, then open the program");
     case motion::MotionState::homing:
-      throw RpcError(kBusy, "the machine is homing: open the program once homing has finished");
+      throw TaskError(TaskErrorKind::busy,
+                      "the machine is homing: open the program once homing has finished");
     default:
-      throw RpcError(kBusy, "the machine is moving: open the program once it has stopped");
+      throw TaskError(TaskErrorKind::busy,
+                      "the machine is moving: open the program once it has stopped");
   }
   OpenRequest request;
   request.path = path;
@@ -39,7 +42,8 @@ void Task::open_program(const std::string& path, std::uint64_t token) {
 void Task::cancel_open(const std::string& why) {
   if (!opening_) return;
   opener_.cancel();
-  completions_.fail(opening_->token, kCancelled, "program.open of '" + opening_->path + "' " + why);
+  answers_.post(opening_->token, TaskError(TaskErrorKind::cancelled,
+                                           "program.open of '" + opening_->path + "' " + why));
   spdlog::info("program.open of '{}' {}", opening_->path, why);
   opening_.reset();
 }
@@ -51,13 +55,13 @@ void Task::finish_open(OpenOutcome outcome) {
   for (const auto& warning : outcome.warnings)
     events_.add("warning", "program", warning);
   // program.run waits for the open; an MDI block does not.
-  if (outcome.error_code == 0 && exec_ != ExecState::idle) {
-    outcome.error_code = kBusy;
-    outcome.error_message = "an MDI command started while '" + pending.path +
-                            "' was checked: open it again once it has finished";
+  if (!outcome.error && exec_ != ExecState::idle) {
+    outcome.error =
+        TaskError(TaskErrorKind::busy, "an MDI command started while '" + pending.path +
+                                           "' was checked: open it again once it has finished");
   }
-  if (outcome.error_code != 0) {
-    completions_.fail(pending.token, outcome.error_code, outcome.error_message);
+  if (outcome.error) {
+    answers_.post(pending.token, std::move(*outcome.error));
     return;
   }
   estimator_.start(outcome.path, pipeline::interpreter_options(config_), pending.start);
@@ -66,7 +70,7 @@ void Task::finish_open(OpenOutcome outcome) {
   last_result_.clear();
   last_error_.clear();
   spdlog::info("program opened: {} ({} lines)", program_path_, program_lines_);
-  completions_.complete(pending.token, nlohmann::json{{"path", program_path_}});
+  answers_.post(pending.token, ProgramOpened{program_path_});
 }
 
 }  // namespace cncd::daemon

@@ -34,9 +34,9 @@ bool Task::skip_before_start(bool program_ended) {
 
 void Task::step() {
   if (exec_ == ExecState::running) {
-    throw RpcError(kBusy, mode_ == Mode::mdi ? "an MDI command is running"
-                          : stepping_        ? "the last step is still running"
-                                             : "the program is running");
+    throw TaskError(TaskErrorKind::busy, mode_ == Mode::mdi ? "an MDI command is running"
+                                         : stepping_        ? "the last step is still running"
+                                                            : "the program is running");
   }
   if (exec_ == ExecState::idle) {
     run_program(0, true);

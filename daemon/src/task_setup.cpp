@@ -18,12 +18,15 @@ std::optional<interp::ToolEntry> Task::find_tool(int number) const {
 }
 
 void Task::set_tool(const interp::ToolEntry& entry) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
   if (config_.tool_table.empty()) {
-    throw RpcError(kWrongState, "the machine has no tool table ([EMCIO] TOOL_TABLE)");
+    throw TaskError(TaskErrorKind::wrong_state,
+                    "the machine has no tool table ([EMCIO] TOOL_TABLE)");
   }
   // Before the file: a value the interpreter would refuse never reaches the disk.
-  if (auto problem = interp::tool_entry_problem(entry)) throw RpcError(kInvalidParams, *problem);
+  if (auto problem = interp::tool_entry_problem(entry))
+    throw TaskError(TaskErrorKind::bad_value, *problem);
   auto tools = interp_->tools();
   const auto it = std::find_if(tools.begin(), tools.end(),
                                [&](const auto& t) { return t.number == entry.number; });
@@ -36,8 +39,8 @@ void Task::set_tool(const interp::ToolEntry& entry) {
   }
   // The file first: when it cannot be written, nothing has changed.
   const std::string error = atomic_write_file(config_.tool_table, format_tool_table(tools));
-  if (!error.empty()) throw RpcError(kFileError, error);
-  if (auto problem = interp_->set_tool(entry)) throw RpcError(kInvalidParams, *problem);
+  if (!error.empty()) throw TaskError(TaskErrorKind::save_failed, error);
+  if (auto problem = interp_->set_tool(entry)) throw TaskError(TaskErrorKind::bad_value, *problem);
   saved_tools_ = std::move(tools);
   events_.add("info", "tools", "tool " + std::to_string(entry.number) + " changed");
 }
@@ -83,13 +86,15 @@ OffsetsReport Task::offsets() const {
 
 void Task::set_offsets(int system, const interp::Pose& origin, std::uint32_t axes,
                        std::optional<double> rotation_deg) {
-  if (exec_ != ExecState::idle) throw RpcError(kBusy, "a program or MDI command is running");
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
   if (auto problem = interp_->set_coord_system_origin(system, origin, axes, rotation_deg)) {
-    throw RpcError(kInvalidParams, *problem);
+    throw TaskError(TaskErrorKind::bad_value, *problem);
   }
   // Saved before the answer; when the file cannot be written the old origin is put back.
   if (const std::string error = save_setup_files(); !error.empty()) {
-    throw RpcError(kFileError, error + "; " + coord_system_name(system) + " is unchanged");
+    throw TaskError(TaskErrorKind::save_failed,
+                    error + "; " + coord_system_name(system) + " is unchanged");
   }
   events_.add("info", "offsets", coord_system_name(system) + " origin changed");
 }
