@@ -9,12 +9,12 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/seqlock.hpp"
 #include "cncd/motion/feedback_checks.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
 #include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/rt_stats.hpp"
-#include "cncd/motion/seqlock.hpp"
 #include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
 
@@ -124,7 +124,7 @@ class ServoLoop {
 
   CommandRing commands_;
   EventRing events_;
-  Seqlock<Status> published_;
+  drivers::Seqlock<Status> published_;
 
   Status status_{};
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
