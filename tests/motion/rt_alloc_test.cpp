@@ -1,14 +1,22 @@
-// The servo period allocates nothing: the servo loop, on the simulated driver, runs a program
-// of lines, arcs, blends and a dwell, overrides and a hold, jogs, homing, a drive fault, an
-// estop and their recovery, while this executable's operator new and delete count every call
-// made inside ServoLoop::cycle(). The planner and the test itself allocate freely between
-// periods.
+// The servo period allocates nothing and takes no lock: the servo loop, on the simulated
+// driver, runs a program of lines, arcs, blends and a dwell, overrides and a hold, jogs,
+// homing, a drive fault, an estop and their recovery, while this executable's operator new and
+// delete, and its pthread mutex, rwlock, spinlock and semaphore waits (which forward to the C
+// library's), count every call made inside ServoLoop::cycle(). The planner and the test itself
+// allocate and lock freely between periods.
 //
-// Sanitizer runtimes bring their own operator new; the test is skipped there.
+// Sanitizer runtimes bring their own operator new and intercept the locks; the test is skipped
+// there.
+#include <dlfcn.h>
+#include <pthread.h>
+#include <semaphore.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <new>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -18,6 +26,7 @@
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/servo_loop.hpp"
 #include "machine_fixture.hpp"
+#include "path_distance.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define CNCD_RT_ALLOC_SANITIZED 1
@@ -35,6 +44,7 @@ namespace {
 thread_local bool t_in_period = false;
 std::atomic<long> g_period_allocs{0};
 std::atomic<long> g_period_frees{0};
+std::atomic<long> g_period_locks{0};
 
 }  // namespace
 
@@ -105,6 +115,49 @@ void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
   counted_free(p);
 }
+
+namespace {
+
+// The C library's definition of `name`, looked up once.
+void* next_symbol(std::atomic<void*>& cache, const char* name) noexcept {
+  void* symbol = cache.load(std::memory_order_acquire);
+  if (symbol == nullptr) {
+    symbol = dlsym(RTLD_NEXT, name);
+    cache.store(symbol, std::memory_order_release);
+  }
+  return symbol;
+}
+
+}  // namespace
+
+// Each counts a call made in the servo period, then does what the C library does. Condition
+// waits need a mutex, which is counted already.
+#define CNCD_COUNTED_LOCK(name, params, args, spec)                          \
+  extern "C" int name params spec {                                          \
+    if (t_in_period) g_period_locks.fetch_add(1, std::memory_order_relaxed); \
+    static std::atomic<void*> next{nullptr};                                 \
+    return reinterpret_cast<decltype(&name)>(next_symbol(next, #name)) args; \
+  }
+CNCD_COUNTED_LOCK(pthread_mutex_lock, (pthread_mutex_t * m), (m), noexcept)
+CNCD_COUNTED_LOCK(pthread_mutex_trylock, (pthread_mutex_t * m), (m), noexcept)
+CNCD_COUNTED_LOCK(pthread_mutex_timedlock,
+                  (pthread_mutex_t* __restrict m, const timespec* __restrict t), (m, t), noexcept)
+CNCD_COUNTED_LOCK(pthread_mutex_clocklock,
+                  (pthread_mutex_t* __restrict m, clockid_t c, const timespec* __restrict t),
+                  (m, c, t), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_rdlock, (pthread_rwlock_t * l), (l), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_wrlock, (pthread_rwlock_t * l), (l), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_tryrdlock, (pthread_rwlock_t * l), (l), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_trywrlock, (pthread_rwlock_t * l), (l), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_timedrdlock,
+                  (pthread_rwlock_t* __restrict l, const timespec* __restrict t), (l, t), noexcept)
+CNCD_COUNTED_LOCK(pthread_rwlock_timedwrlock,
+                  (pthread_rwlock_t* __restrict l, const timespec* __restrict t), (l, t), noexcept)
+CNCD_COUNTED_LOCK(pthread_spin_lock, (pthread_spinlock_t * l), (l), noexcept)
+CNCD_COUNTED_LOCK(sem_wait, (sem_t * s), (s), )
+CNCD_COUNTED_LOCK(sem_trywait, (sem_t * s), (s), noexcept)
+CNCD_COUNTED_LOCK(sem_timedwait, (sem_t* __restrict s, const timespec* __restrict t), (s, t), )
+#undef CNCD_COUNTED_LOCK
 #endif
 
 namespace cncd::motion {
@@ -199,17 +252,6 @@ class Rig {
   std::vector<std::string> events_;
 };
 
-Move arc_to(double x, double y, double cx, double cy, int turns, double feed) {
-  Move m;
-  m.kind = Move::Kind::arc;
-  m.end = {x, y, 0, 0, 0, 0, 0, 0, 0};
-  m.center_first = cx;
-  m.center_second = cy;
-  m.turns = turns;
-  m.feed = feed;
-  return m;
-}
-
 Move blended(Move m) {
   m.path_mode = Move::PathMode::blend;
   m.tolerance = 0.05;
@@ -217,6 +259,7 @@ Move blended(Move m) {
 }
 
 void program(Rig& rig) {
+  using test::arc_to;
   using test::line_to;
   rig.queue(line_to(Move::Kind::traverse, 10, 0, 5));
   rig.queue(blended(line_to(Move::Kind::feed, 10, 0, 0, 20)));
@@ -237,16 +280,18 @@ void program(Rig& rig) {
 struct Counted {
   long allocs;
   long frees;
+  long locks;
 };
 Counted take_counts() {
-  return {g_period_allocs.exchange(0), g_period_frees.exchange(0)};
+  return {g_period_allocs.exchange(0), g_period_frees.exchange(0), g_period_locks.exchange(0)};
 }
 
-#define EXPECT_NO_PERIOD_ALLOCATION(phase)                                                    \
+#define EXPECT_PERIODS_RT_SAFE(phase)                                                         \
   do {                                                                                        \
     const Counted counted = take_counts();                                                    \
     EXPECT_EQ(counted.allocs, 0) << (phase) << ": operator new called in the servo period";   \
     EXPECT_EQ(counted.frees, 0) << (phase) << ": operator delete called in the servo period"; \
+    EXPECT_EQ(counted.locks, 0) << (phase) << ": a lock taken in the servo period";           \
   } while (0)
 
 void run_everything(Rig& rig) {
@@ -257,12 +302,12 @@ void run_everything(Rig& rig) {
   rig.run_until_idle();
   ASSERT_EQ(rig.status().machine, MachineState::on);
   ASSERT_TRUE(rig.status().homed[0]);
-  EXPECT_NO_PERIOD_ALLOCATION("homing");
+  EXPECT_PERIODS_RT_SAFE("homing");
 
   program(rig);
   rig.run_until_idle();
   EXPECT_EQ(rig.status().fault_reason[0], '\0') << rig.status().fault_reason;
-  EXPECT_NO_PERIOD_ALLOCATION("program");
+  EXPECT_PERIODS_RT_SAFE("program");
 
   // Overrides and a hold in the middle of a long move, then an abort.
   rig.queue(test::line_to(Move::Kind::feed, 300, 0, 0, 100));
@@ -279,7 +324,7 @@ void run_everything(Rig& rig) {
   rig.command(Kind::abort);
   rig.run_until_idle();
   rig.command(Kind::feed_override, 0, 0, 1.0);
-  EXPECT_NO_PERIOD_ALLOCATION("overrides, hold and abort");
+  EXPECT_PERIODS_RT_SAFE("overrides, hold and abort");
 
   // Jogs: continuous, reversed, stopped; an increment; one refused (an event with words).
   rig.command(Kind::jog_start, 0, 0, 50);
@@ -293,7 +338,7 @@ void run_everything(Rig& rig) {
   rig.command(Kind::jog_start, 0, 7, 50);
   rig.cycles(10);
   EXPECT_TRUE(rig.saw("jog ignored: the machine has no such axis"));
-  EXPECT_NO_PERIOD_ALLOCATION("jogging");
+  EXPECT_PERIODS_RT_SAFE("jogging");
 
   // A drive fault in the middle of a move, and the recovery.
   rig.queue(test::line_to(Move::Kind::feed, 0, 0, -20, 50));
@@ -311,7 +356,7 @@ void run_everything(Rig& rig) {
   rig.queue(test::line_to(Move::Kind::feed, 5, 5, 0, 50));
   rig.run_until_idle();
   EXPECT_EQ(rig.status().fault_reason[0], '\0') << rig.status().fault_reason;
-  EXPECT_NO_PERIOD_ALLOCATION("drive fault and recovery");
+  EXPECT_PERIODS_RT_SAFE("drive fault and recovery");
 
   // A tripped limit switch, stale feedback and the estop input, each recovered from.
   rig.sim().set_limit(0, false, true);
@@ -337,7 +382,7 @@ void run_everything(Rig& rig) {
   rig.run_until_idle();
   EXPECT_EQ(rig.status().fault_reason[0], '\0') << rig.status().fault_reason;
   rig.command(Kind::estop);
-  EXPECT_NO_PERIOD_ALLOCATION("limits, stale feedback, estop and recovery");
+  EXPECT_PERIODS_RT_SAFE("limits, stale feedback, estop and recovery");
   EXPECT_GT(rig.periods(), 10'000);
 }
 
@@ -360,6 +405,27 @@ TEST_F(RtAllocation, TheCountingHookSeesAnAllocationInThePeriod) {
   const Counted counted = take_counts();
   EXPECT_EQ(counted.allocs, 2);
   EXPECT_EQ(counted.frees, 2);
+  EXPECT_EQ(counted.locks, 0);
+}
+
+TEST_F(RtAllocation, TheCountingHookSeesALockInThePeriod) {
+  std::mutex mutex;
+  std::shared_mutex shared;
+  sem_t semaphore;
+  ASSERT_EQ(sem_init(&semaphore, 0, 2), 0);
+  take_counts();
+  t_in_period = true;
+  { const std::lock_guard guard(mutex); }
+  if (mutex.try_lock()) mutex.unlock();
+  { const std::shared_lock reading(shared); }
+  { const std::unique_lock writing(shared); }
+  sem_wait(&semaphore);
+  sem_trywait(&semaphore);
+  t_in_period = false;
+  sem_destroy(&semaphore);
+  const Counted counted = take_counts();
+  EXPECT_EQ(counted.locks, 6);
+  EXPECT_EQ(counted.allocs, 0);
 }
 
 TEST_F(RtAllocation, TrapezoidalServoPeriodsNeverAllocate) {
