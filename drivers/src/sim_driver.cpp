@@ -1,7 +1,9 @@
 #include "cncd/drivers/sim_driver.hpp"
 
 #include <cmath>
-#include <cstdio>
+#include <cstring>
+
+#include "cncd/drivers/fault_reason.hpp"
 
 #include "ini_lookup.hpp"
 
@@ -63,7 +65,13 @@ bool SimDriver::fault_reason(char* out, std::size_t size) const noexcept {
   out[0] = '\0';
   for (int i = 0; i < kMaxJoints; ++i) {
     if (!fault_[static_cast<std::size_t>(i)].load(std::memory_order_relaxed)) continue;
-    std::snprintf(out, size, "fault injected on simulated drive %d", i);
+    // Put together by hand: the servo thread asks, and it formats nothing.
+    char text[48] = "fault injected on simulated drive ";
+    std::size_t n = std::strlen(text);
+    if (i >= 10) text[n++] = static_cast<char>('0' + i / 10);
+    text[n++] = static_cast<char>('0' + i % 10);
+    text[n] = '\0';
+    copy_text(out, size, text);
     return true;
   }
   return false;

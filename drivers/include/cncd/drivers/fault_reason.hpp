@@ -4,13 +4,22 @@
 
 #include <array>
 #include <cstddef>
-#include <cstdio>
+#include <cstring>
 
 #include "cncd/drivers/seqlock.hpp"
 
 namespace cncd::drivers {
 
 inline constexpr std::size_t kFaultReasonSize = 160;
+
+// Copies `text` into `out` of `size` bytes, cut to fit and NUL-terminated. RT-safe: the servo
+// thread copies words and formats none.
+inline void copy_text(char* out, std::size_t size, const char* text) noexcept {
+  if (size == 0) return;
+  const std::size_t n = strnlen(text, size - 1);
+  std::memcpy(out, text, n);
+  out[n] = '\0';
+}
 
 struct FaultText {
   std::array<char, kFaultReasonSize> text{};
@@ -21,15 +30,15 @@ class FaultReason {
   // One writer thread. An empty text clears the reason.
   void set(const char* text) noexcept {
     FaultText value;
-    std::snprintf(value.text.data(), value.text.size(), "%s", text);
+    copy_text(value.text.data(), value.text.size(), text);
     text_.store(value);
   }
   void clear() noexcept { text_.store(FaultText{}); }
   // RT-safe, any thread: copies the reason (NUL-terminated, possibly empty) into `out`.
   void copy(char* out, std::size_t size) const noexcept {
-    if (size == 0) return;
-    const FaultText value = text_.load();
-    std::snprintf(out, size, "%s", value.text.data());
+    FaultText value = text_.load();
+    value.text.back() = '\0';
+    copy_text(out, size, value.text.data());
   }
 
  private:
