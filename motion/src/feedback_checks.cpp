@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 namespace cncd::motion {
 
@@ -19,32 +18,28 @@ void FeedbackChecks::record(std::uint64_t cycle, const drivers::JointCommand* co
 }
 
 bool FeedbackChecks::check(const JointFeedbacks& feedback, std::uint64_t cycle,
-                           std::uint32_t limits_ignored, Fault& fault) const noexcept {
+                           std::uint32_t limits_ignored, RtEvent& fault) const noexcept {
+  using Code = RtEvent::Code;
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     const auto& fb = feedback[k];
-    char* text = fault.text;
-    constexpr std::size_t size = sizeof fault.text;
+    fault.joint = static_cast<std::int8_t>(j);
     if (!std::isfinite(fb.position)) {
-      fault.joint = j;
-      std::snprintf(text, size, "joint %d: feedback position is not a number", j);
+      fault.code = Code::feedback_not_a_number;
       return false;
     }
     if (fb.fault || fb.stale) {
-      fault.joint = j;
+      fault.code = fb.fault ? Code::drive_fault : Code::feedback_stale;
       // The driver may know more (which drive, register or line; why a bus went quiet).
-      char detail[160] = {};
-      if (joint_driver_[k] != nullptr) joint_driver_[k]->fault_reason(detail, sizeof detail);
-      std::snprintf(text, size, "joint %d: %s%s%s", j,
-                    fb.fault ? "drive fault" : "feedback is stale", detail[0] ? ": " : "", detail);
+      fault.text[0] = '\0';
+      if (joint_driver_[k] != nullptr)
+        joint_driver_[k]->fault_reason(fault.text, sizeof fault.text);
       return false;
     }
     // A tripped limit switch stops everything, except while homing a joint configured to
     // ignore its limits (its home switch shares the limit input).
     if ((fb.min_limit || fb.max_limit) && (limits_ignored & (1u << j)) == 0) {
-      fault.joint = j;
-      std::snprintf(text, size, "joint %d: %s limit switch tripped", j,
-                    fb.min_limit ? "minimum" : "maximum");
+      fault.code = fb.min_limit ? Code::min_limit_switch : Code::max_limit_switch;
       return false;
     }
     // LinuxCNC's limit: FERROR at full speed, scaled down with speed, never below MIN_FERROR;
@@ -64,27 +59,28 @@ bool FeedbackChecks::check(const JointFeedbacks& feedback, std::uint64_t cycle,
     const double high = std::max(older.position, newer.position);
     const double error = std::max({low - fb.position, fb.position - high, 0.0});
     if (error > limit) {
-      fault.joint = j;
-      // Clamped: printing a huge number with %f would need a large buffer.
-      const int n = std::snprintf(text, size, "joint %d: following error %.4f exceeds %.4f", j,
-                                  std::min(error, 1e9), std::min(limit, 1e9));
       const auto ago = [cycle](std::uint64_t then) {
-        return static_cast<unsigned long long>(cycle - 1 > then ? cycle - 1 - then : 0);
+        return cycle - 1 > then ? cycle - 1 - then : std::uint64_t{0};
       };
-      if (n > 0 && static_cast<std::size_t>(n) < size && ago(older.cycle) > 0) {
-        const auto rest = size - static_cast<std::size_t>(n);
-        if (older.cycle == newer.cycle) {
-          std::snprintf(text + n, rest, " (against the command of %llu periods ago)",
-                        ago(newer.cycle));
-        } else {
-          std::snprintf(text + n, rest, " (against the commands of %llu to %llu periods ago)",
-                        ago(older.cycle), ago(newer.cycle));
-        }
-      }
+      fault.code = Code::following_error;
+      fault.error = error;
+      fault.limit = limit;
+      fault.oldest_ago = ago(older.cycle);
+      fault.newest_ago = ago(newer.cycle);
       return false;
     }
   }
+  fault.joint = -1;
   return true;
+}
+
+bool FeedbackChecks::check(const JointFeedbacks& feedback, std::uint64_t cycle,
+                           std::uint32_t limits_ignored, Fault& fault) const noexcept {
+  RtEvent event;
+  const bool ok = check(feedback, cycle, limits_ignored, event);
+  fault.joint = event.joint;
+  if (!ok) format_event(event, fault.text, sizeof fault.text);
+  return ok;
 }
 
 drivers::JointCommand FeedbackChecks::answered_command(std::size_t k, std::uint64_t cycle,

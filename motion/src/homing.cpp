@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "profile.hpp"
 
@@ -35,7 +34,15 @@ bool Homing::ignores_limits(int j) const noexcept {
 }
 
 void Homing::fail(int j, const char* what) noexcept {
-  std::snprintf(error_, sizeof error_, "joint %d: %s", j, what);
+  fault_ = RtEvent{};
+  fault_.code = RtEvent::Code::homing_failed;
+  fault_.joint = static_cast<std::int8_t>(j);
+  fault_.words = what;
+}
+
+const char* Homing::error() const noexcept {
+  format_event(fault_, error_, sizeof error_);
+  return error_;
 }
 
 bool Homing::check_config(int j) noexcept {
@@ -52,9 +59,10 @@ bool Homing::check_config(int j) noexcept {
   } else if (joint.home_latch_vel == 0) {
     fail(j, "invalid homing config: a non-zero HOME_SEARCH_VEL needs HOME_LATCH_VEL");
   } else if (!(switch_joints_ & (1u << j))) {
-    std::snprintf(error_, sizeof error_,
-                  "joint %d: switch homing needs a home switch input, which driver '%s' lacks", j,
-                  joint.driver.c_str());
+    fault_ = RtEvent{};
+    fault_.code = RtEvent::Code::homing_needs_switch;
+    fault_.joint = static_cast<std::int8_t>(j);
+    drivers::copy_text(fault_.text, sizeof fault_.text, joint.driver.c_str());
   } else {
     return true;
   }
@@ -62,9 +70,9 @@ bool Homing::check_config(int j) noexcept {
 }
 
 bool Homing::start(std::uint32_t mask, JointIo& io) noexcept {
-  error_[0] = '\0';
+  fault_ = RtEvent{};
   if (active_) {
-    std::snprintf(error_, sizeof error_, "homing is already in progress");
+    fault_.code = RtEvent::Code::homing_in_progress;
     return false;
   }
   const std::uint32_t all = joint_count_ >= 32 ? ~0u : (1u << joint_count_) - 1;

@@ -2,7 +2,6 @@
 // set-points guarded, commands written and recorded for late feedback.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "cncd/motion/servo_loop.hpp"
 
@@ -24,8 +23,8 @@ void ServoLoop::read_drivers() noexcept {
     joints_.home_switch[k] = feedback_[k].home_switch;
   }
   if (inputs.estop && status_.machine != MachineState::estop) {
-    stop_now(MachineState::estop, nullptr);
-    latch_fault("estop input asserted");
+    stop_now(MachineState::estop);
+    latch_fault(RtEvent::Code::estop_input);
   }
 }
 
@@ -38,10 +37,10 @@ void ServoLoop::check_joints() noexcept {
   for (int j = 0; j < joint_count_; ++j) {
     if (homing_.ignores_limits(j)) limits_ignored |= 1u << j;
   }
-  FeedbackChecks::Fault fault;
+  RtEvent fault;
   if (checks_.check(feedback_, cycle_, limits_ignored, fault)) return;
   status_.joint_fault[static_cast<std::size_t>(fault.joint)] = true;
-  latch_fault(fault.text);
+  latch_fault(fault);
 }
 
 void ServoLoop::guard_set_points() noexcept {
@@ -55,9 +54,7 @@ void ServoLoop::guard_set_points() noexcept {
     joints_.command[k] = last_motor_cmd_[k] - joints_.motor_offset[k];
     status_.joint_fault[k] = true;
     held = true;
-    char text[64];
-    std::snprintf(text, sizeof text, "non-finite set-point on joint %d", j);
-    latch_fault(text);
+    latch_fault(RtEvent::Code::set_point_not_finite, j);
   }
   if (held) sync_axes_from_joints();
 }

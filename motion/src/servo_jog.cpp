@@ -1,6 +1,4 @@
 // The jog part of the servo loop: jog commands in, jogging axes advanced, their joints moved.
-#include <cstdio>
-
 #include "cncd/motion/servo_loop.hpp"
 
 namespace cncd::motion {
@@ -37,9 +35,7 @@ void ServoLoop::apply_jog(const Command& command) noexcept {
             : jog_.increment(command.axis, position, command.distance, command.velocity, homed);
   }
   if (refusal != nullptr) {
-    char text[120];
-    std::snprintf(text, sizeof text, "jog ignored: %s", refusal);
-    post(Event::Level::warning, text);
+    warn(RtEvent::Code::jog_ignored, refusal);
     return;
   }
   status_.motion = MotionState::jogging;

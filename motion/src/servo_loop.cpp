@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 
 namespace cncd::motion {
 namespace {
@@ -36,11 +34,6 @@ FeedbackChecks::JointDrivers joint_drivers(const std::vector<DriverBinding>& dri
   return out;
 }
 
-template <std::size_t N>
-void copy_name(char (&out)[N], const char* name) {
-  std::snprintf(out, N, "%s", name);
-}
-
 }  // namespace
 
 ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBinding> drivers)
@@ -61,7 +54,8 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
   for (const auto& binding : drivers_) {
     for (int j : binding.joints) {
       if (j < 0 || j >= kJoints) continue;
-      copy_name(status_.joints[static_cast<std::size_t>(j)].driver, binding.driver->name());
+      auto& driver = status_.joints[static_cast<std::size_t>(j)].driver;
+      drivers::copy_text(driver, sizeof driver, binding.driver->name());
     }
   }
   status_.joint_count = joint_count_;
@@ -95,32 +89,50 @@ void ServoLoop::adopt_start_positions() noexcept {
   sync_axes_from_joints();
 }
 
-namespace {
-// Copies `text` into a fixed buffer, cut to fit. RT-safe.
-void copy_text(char* out, std::size_t size, const char* text) noexcept {
-  const std::size_t n = strnlen(text, size - 1);
-  std::memcpy(out, text, n);
-  out[n] = '\0';
+Status ServoLoop::status() const noexcept {
+  Status out;
+  static_cast<ServoStatus&>(out) = published_.load();
+  if (out.fault.code != RtEvent::Code::none)
+    format_event(out.fault, out.fault_reason, sizeof out.fault_reason);
+  return out;
 }
-}  // namespace
 
-void ServoLoop::post(Event::Level level, const char* text) noexcept {
-  Event event;
-  event.level = level;
-  copy_text(event.text, sizeof event.text, text);
+bool EventReader::pop(Event& out) noexcept {
+  if (!ring_.pop(out.record)) return false;
+  out.level = out.record.level;
+  format_event(out.record, out.text, sizeof out.text);
+  return true;
+}
+
+void ServoLoop::post(const RtEvent& event) noexcept {
   events_.push(event);  // a full ring drops the event rather than wait
 }
 
-void ServoLoop::latch_fault(const char* reason) noexcept {
-  if (status_.fault_reason[0] == '\0') {
-    copy_text(status_.fault_reason, sizeof status_.fault_reason, reason);
-    post(Event::Level::fault, reason);
-  }
-  stop_now(status_.machine == MachineState::estop ? MachineState::estop : MachineState::off,
-           nullptr);
+void ServoLoop::warn(RtEvent::Code code, const char* words) noexcept {
+  RtEvent event;
+  event.code = code;
+  event.level = EventLevel::warning;
+  event.words = words;
+  post(event);
 }
 
-void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
+void ServoLoop::latch_fault(RtEvent fault) noexcept {
+  if (status_.fault.code == RtEvent::Code::none) {
+    fault.level = EventLevel::fault;
+    status_.fault = fault;
+    post(fault);
+  }
+  stop_now(status_.machine == MachineState::estop ? MachineState::estop : MachineState::off);
+}
+
+void ServoLoop::latch_fault(RtEvent::Code code, int joint) noexcept {
+  RtEvent fault;
+  fault.code = code;
+  fault.joint = static_cast<std::int8_t>(joint);
+  latch_fault(fault);
+}
+
+void ServoLoop::stop_now(MachineState next) noexcept {
   path_.flush();
   homing_.stop_now();
   jog_.halt();
@@ -133,31 +145,33 @@ void ServoLoop::stop_now(MachineState next, const char* reason) noexcept {
   status_.motion = MotionState::idle;
   status_.velocity = 0;
   status_.distance_to_go = 0;
-  if (reason != nullptr) post(Event::Level::warning, reason);
 }
 
 void ServoLoop::apply(const Command& command) noexcept {
   switch (command.kind) {
     case Command::Kind::estop:
-      if (status_.machine != MachineState::estop) stop_now(MachineState::estop, "estop");
+      if (status_.machine != MachineState::estop) {
+        stop_now(MachineState::estop);
+        warn(RtEvent::Code::estop);
+      }
       break;
     case Command::Kind::reset_estop:
       if (status_.machine == MachineState::estop) {
         status_.machine = MachineState::off;
-        status_.fault_reason[0] = '\0';
+        status_.fault = {};
         status_.joint_fault = {};
       }
       break;
     case Command::Kind::on:
       if (status_.machine == MachineState::off) {
         status_.machine = MachineState::on;
-        status_.fault_reason[0] = '\0';
+        status_.fault = {};
         status_.joint_fault = {};
         sync_axes_from_joints();
       }
       break;
     case Command::Kind::off:
-      if (status_.machine == MachineState::on) stop_now(MachineState::off, nullptr);
+      if (status_.machine == MachineState::on) stop_now(MachineState::off);
       break;
     case Command::Kind::home:
       start_homing(command.joint_mask);
@@ -194,11 +208,11 @@ void ServoLoop::apply(const Command& command) noexcept {
 
 void ServoLoop::start_homing(std::uint32_t mask) noexcept {
   if (status_.machine != MachineState::on) {
-    post(Event::Level::warning, "home ignored: the machine is not on");
+    warn(RtEvent::Code::home_ignored_not_on);
   } else if (path_.pending() || homing_.active() || jog_.active()) {
-    post(Event::Level::warning, "home ignored: the machine is moving");
+    warn(RtEvent::Code::home_ignored_moving);
   } else if (!homing_.start(mask, joints_)) {
-    latch_fault(homing_.error());
+    latch_fault(homing_.fault());
   } else {
     status_.motion = MotionState::homing;
     sync_axes_from_joints();
@@ -208,10 +222,10 @@ void ServoLoop::start_homing(std::uint32_t mask) noexcept {
 void ServoLoop::advance_homing() noexcept {
   switch (homing_.update(joints_)) {
     case Homing::Result::failed:
-      latch_fault(homing_.error());
+      latch_fault(homing_.fault());
       return;
     case Homing::Result::aborted:
-      post(Event::Level::warning, "homing aborted");
+      warn(RtEvent::Code::homing_aborted);
       status_.motion = MotionState::idle;
       break;
     case Homing::Result::finished:
@@ -246,16 +260,13 @@ void ServoLoop::advance_path() noexcept {
   status_.distance_to_go = path_.distance_to_go();
   status_.motion = path_.motion();
   if (result.fault == PathExecutor::Fault::joints_apart) {
-    char text[120];
-    std::snprintf(text, sizeof text,
-                  "joint %d stands apart from axis %c: home the joints of an axis together, "
-                  "to the same HOME",
-                  apart,
-                  config::kAxisLetters[static_cast<std::size_t>(
-                      joint_axis_[static_cast<std::size_t>(apart)])]);
-    latch_fault(text);
+    RtEvent fault;
+    fault.code = RtEvent::Code::joints_apart;
+    fault.joint = static_cast<std::int8_t>(apart);
+    fault.axis = static_cast<std::int8_t>(joint_axis_[static_cast<std::size_t>(apart)]);
+    latch_fault(fault);
   } else if (result.fault == PathExecutor::Fault::off_path) {
-    latch_fault("a queued move does not start where the machine stands");
+    latch_fault(RtEvent::Code::off_path);
   }
   // Joints follow the path only while it moves: at rest they keep what homing left (a gantry
   // joint homed apart is caught, not jumped, when the next move starts).

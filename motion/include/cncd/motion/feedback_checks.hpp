@@ -12,6 +12,7 @@
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
 #include "cncd/motion/command_history.hpp"
+#include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
@@ -20,10 +21,10 @@ class FeedbackChecks {
  public:
   using JointDrivers = std::array<drivers::Driver*, kJoints>;
   using JointFeedbacks = std::array<drivers::JointFeedback, kJoints>;
-  // The first joint that failed and why, in words that fit Status::fault_reason.
+  // The first joint that failed and why, in words.
   struct Fault {
     int joint = -1;
-    char text[240] = {};
+    char text[kEventTextSize] = {};
   };
 
   // Non-RT. `joint_driver`: each joint's driver, asked for its own words about a fault (nullptr:
@@ -36,8 +37,12 @@ class FeedbackChecks {
   void record(std::uint64_t cycle, const drivers::JointCommand* commands) noexcept;
   // RT: judges every joint's `feedback` (motor coordinates) read in servo cycle `cycle`, with
   // the drives enabled since the last cycle. Returns false with the first joint that fails in
-  // `fault`. The limit switches of the joints in the mask `limits_ignored` (homing with
-  // HOME_IGNORE_LIMITS) do not count.
+  // `fault` (its code, joint and numbers; the driver's own words where it has some). The limit
+  // switches of the joints in the mask `limits_ignored` (homing with HOME_IGNORE_LIMITS) do
+  // not count.
+  bool check(const JointFeedbacks& feedback, std::uint64_t cycle, std::uint32_t limits_ignored,
+             RtEvent& fault) const noexcept;
+  // Not RT: the same, with the fault in words.
   bool check(const JointFeedbacks& feedback, std::uint64_t cycle, std::uint32_t limits_ignored,
              Fault& fault) const noexcept;
   // RT: joint `k`'s command of `cycle` (motor coordinates) as feedback read in servo cycle

@@ -14,6 +14,7 @@
 #include <cstdint>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
@@ -35,7 +36,7 @@ class Homing {
   Homing(const config::MachineConfig& config, double period_s, std::uint32_t switch_joints);
 
   // RT. Starts homing the joints in `mask` (all ones: "home all", the joints that have a
-  // HOME_SEQUENCE, or every joint when none has). Returns false, with the reason in error(),
+  // HOME_SEQUENCE, or every joint when none has). Returns false, with the reason in fault(),
   // when a joint's homing configuration cannot be carried out; nothing moves then.
   bool start(std::uint32_t mask, JointIo& io) noexcept;
   // RT. One servo period: advances every homing joint and moves on through the sequences.
@@ -52,7 +53,9 @@ class Homing {
   // True while joint `j` homes with HOME_IGNORE_LIMITS (its limit switch is its home switch).
   bool ignores_limits(int j) const noexcept;
   // Why start() refused or update() failed.
-  const char* error() const noexcept { return error_; }
+  const RtEvent& fault() const noexcept { return fault_; }
+  // Not RT: fault() in words, valid until the next call.
+  const char* error() const noexcept;
 
  private:
   enum class Phase : std::uint8_t {
@@ -87,14 +90,14 @@ class Homing {
 
   bool check_config(int j) noexcept;
   void start_sequence(JointIo& io) noexcept;
-  bool step_joint(int j, JointIo& io) noexcept;  // false: failed, error_ set
+  bool step_joint(int j, JointIo& io) noexcept;  // false: failed, fault_ set
   bool settle(int j) noexcept;
   void enter(int j, Phase phase) noexcept;
   void start_move(int j, const JointIo& io, double velocity, double target,
                   bool to_target) noexcept;
   void set_position(int j, JointIo& io, double position) noexcept;
   bool sync_ready(int j) const noexcept;
-  void fail(int j, const char* what) noexcept;
+  void fail(int j, const char* what) noexcept;  // `what`: a string literal
 
   const config::MachineConfig& config_;
   double period_s_;
@@ -105,7 +108,8 @@ class Homing {
   int sequence_ = -1;          // sequence homing now, -1 = none
   bool active_ = false;
   bool aborting_ = false;
-  char error_[120] = {};
+  RtEvent fault_;
+  mutable char error_[kEventTextSize] = {};
 };
 
 }  // namespace cncd::motion

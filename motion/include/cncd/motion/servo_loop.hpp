@@ -14,6 +14,7 @@
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
 #include "cncd/motion/path_executor.hpp"
+#include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/rt_stats.hpp"
 #include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
@@ -43,11 +44,25 @@ struct Command {
   double distance = 0;  // jog_increment: units, signed
 };
 
-// Something the servo thread tells the non-RT side (which logs it).
+// Something the servo thread tells the non-RT side (which logs it), as that side reads it.
 struct Event {
-  enum class Level : std::uint8_t { info, warning, fault };
+  using Level = EventLevel;
   Level level = Level::info;
-  char text[240] = {};  // room for a fault_reason with the driver's own words
+  RtEvent record;
+  char text[kEventTextSize] = {};  // the record in words
+};
+
+// The consumer's end of the servo thread's events: each record is put in words as it is
+// popped, on the consumer's thread.
+class EventReader {
+ public:
+  using Ring = SpscRing<RtEvent, 64>;
+  explicit EventReader(Ring& ring) noexcept : ring_(ring) {}
+  // Consumer thread. False when empty.
+  bool pop(Event& out) noexcept;
+
+ private:
+  Ring& ring_;
 };
 
 // One joint's place in a driver: the servo loop hands each driver its joints' commands as a
@@ -65,7 +80,7 @@ class ServoLoop {
  public:
   using SegmentRing = PathExecutor::SegmentRing;
   using CommandRing = SpscRing<Command, 64>;
-  using EventRing = SpscRing<Event, 64>;
+  using EventRing = EventReader::Ring;
 
   // Non-RT. `config` must outlive the loop; the drivers are configured and enabled by the
   // caller. Starts in estop.
@@ -79,9 +94,9 @@ class ServoLoop {
   // Producer: the task thread. Consumer: the servo thread.
   CommandRing& commands() noexcept { return commands_; }
   // Producer: the servo thread. Consumer: the task thread.
-  EventRing& events() noexcept { return events_; }
-  // Any thread.
-  Status status() const noexcept { return published_.load(); }
+  EventReader events() noexcept { return EventReader(events_); }
+  // Any thread but the servo thread (the fault is put in words here).
+  Status status() const noexcept;
   // Before the first cycle, or on the servo thread.
   void set_rt_flags(bool realtime, bool memory_locked) noexcept;
   // Before the first cycle: the joints start at these positions (still unhomed) wherever the
@@ -92,7 +107,7 @@ class ServoLoop {
  private:
   void apply(const Command& command) noexcept;
   void start_homing(std::uint32_t mask) noexcept;
-  void stop_now(MachineState next, const char* reason) noexcept;
+  void stop_now(MachineState next) noexcept;
   // One period of path motion: the executor's progress into the status, its fault latched,
   // the joints moved with their axes.
   void advance_path() noexcept;
@@ -107,11 +122,14 @@ class ServoLoop {
   void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
   void write_drivers() noexcept;
   // RT: a joint whose set-point is not a number keeps its last command and the machine
-  // faults ("non-finite set-point on joint N"): a drive never sees a NaN or an infinity.
+  // faults (RtEvent::Code::set_point_not_finite): a drive never sees a NaN or an infinity.
   void guard_set_points() noexcept;
   void update_stats(std::int64_t wake_error_ns) noexcept;
-  void latch_fault(const char* reason) noexcept;
-  void post(Event::Level level, const char* text) noexcept;
+  // The first fault latched stays in the status until the machine is reset or turned on.
+  void latch_fault(RtEvent fault) noexcept;
+  void latch_fault(RtEvent::Code code, int joint = -1) noexcept;
+  void post(const RtEvent& event) noexcept;
+  void warn(RtEvent::Code code, const char* words = nullptr) noexcept;
   void sync_axes_from_joints() noexcept;
   void adopt_start_positions() noexcept;
   void publish() noexcept;
@@ -124,9 +142,9 @@ class ServoLoop {
 
   CommandRing commands_;
   EventRing events_;
-  drivers::Seqlock<Status> published_;
+  drivers::Seqlock<ServoStatus> published_;
 
-  Status status_{};
+  ServoStatus status_{};
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
   AxisPose axis_pose_{};
   JointIo joints_{};

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 
+#include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
@@ -37,7 +38,8 @@ struct JointStatus {
   char driver[12] = {};  // the driver's name ("sim", "gpio", "modbus"), "" when none
 };
 
-struct Status {
+// What the servo thread publishes every period.
+struct ServoStatus {
   std::uint64_t sequence = 0;  // servo cycle count at publication
   MachineState machine = MachineState::estop;
   MotionState motion = MotionState::idle;
@@ -57,8 +59,14 @@ struct Status {
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
   std::uint64_t segments_done = 0;  // segments completed (or dropped by an abort) since start
   std::uint64_t moves_done = 0;     // programmed moves completed (or dropped) since start
-  char fault_reason[240] = {};      // latched fault, "" when none
+  RtEvent fault;                    // latched fault, code none when none
   RtStats rt;
+};
+
+// The servo thread's snapshot as its readers see it: the latched fault also in words, put
+// there by the reader.
+struct Status : ServoStatus {
+  char fault_reason[kEventTextSize] = {};  // "" when none
 };
 
 }  // namespace cncd::motion
