@@ -2,6 +2,8 @@
 // when its acceleration may change by at most `jerk` per second. Internal to motion; RT-safe.
 #pragma once
 
+#include "cncd/drivers/rt.hpp"
+
 namespace cncd::motion::scurve {
 
 // Shortest distance in which speed `v` with acceleration `a` comes down to `target` with the
@@ -10,11 +12,12 @@ namespace cncd::motion::scurve {
 // back to zero as the speed reaches `target`. 0 when the speed never exceeds `target` on the
 // way (`a` ramped straight to zero keeps it at or below). Where ramping `a` up from below zero
 // already drops the speed to `target`, the distance until it does.
-double brake_distance(double v, double a, double target, double accel, double jerk) noexcept;
+CNCD_RT double brake_distance(double v, double a, double target, double accel,
+                              double jerk) noexcept;
 
 // The speed at which the path settles when its acceleration `a` is ramped to zero at `jerk`
 // from speed `v`.
-inline double settle_speed(double v, double a, double jerk) noexcept {
+CNCD_RT inline double settle_speed(double v, double a, double jerk) noexcept {
   return v + (a >= 0 ? a * a : -a * a) / (2.0 * jerk);
 }
 
@@ -25,6 +28,6 @@ struct Step {
   double velocity = 0;
   double acceleration = 0;
 };
-Step integrate(double v, double a, double a_next, double dt) noexcept;
+CNCD_RT Step integrate(double v, double a, double a_next, double dt) noexcept;
 
 }  // namespace cncd::motion::scurve

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/rt.hpp"
 
 namespace cncd::drivers {
 
@@ -74,15 +75,15 @@ class Driver {
   virtual void enable() = 0;
   virtual void disable() = 0;
   // RT, servo thread: hand over this period's commands (indexed like configure()'s joints).
-  virtual void write(const JointCommand* commands, int count) noexcept = 0;
+  CNCD_RT virtual void write(const JointCommand* commands, int count) noexcept = 0;
   // RT, servo thread: fill this period's feedback (indexed like configure()'s joints).
-  virtual void read(JointFeedback* feedback, int count) noexcept = 0;
+  CNCD_RT virtual void read(JointFeedback* feedback, int count) noexcept = 0;
   // RT, servo thread: machine-wide inputs; drivers without inputs leave them alone.
-  virtual void read_inputs(MachineInputs& /*inputs*/) noexcept {}
+  CNCD_RT virtual void read_inputs(MachineInputs& /*inputs*/) noexcept {}
   // RT-safe, any thread: copies into `out` (NUL-terminated) why the driver last reported a
   // fault, naming the drive, register or line; returns false (and an empty text) when it has
   // nothing to say. The text stays until the fault is reset.
-  virtual bool fault_reason(char* out, std::size_t size) const noexcept {
+  CNCD_RT virtual bool fault_reason(char* out, std::size_t size) const noexcept {
     if (size > 0) out[0] = '\0';
     return false;
   }

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstring>
 
+#include "cncd/drivers/rt.hpp"
 #include "cncd/drivers/seqlock.hpp"
 
 namespace cncd::drivers {
@@ -14,7 +15,7 @@ inline constexpr std::size_t kFaultReasonSize = 160;
 
 // Copies `text` into `out` of `size` bytes, cut to fit and NUL-terminated. RT-safe: the servo
 // thread copies words and formats none.
-inline void copy_text(char* out, std::size_t size, const char* text) noexcept {
+CNCD_RT inline void copy_text(char* out, std::size_t size, const char* text) noexcept {
   if (size == 0) return;
   const std::size_t n = strnlen(text, size - 1);
   std::memcpy(out, text, n);
@@ -35,7 +36,7 @@ class FaultReason {
   }
   void clear() noexcept { text_.store(FaultText{}); }
   // RT-safe, any thread: copies the reason (NUL-terminated, possibly empty) into `out`.
-  void copy(char* out, std::size_t size) const noexcept {
+  CNCD_RT void copy(char* out, std::size_t size) const noexcept {
     FaultText value = text_.load();
     value.text.back() = '\0';
     copy_text(out, size, value.text.data());

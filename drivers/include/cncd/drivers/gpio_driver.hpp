@@ -13,6 +13,7 @@
 
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/gpio_backend.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/drivers/seqlock.hpp"
 
 namespace cncd::drivers {
@@ -28,9 +29,9 @@ class GpioDriver final : public Driver {
                         const std::vector<int>& joints) override;
   void enable() override;
   void disable() override;
-  void write(const JointCommand* commands, int count) noexcept override;
-  void read(JointFeedback* feedback, int count) noexcept override;
-  void read_inputs(MachineInputs& inputs) noexcept override;
+  CNCD_RT void write(const JointCommand* commands, int count) noexcept override;
+  CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
+  CNCD_RT void read_inputs(MachineInputs& inputs) noexcept override;
   std::uint32_t capabilities() const noexcept override { return capabilities_; }
   const char* name() const noexcept override { return "gpio"; }
 

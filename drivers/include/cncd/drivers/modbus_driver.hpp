@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
 
 namespace cncd::drivers {
 
@@ -29,9 +30,9 @@ class ModbusDriver final : public Driver {
   // starts from the drives' real positions.
   void enable() override;
   void disable() override;
-  void write(const JointCommand* commands, int count) noexcept override;
-  void read(JointFeedback* feedback, int count) noexcept override;
-  bool fault_reason(char* out, std::size_t size) const noexcept override;
+  CNCD_RT void write(const JointCommand* commands, int count) noexcept override;
+  CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
+  CNCD_RT bool fault_reason(char* out, std::size_t size) const noexcept override;
   // The stale deadline of the slowest bus plus its update period.
   std::int64_t feedback_deadline_ns() const noexcept override { return deadline_ns_; }
   std::uint32_t capabilities() const noexcept override { return kCapPositionFeedback; }

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <type_traits>
 
+#include "cncd/drivers/rt.hpp"
+
 namespace cncd::drivers {
 
 template <typename T>
@@ -17,7 +19,7 @@ class Seqlock {
 
  public:
   // RT-safe; one writer thread only.
-  void store(const T& value) noexcept {
+  CNCD_RT void store(const T& value) noexcept {
     std::array<std::uint64_t, kWords> buffer{};
     std::memcpy(buffer.data(), &value, sizeof(T));
     // The acquire read-modify-write keeps the payload stores after the odd count; the release
@@ -30,7 +32,7 @@ class Seqlock {
   }
 
   // RT-safe, any thread. False when a write overlapped; `out` is then unchanged.
-  bool try_load(T& out) const noexcept {
+  CNCD_RT bool try_load(T& out) const noexcept {
     const std::uint64_t before = seq_.load(std::memory_order_acquire);
     if ((before & 1u) != 0) return false;
     std::array<std::uint64_t, kWords> buffer{};
@@ -43,7 +45,7 @@ class Seqlock {
 
   // RT-safe, any thread. Retries until a consistent copy is read; the writer's critical section
   // is a few stores, so this ends quickly.
-  T load() const noexcept {
+  CNCD_RT T load() const noexcept {
     T out{};
     while (!try_load(out)) {
     }
@@ -51,7 +53,9 @@ class Seqlock {
   }
 
   // Number of completed stores; lets a reader see whether anything new arrived.
-  std::uint64_t version() const noexcept { return seq_.load(std::memory_order_acquire) / 2; }
+  CNCD_RT std::uint64_t version() const noexcept {
+    return seq_.load(std::memory_order_acquire) / 2;
+  }
 
  private:
   static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
 
 namespace cncd::drivers {
 
@@ -22,12 +23,12 @@ class SimDriver final : public Driver {
   void enable() override {}
   void disable() override {}
   // RT: positions are in motor units; the first write also sets the simulated position.
-  void write(const JointCommand* commands, int count) noexcept override;
+  CNCD_RT void write(const JointCommand* commands, int count) noexcept override;
   // RT.
-  void read(JointFeedback* feedback, int count) noexcept override;
-  void read_inputs(MachineInputs& inputs) noexcept override;
+  CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
+  CNCD_RT void read_inputs(MachineInputs& inputs) noexcept override;
   // RT-safe, any thread: names the first joint with an injected fault.
-  bool fault_reason(char* out, std::size_t size) const noexcept override;
+  CNCD_RT bool fault_reason(char* out, std::size_t size) const noexcept override;
   std::uint32_t capabilities() const noexcept override {
     return kCapHomeSwitch | kCapLimitSwitches | kCapEstopInput;
   }

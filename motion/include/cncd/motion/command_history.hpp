@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
 
 namespace cncd::motion {
 
@@ -23,15 +24,15 @@ class CommandHistory {
 
   // RT: the commands of servo cycle `cycle` (motor coordinates), one per joint, every cycle in
   // turn. An older cycle than the last is ignored; after a gap the history starts afresh.
-  void record(std::uint64_t cycle, const drivers::JointCommand* commands) noexcept;
+  CNCD_RT void record(std::uint64_t cycle, const drivers::JointCommand* commands) noexcept;
 
   // RT: joint `joint`'s command of `cycle`. A cycle that fell out of the history gives the
   // oldest held; one not recorded yet (0 included) the latest. Nullptr while nothing is.
-  const drivers::JointCommand* find(int joint, std::uint64_t cycle) const noexcept;
+  CNCD_RT const drivers::JointCommand* find(int joint, std::uint64_t cycle) const noexcept;
 
   std::size_t depth() const noexcept { return depth_; }
   // The oldest and the latest cycle held (0 when none).
-  std::uint64_t oldest() const noexcept;
+  CNCD_RT std::uint64_t oldest() const noexcept;
   std::uint64_t latest() const noexcept { return latest_; }
 
  private:

@@ -11,6 +11,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/motion/command_history.hpp"
 #include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
@@ -34,22 +35,22 @@ class FeedbackChecks {
 
   // RT: every joint's command written in servo cycle `cycle` (motor coordinates), every cycle
   // in turn.
-  void record(std::uint64_t cycle, const drivers::JointCommand* commands) noexcept;
+  CNCD_RT void record(std::uint64_t cycle, const drivers::JointCommand* commands) noexcept;
   // RT: judges every joint's `feedback` (motor coordinates) read in servo cycle `cycle`, with
   // the drives enabled since the last cycle. Returns false with the first joint that fails in
   // `fault` (its code, joint and numbers; the driver's own words where it has some). The limit
   // switches of the joints in the mask `limits_ignored` (homing with HOME_IGNORE_LIMITS) do
   // not count.
-  bool check(const JointFeedbacks& feedback, std::uint64_t cycle, std::uint32_t limits_ignored,
-             RtEvent& fault) const noexcept;
+  CNCD_RT bool check(const JointFeedbacks& feedback, std::uint64_t cycle,
+                     std::uint32_t limits_ignored, RtEvent& fault) const noexcept;
   // Not RT: the same, with the fault in words.
   bool check(const JointFeedbacks& feedback, std::uint64_t cycle, std::uint32_t limits_ignored,
              Fault& fault) const noexcept;
   // RT: joint `k`'s command of `cycle` (motor coordinates) as feedback read in servo cycle
   // `now` names it: 0 or a cycle not written yet is the latest one written, one that fell out
   // of the history its oldest.
-  drivers::JointCommand answered_command(std::size_t k, std::uint64_t cycle,
-                                         std::uint64_t now) const noexcept;
+  CNCD_RT drivers::JointCommand answered_command(std::size_t k, std::uint64_t cycle,
+                                                 std::uint64_t now) const noexcept;
 
  private:
   const config::MachineConfig& config_;

@@ -14,6 +14,7 @@
 #include <cstdint>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
 
@@ -38,22 +39,22 @@ class Homing {
   // RT. Starts homing the joints in `mask` (all ones: "home all", the joints that have a
   // HOME_SEQUENCE, or every joint when none has). Returns false, with the reason in fault(),
   // when a joint's homing configuration cannot be carried out; nothing moves then.
-  bool start(std::uint32_t mask, JointIo& io) noexcept;
+  CNCD_RT bool start(std::uint32_t mask, JointIo& io) noexcept;
   // RT. One servo period: advances every homing joint and moves on through the sequences.
   // `finished` and `aborted` are reported once, then `idle`.
-  Result update(JointIo& io) noexcept;
+  CNCD_RT Result update(JointIo& io) noexcept;
   // RT. Brings the homing joints to a controlled stop; update() reports `aborted` once they
   // stand still. The joints stay unhomed.
-  void abort() noexcept;
+  CNCD_RT void abort() noexcept;
   // RT. Forgets any homing in progress at once (estop, machine off, fault).
-  void stop_now() noexcept;
+  CNCD_RT void stop_now() noexcept;
 
-  bool active() const noexcept { return active_; }
-  bool stopping() const noexcept { return aborting_; }
+  CNCD_RT bool active() const noexcept { return active_; }
+  CNCD_RT bool stopping() const noexcept { return aborting_; }
   // True while joint `j` homes with HOME_IGNORE_LIMITS (its limit switch is its home switch).
-  bool ignores_limits(int j) const noexcept;
+  CNCD_RT bool ignores_limits(int j) const noexcept;
   // Why start() refused or update() failed.
-  const RtEvent& fault() const noexcept { return fault_; }
+  CNCD_RT const RtEvent& fault() const noexcept { return fault_; }
   // Not RT: fault() in words, valid until the next call.
   const char* error() const noexcept;
 
@@ -88,16 +89,16 @@ class Homing {
     FreeMove move;
   };
 
-  bool check_config(int j) noexcept;
-  void start_sequence(JointIo& io) noexcept;
-  bool step_joint(int j, JointIo& io) noexcept;  // false: failed, fault_ set
-  bool settle(int j) noexcept;
-  void enter(int j, Phase phase) noexcept;
-  void start_move(int j, const JointIo& io, double velocity, double target,
-                  bool to_target) noexcept;
-  void set_position(int j, JointIo& io, double position) noexcept;
-  bool sync_ready(int j) const noexcept;
-  void fail(int j, const char* what) noexcept;  // `what`: a string literal
+  CNCD_RT bool check_config(int j) noexcept;
+  CNCD_RT void start_sequence(JointIo& io) noexcept;
+  CNCD_RT bool step_joint(int j, JointIo& io) noexcept;  // false: failed, fault_ set
+  CNCD_RT bool settle(int j) noexcept;
+  CNCD_RT void enter(int j, Phase phase) noexcept;
+  CNCD_RT void start_move(int j, const JointIo& io, double velocity, double target,
+                          bool to_target) noexcept;
+  CNCD_RT void set_position(int j, JointIo& io, double position) noexcept;
+  CNCD_RT bool sync_ready(int j) const noexcept;
+  CNCD_RT void fail(int j, const char* what) noexcept;  // `what`: a string literal
 
   const config::MachineConfig& config_;
   double period_s_;

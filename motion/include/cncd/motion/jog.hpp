@@ -6,14 +6,15 @@
 #include <cstdint>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
 
 // Why a jog of `axis` from `position` in `direction` (+1 or -1) cannot start, or nullptr.
 // A homed axis may not jog at or beyond its soft limit in that direction. Any thread.
-const char* jog_refusal(const config::MachineConfig& config, int axis, double position,
-                        double direction, bool homed) noexcept;
+CNCD_RT const char* jog_refusal(const config::MachineConfig& config, int axis, double position,
+                                double direction, bool homed) noexcept;
 
 class Jog {
  public:
@@ -23,23 +24,23 @@ class Jog {
   // units/s (its sign is the direction, its size capped at MAX_VELOCITY), on a homed axis up
   // to the soft limit. An axis jogging the same way takes the new speed; one jogging the other
   // way comes to rest first. Returns nullptr or why it is refused.
-  const char* start(int axis, double position, double velocity, bool homed) noexcept;
+  CNCD_RT const char* start(int axis, double position, double velocity, bool homed) noexcept;
   // RT. Moves `axis` by `distance` (on a homed axis no further than the soft limit) at up to
   // `speed` units/s. Refused while the axis jogs.
-  const char* increment(int axis, double position, double distance, double speed,
-                        bool homed) noexcept;
+  CNCD_RT const char* increment(int axis, double position, double distance, double speed,
+                                bool homed) noexcept;
   // RT. Controlled stop at the axis's MAX_ACCELERATION.
-  void stop(int axis) noexcept;
-  void stop_all() noexcept;
+  CNCD_RT void stop(int axis) noexcept;
+  CNCD_RT void stop_all() noexcept;
   // RT. Forgets every jog at once (estop, drives off): the caller holds the positions.
-  void halt() noexcept;
-  bool active() const noexcept { return active_mask() != 0; }
+  CNCD_RT void halt() noexcept;
+  CNCD_RT bool active() const noexcept { return active_mask() != 0; }
   // Bit i set: axis i is jogging.
-  std::uint32_t active_mask() const noexcept;
+  CNCD_RT std::uint32_t active_mask() const noexcept;
   // RT. Advances every jogging axis by `dt` seconds and writes its position into `pose`.
-  void update(AxisPose& pose, double dt) noexcept;
+  CNCD_RT void update(AxisPose& pose, double dt) noexcept;
   // Speed along the combined direction of the jogging axes, units/s.
-  double speed() const noexcept;
+  CNCD_RT double speed() const noexcept;
 
  private:
   struct AxisJog {
@@ -55,7 +56,7 @@ class Jog {
     double pending_velocity = 0;
     bool pending_homed = false;
   };
-  void begin(int axis, double position, double target, double speed) noexcept;
+  CNCD_RT void begin(int axis, double position, double target, double speed) noexcept;
 
   const config::MachineConfig& config_;
   std::array<AxisJog, kAxes> axes_{};

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
@@ -39,67 +40,67 @@ class PathExecutor {
 
   // One period of `dt` seconds along the path; `pose` (the axes) follows it. When a move
   // would start from rest while `joints_apart` is set, the path faults instead.
-  Result advance(double dt, AxisPose& pose, bool joints_apart) noexcept;
+  CNCD_RT Result advance(double dt, AxisPose& pose, bool joints_apart) noexcept;
   // Drops every queued segment at once, counted as done (estop, drives off, a fault).
-  void flush() noexcept;
+  CNCD_RT void flush() noexcept;
   // Controlled stop and the queue dropped once the path stands still (nothing when idle).
-  void abort() noexcept;
-  void pause() noexcept;
-  void resume() noexcept;
+  CNCD_RT void abort() noexcept;
+  CNCD_RT void pause() noexcept;
+  CNCD_RT void resume() noexcept;
   // The feed and rapid override ratios, already clamped.
-  void set_overrides(double feed, double rapid) noexcept;
+  CNCD_RT void set_overrides(double feed, double rapid) noexcept;
 
   // Path motion under way or waiting, in the look-ahead window or in the ring.
-  bool pending() const noexcept { return window_count_ > 0 || segments_.size() > 0; }
+  CNCD_RT bool pending() const noexcept { return window_count_ > 0 || segments_.size() > 0; }
   // A segment is being executed: the path is not at rest between two periods.
-  bool active() const noexcept { return has_active_; }
-  std::uint32_t queued() const noexcept {
+  CNCD_RT bool active() const noexcept { return has_active_; }
+  CNCD_RT std::uint32_t queued() const noexcept {
     return static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
   }
   // What the last advance() left; the line stays that of the last segment executed.
-  double velocity() const noexcept { return velocity_; }
-  double distance_to_go() const noexcept { return distance_to_go_; }
-  MotionState motion() const noexcept { return motion_; }
-  std::int32_t line() const noexcept { return line_; }
+  CNCD_RT double velocity() const noexcept { return velocity_; }
+  CNCD_RT double distance_to_go() const noexcept { return distance_to_go_; }
+  CNCD_RT MotionState motion() const noexcept { return motion_; }
+  CNCD_RT std::int32_t line() const noexcept { return line_; }
   // Segments and programmed moves completed or dropped since the start.
-  std::uint64_t segments_done() const noexcept { return segments_done_; }
-  std::uint64_t moves_done() const noexcept { return moves_done_; }
+  CNCD_RT std::uint64_t segments_done() const noexcept { return segments_done_; }
+  CNCD_RT std::uint64_t moves_done() const noexcept { return moves_done_; }
   // The path's jerk limit, 0 for trapezoidal profiles.
-  double jerk() const noexcept { return jerk_; }
+  CNCD_RT double jerk() const noexcept { return jerk_; }
 
  private:
-  Segment& window_at(std::uint64_t seq) noexcept {
+  CNCD_RT Segment& window_at(std::uint64_t seq) noexcept {
     return window_[static_cast<std::size_t>(seq % kWindow)];
   }
   // Drops the path for `fault`.
-  void fail(Fault fault) noexcept;
-  bool starts_here(const Segment& segment, const AxisPose& pose) noexcept;  // false: failed
-  double speed_limit(const Segment& segment) const noexcept;  // with overrides and holds
+  CNCD_RT void fail(Fault fault) noexcept;
+  CNCD_RT bool starts_here(const Segment& segment, const AxisPose& pose) noexcept;  // false: failed
+  CNCD_RT double speed_limit(const Segment& segment) const noexcept;  // with overrides and holds
   // Takes segments from the ring while the window holds less than the path needs to stop
   // from its fastest speed, and brings the exit speeds up to date, within this period's work
   // budget.
-  void fill_window() noexcept;
+  CNCD_RT void fill_window() noexcept;
   // Continues the backward pass over the exit speeds for up to pass_budget_ steps.
-  void run_pass() noexcept;
+  CNCD_RT void run_pass() noexcept;
   // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
-  void soft_limits_changed() noexcept;
-  void finish_front() noexcept;          // the window's first segment is done
-  double window_floor_accel() noexcept;  // the smallest acceleration limit in the window
+  CNCD_RT void soft_limits_changed() noexcept;
+  CNCD_RT void finish_front() noexcept;          // the window's first segment is done
+  CNCD_RT double window_floor_accel() noexcept;  // the smallest acceleration limit in the window
   // S-curve profiles (path_scurve.cpp): one period of path motion whose acceleration changes
   // by at most jerk_ per second, through as many segments as it covers. Spends all of `dt`.
-  void scurve_step(double& dt, AxisPose& pose) noexcept;
+  CNCD_RT void scurve_step(double& dt, AxisPose& pose) noexcept;
   // The speed limits ahead of the path's position into limits_, as far as the path, `ds`
   // further on at speed `v` and acceleration `a`, could need to slow down for them.
-  void gather_limits(double ds, double v, double a) noexcept;
+  CNCD_RT void gather_limits(double ds, double v, double a) noexcept;
   // Whether a step from `v_before`, `a_before` to speed `v` and acceleration `a`, `ds` further on,
   // keeps every limit gathered (the hard ones only when `soft` is false): those it passes, and
   // those ahead it can still slow down for; with `speeds_only`, the speeds alone and not the
   // coming segments' acceleration limits.
-  bool keeps_limits(double v_before, double a_before, double v, double a, double ds, bool soft,
-                    bool speeds_only = false) const noexcept;
+  CNCD_RT bool keeps_limits(double v_before, double a_before, double v, double a, double ds,
+                            bool soft, bool speeds_only = false) const noexcept;
   // Whether a deceleration `a` at speed `v`, `ds` further on, can ease off to every coming
   // segment's own acceleration limit before reaching it.
-  bool eases_in_time(double v, double a, double ds) const noexcept;
+  CNCD_RT bool eases_in_time(double v, double a, double ds) const noexcept;
 
   double period_s_;
   SegmentRing segments_;

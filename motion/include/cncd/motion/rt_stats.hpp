@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdint>
 
+#include "cncd/drivers/rt.hpp"
+
 namespace cncd::motion {
 
 class RtHistogram {
@@ -14,10 +16,10 @@ class RtHistogram {
   static constexpr int kCoarse = 990;
   static constexpr int kBuckets = kFine + kCoarse + 1;
 
-  void add(std::int64_t error_ns) noexcept;
+  CNCD_RT void add(std::int64_t error_ns) noexcept;
   // Upper edge (ns) of the bucket holding the q-quantile, q in [0, 1].
-  std::int64_t quantile_ns(double q) const noexcept;
-  std::int64_t max_ns() const noexcept { return max_ns_; }
+  CNCD_RT std::int64_t quantile_ns(double q) const noexcept;
+  CNCD_RT std::int64_t max_ns() const noexcept { return max_ns_; }
   std::uint64_t count() const noexcept { return count_; }
 
  private:

@@ -9,6 +9,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
 #include "cncd/drivers/seqlock.hpp"
 #include "cncd/motion/feedback_checks.hpp"
 #include "cncd/motion/homing.hpp"
@@ -87,7 +88,7 @@ class ServoLoop {
   ServoLoop(const config::MachineConfig& config, std::vector<DriverBinding> drivers);
 
   // RT: one servo period. `wake_error_ns` is how late this cycle woke (for the statistics).
-  void cycle(std::int64_t wake_error_ns) noexcept;
+  CNCD_RT void cycle(std::int64_t wake_error_ns) noexcept;
 
   // Producer: the planner (task thread). Consumer: the servo thread.
   SegmentRing& segments() noexcept { return path_.segments(); }
@@ -105,34 +106,34 @@ class ServoLoop {
   void set_start_positions(const JointArray& joints) noexcept;
 
  private:
-  void apply(const Command& command) noexcept;
-  void start_homing(std::uint32_t mask) noexcept;
-  void stop_now(MachineState next) noexcept;
+  CNCD_RT void apply(const Command& command) noexcept;
+  CNCD_RT void start_homing(std::uint32_t mask) noexcept;
+  CNCD_RT void stop_now(MachineState next) noexcept;
   // One period of path motion: the executor's progress into the status, its fault latched,
   // the joints moved with their axes.
-  void advance_path() noexcept;
+  CNCD_RT void advance_path() noexcept;
   // The first joint whose command stands apart from its axis's position, or -1.
-  int joint_apart() const noexcept;
-  void advance_homing() noexcept;
-  void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
-  void advance_jog() noexcept;
-  bool axis_homed(int axis) const noexcept;
-  void read_drivers() noexcept;
+  CNCD_RT int joint_apart() const noexcept;
+  CNCD_RT void advance_homing() noexcept;
+  CNCD_RT void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
+  CNCD_RT void advance_jog() noexcept;
+  CNCD_RT bool axis_homed(int axis) const noexcept;
+  CNCD_RT void read_drivers() noexcept;
   // Feedback judged by checks_; the first joint that fails latches the fault.
-  void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
-  void write_drivers() noexcept;
+  CNCD_RT void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
+  CNCD_RT void write_drivers() noexcept;
   // RT: a joint whose set-point is not a number keeps its last command and the machine
   // faults (RtEvent::Code::set_point_not_finite): a drive never sees a NaN or an infinity.
-  void guard_set_points() noexcept;
-  void update_stats(std::int64_t wake_error_ns) noexcept;
+  CNCD_RT void guard_set_points() noexcept;
+  CNCD_RT void update_stats(std::int64_t wake_error_ns) noexcept;
   // The first fault latched stays in the status until the machine is reset or turned on.
-  void latch_fault(RtEvent fault) noexcept;
-  void latch_fault(RtEvent::Code code, int joint = -1) noexcept;
-  void post(const RtEvent& event) noexcept;
-  void warn(RtEvent::Code code, const char* words = nullptr) noexcept;
-  void sync_axes_from_joints() noexcept;
-  void adopt_start_positions() noexcept;
-  void publish() noexcept;
+  CNCD_RT void latch_fault(RtEvent fault) noexcept;
+  CNCD_RT void latch_fault(RtEvent::Code code, int joint = -1) noexcept;
+  CNCD_RT void post(const RtEvent& event) noexcept;
+  CNCD_RT void warn(RtEvent::Code code, const char* words = nullptr) noexcept;
+  CNCD_RT void sync_axes_from_joints() noexcept;
+  CNCD_RT void adopt_start_positions() noexcept;
+  CNCD_RT void publish() noexcept;
 
   const config::MachineConfig& config_;
   std::vector<DriverBinding> drivers_;

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <type_traits>
 
+#include "cncd/drivers/rt.hpp"
+
 namespace cncd::motion {
 
 template <typename T, std::size_t Capacity>
@@ -16,7 +18,7 @@ class SpscRing {
 
  public:
   // Producer thread. False when full.
-  bool push(const T& value) noexcept {
+  CNCD_RT bool push(const T& value) noexcept {
     const std::size_t head = head_.load(std::memory_order_relaxed);
     if (head - tail_.load(std::memory_order_acquire) == Capacity) return false;
     slots_[head & (Capacity - 1)] = value;
@@ -24,7 +26,7 @@ class SpscRing {
     return true;
   }
   // Consumer thread. False when empty.
-  bool pop(T& out) noexcept {
+  CNCD_RT bool pop(T& out) noexcept {
     const std::size_t tail = tail_.load(std::memory_order_relaxed);
     if (tail == head_.load(std::memory_order_acquire)) return false;
     out = slots_[tail & (Capacity - 1)];
@@ -32,13 +34,13 @@ class SpscRing {
     return true;
   }
   // Consumer thread: the oldest element without removing it, or nullptr.
-  const T* front() const noexcept {
+  CNCD_RT const T* front() const noexcept {
     const std::size_t tail = tail_.load(std::memory_order_relaxed);
     if (tail == head_.load(std::memory_order_acquire)) return nullptr;
     return &slots_[tail & (Capacity - 1)];
   }
   // Any thread; exact only on the producer or consumer thread.
-  std::size_t size() const noexcept {
+  CNCD_RT std::size_t size() const noexcept {
     return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire);
   }
   static constexpr std::size_t capacity() noexcept { return Capacity; }
