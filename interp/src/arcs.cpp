@@ -139,15 +139,12 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
     sweep += 2.0 * std::numbers::pi * (turns - 1);
     set_inverse_time_rate(std::hypot(radius * sweep, end[axes.normal] - pos_[axes.normal]));
   }
-  CanonCommand& command = make(CanonKind::arc_feed);
-  command.first_end = end1;
-  command.second_end = end2;
+  ArcFeed command;
+  command.plane = modal_.plane;
+  command.set_end(end);
   command.first_axis = center1;
   command.second_axis = center2;
   command.rotation = clockwise ? -turns : turns;
-  command.axis_end_point = end[axes.normal];
-  command.plane = modal_.plane;
-  command.pos = end;
   emit(command);
   pos_ = end;
 }

@@ -94,17 +94,14 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     // Below the R plane: go up to it first, once for all repeats.
     Pose up = pos_;
     up[g.c] = g.r;
-    emit_straight(CanonKind::straight_traverse, up);
+    emit_straight(StraightKind::traverse, up);
     old_c = g.r;
   }
   g.clear = (!modal_.retract_r_plane && old_c > g.r) ? old_c : g.r;
 
   const bool switch_mode = modal_.control != MotionMode::exact_path;
   if (switch_mode) {
-    CanonCommand& command = make(CanonKind::set_motion_control_mode);
-    command.ivalue = static_cast<int>(MotionMode::exact_path);
-    command.value = 0;
-    emit(command);
+    emit(SetMotionControlMode{MotionMode::exact_path, 0.0});
   }
   // Cycle-specific words, checked once the cycle has started (as LinuxCNC does).
   const bool needs_p = code == 820 || code == 860 || code == 880 || code == 890;
@@ -171,11 +168,8 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     cycle_body(code, g, a, b, current_c);
   }
   if (switch_mode) {
-    CanonCommand& command = make(CanonKind::set_motion_control_mode);
-    command.ivalue = static_cast<int>(modal_.control);
-    command.value = modal_.tolerance;
-    emit(command);
-    emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
+    emit(SetMotionControlMode{modal_.control, modal_.tolerance});
+    emit(SetNaivecamTolerance{modal_.naive_tolerance});
   }
 }
 
@@ -183,7 +177,7 @@ void Interpreter::Impl::do_canned_cycle(int code) {
 // clear height (`current_c` tracks the drilling-axis position between moves).
 void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, double b,
                                    double& current_c) {
-  auto move = [&](CanonKind kind, double a_value, double b_value, double c_value) {
+  auto move = [&](StraightKind kind, double a_value, double b_value, double c_value) {
     Pose end = pos_;
     end[g.a] = a_value;
     end[g.b] = b_value;
@@ -191,12 +185,17 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
     emit_straight(kind, end);
     current_c = c_value;
   };
-  auto traverse = [&](double c_value) { move(CanonKind::straight_traverse, a, b, c_value); };
-  auto feed = [&](double c_value) { move(CanonKind::straight_feed, a, b, c_value); };
-  auto dwell = [&](double seconds) { emit_simple(CanonKind::dwell, 0, seconds); };
-  const CanonKind restart = modal_.spindle == SpindleDir::counterclockwise
-                                ? CanonKind::start_spindle_counterclockwise
-                                : CanonKind::start_spindle_clockwise;
+  auto traverse = [&](double c_value) { move(StraightKind::traverse, a, b, c_value); };
+  auto feed = [&](double c_value) { move(StraightKind::feed, a, b, c_value); };
+  auto dwell = [&](double seconds) { emit(Dwell{seconds}); };
+  auto start_spindle = [&](bool counterclockwise) {
+    if (counterclockwise) {
+      emit(StartSpindleCounterclockwise{});
+    } else {
+      emit(StartSpindleClockwise{});
+    }
+  };
+  auto restart = [&] { start_spindle(modal_.spindle == SpindleDir::counterclockwise); };
 
   traverse(current_c);
   if (current_c != g.r) traverse(g.r);
@@ -242,19 +241,17 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
       if (!right_hand && modal_.spindle == SpindleDir::clockwise) {
         fail("Spindle turning clockwise in G74");
       }
-      emit_simple(CanonKind::set_feed_override_enable, 0);
-      emit_simple(CanonKind::set_spindle_override_enable, 0);
+      emit(SetFeedOverrideEnable{false});
+      emit(SetSpindleOverrideEnable{false});
       feed(g.bottom);
-      emit_simple(CanonKind::stop_spindle_turning);
-      emit_simple(right_hand ? CanonKind::start_spindle_counterclockwise
-                             : CanonKind::start_spindle_clockwise);
+      emit(StopSpindleTurning{});
+      start_spindle(right_hand);
       dwell(cycle_.p);
       feed(g.clear);
-      emit_simple(CanonKind::stop_spindle_turning);
-      emit_simple(right_hand ? CanonKind::start_spindle_clockwise
-                             : CanonKind::start_spindle_counterclockwise);
-      emit_simple(CanonKind::set_feed_override_enable, 1);
-      emit_simple(CanonKind::set_spindle_override_enable, 1);
+      emit(StopSpindleTurning{});
+      start_spindle(!right_hand);
+      emit(SetFeedOverrideEnable{true});
+      emit(SetSpindleOverrideEnable{true});
       break;
     }
     case 850:
@@ -265,39 +262,39 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
     case 860:
       feed(g.bottom);
       dwell(cycle_.p);
-      emit_simple(CanonKind::stop_spindle_turning);
+      emit(StopSpindleTurning{});
       traverse(g.clear);
-      emit_simple(restart);
+      restart();
       break;
     case 870: {
       // Back boring: enter beside the hole with the spindle oriented, cut upwards to K.
       const double off_a = a + g.i;
       const double off_b = b + g.j;
       auto offset_traverse = [&](double c_value) {
-        move(CanonKind::straight_traverse, off_a, off_b, c_value);
+        move(StraightKind::traverse, off_a, off_b, c_value);
       };
       offset_traverse(current_c);
-      emit_simple(CanonKind::stop_spindle_turning);
-      emit_simple(CanonKind::orient_spindle, 2, 0.0);
+      emit(StopSpindleTurning{});
+      emit(OrientSpindle{0.0, 2});
       offset_traverse(g.bottom);
       traverse(g.bottom);
-      emit_simple(restart);
+      restart();
       feed(g.k);
       feed(g.bottom);
-      emit_simple(CanonKind::stop_spindle_turning);
-      emit_simple(CanonKind::orient_spindle, 2, 0.0);
+      emit(StopSpindleTurning{});
+      emit(OrientSpindle{0.0, 2});
       offset_traverse(g.bottom);
       offset_traverse(g.clear);
       traverse(g.clear);
-      emit_simple(restart);
+      restart();
       break;
     }
     case 880:
       feed(g.bottom);
       dwell(cycle_.p);
-      emit_simple(CanonKind::stop_spindle_turning);
-      emit_simple(CanonKind::program_stop);
-      emit_simple(restart);
+      emit(StopSpindleTurning{});
+      emit(ProgramStop{});
+      restart();
       // The operator retracts by hand during the stop; LinuxCNC then takes the tool to be at
       // the clear height.
       pos_[g.c] = g.clear;

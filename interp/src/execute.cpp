@@ -41,15 +41,11 @@ void Interpreter::Impl::do_comment() {
   const std::string& text = block_.comments[static_cast<std::size_t>(block_.comment_count - 1)];
   std::size_t rest = 0;
   if (starts_with_word(text, "msg,", rest)) {
-    CanonCommand& command = make(CanonKind::message);
-    command.text = text.substr(rest);
-    emit(command);
+    emit(Message{text.substr(rest)});
     return;
   }
   if (starts_with_word(text, "debug,", rest)) {
-    CanonCommand& command = make(CanonKind::message);
-    command.text = substitute_parameters(text.substr(rest));
-    emit(command);
+    emit(Message{substitute_parameters(text.substr(rest))});
     return;
   }
   // PRINT and LOG comments go to the operator's terminal or a log file, not to the machine.
@@ -114,26 +110,26 @@ void Interpreter::Impl::do_feed_mode() {
   if (code >= 0) {
     if (code == 930) {
       emit_comment("interpreter: feed mode set to inverse time");
-      emit_simple(CanonKind::set_feed_mode, 0);
+      emit(SetFeedMode{FeedRateMode::per_minute});
       modal_.feed_mode = FeedMode::inverse_time;
     } else if (code == 940) {
       emit_comment("interpreter: feed mode set to units per minute");
-      emit_simple(CanonKind::set_feed_mode, 0);
+      emit(SetFeedMode{FeedRateMode::per_minute});
       modal_.feed_mode = FeedMode::units_per_minute;
       modal_.feed_rate = 0;
-      emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+      emit(SetFeedRate{0.0});
     } else {
       emit_comment("interpreter: feed mode set to units per revolution");
-      emit_simple(CanonKind::set_feed_mode, 1);
+      emit(SetFeedMode{FeedRateMode::per_revolution});
       modal_.feed_mode = FeedMode::units_per_rev;
       modal_.feed_rate = 0;
-      emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+      emit(SetFeedRate{0.0});
     }
   }
   if (block_.has('f')) {
     modal_.feed_rate = block_.get('f');
     if (modal_.feed_mode != FeedMode::inverse_time) {
-      emit_simple(CanonKind::set_feed_rate, 0, modal_.feed_rate);
+      emit(SetFeedRate{modal_.feed_rate});
     }
   }
 }
@@ -141,7 +137,7 @@ void Interpreter::Impl::do_feed_mode() {
 void Interpreter::Impl::do_tool_and_spindle() {
   if (block_.has('s')) {
     modal_.speed = block_.get('s');
-    emit_simple(CanonKind::set_spindle_speed, 0, modal_.speed);
+    emit(SetSpindleSpeed{modal_.speed});
   }
   if (block_.has('t')) {
     const int tool = to_int(block_.get('t'));
@@ -150,14 +146,14 @@ void Interpreter::Impl::do_tool_and_spindle() {
            block_.col('t'));
     }
     tool_prepped_ = tool;
-    emit_simple(CanonKind::select_tool, tool);
+    emit(SelectTool{tool});
   }
   const int change = block_.m_code(MGroup::tool_change);
   if (change == 6) {
     const int tool = tool_prepped_ < 0 ? tool_in_spindle_ : tool_prepped_;
-    emit_simple(CanonKind::start_change);
-    emit_simple(CanonKind::stop_spindle_turning);
-    emit_simple(CanonKind::change_tool, tool);
+    emit(StartChange{});
+    emit(StopSpindleTurning{});
+    emit(ChangeTool{tool});
     tool_in_spindle_ = tool;
     modal_.spindle = SpindleDir::stopped;
   } else if (change == 61) {
@@ -166,20 +162,20 @@ void Interpreter::Impl::do_tool_and_spindle() {
     }
     const int tool = to_int(block_.get('q'));
     tool_in_spindle_ = tool;
-    emit_simple(CanonKind::change_tool_number, tool);
+    emit(ChangeToolNumber{tool});
   }
   switch (block_.m_code(MGroup::spindle)) {
     case 3:
       modal_.spindle = SpindleDir::clockwise;
-      emit_simple(CanonKind::start_spindle_clockwise);
+      emit(StartSpindleClockwise{});
       break;
     case 4:
       modal_.spindle = SpindleDir::counterclockwise;
-      emit_simple(CanonKind::start_spindle_counterclockwise);
+      emit(StartSpindleCounterclockwise{});
       break;
     case 5:
       modal_.spindle = SpindleDir::stopped;
-      emit_simple(CanonKind::stop_spindle_turning);
+      emit(StopSpindleTurning{});
       break;
     default:
       break;
@@ -190,16 +186,16 @@ void Interpreter::Impl::do_coolant_and_overrides() {
   switch (block_.m_code(MGroup::coolant)) {
     case 7:
       modal_.mist = true;
-      emit_simple(CanonKind::mist_on);
+      emit(MistOn{});
       break;
     case 8:
       modal_.flood = true;
-      emit_simple(CanonKind::flood_on);
+      emit(FloodOn{});
       break;
     case 9:
       modal_.mist = modal_.flood = false;
-      emit_simple(CanonKind::mist_off);
-      emit_simple(CanonKind::flood_off);
+      emit(MistOff{});
+      emit(FloodOff{});
       break;
     default:
       break;
@@ -211,29 +207,29 @@ void Interpreter::Impl::do_coolant_and_overrides() {
   switch (code) {
     case 48:
       modal_.feed_override = modal_.speed_override = true;
-      emit_simple(CanonKind::set_feed_override_enable, 1);
-      emit_simple(CanonKind::set_spindle_override_enable, 1);
+      emit(SetFeedOverrideEnable{true});
+      emit(SetSpindleOverrideEnable{true});
       break;
     case 49:
       modal_.feed_override = modal_.speed_override = false;
-      emit_simple(CanonKind::set_feed_override_enable, 0);
-      emit_simple(CanonKind::set_spindle_override_enable, 0);
+      emit(SetFeedOverrideEnable{false});
+      emit(SetSpindleOverrideEnable{false});
       break;
     case 50:
       modal_.feed_override = on;
-      emit_simple(CanonKind::set_feed_override_enable, on ? 1 : 0);
+      emit(SetFeedOverrideEnable{on});
       break;
     case 51:
       modal_.speed_override = on;
-      emit_simple(CanonKind::set_spindle_override_enable, on ? 1 : 0);
+      emit(SetSpindleOverrideEnable{on});
       break;
     case 52:
       modal_.adaptive_feed = on;
-      emit_simple(CanonKind::set_adaptive_feed_enable, on ? 1 : 0);
+      emit(SetAdaptiveFeedEnable{on});
       break;
     default:
       modal_.feed_hold = on;
-      emit_simple(CanonKind::set_feed_hold_enable, on ? 1 : 0);
+      emit(SetFeedHoldEnable{on});
       break;
   }
 }
@@ -243,17 +239,14 @@ void Interpreter::Impl::do_dwell() {
   if (!block_.has('p') || block_.get('p') < 0) {
     fail("Dwell time missing with g4", block_.g_column[0]);
   }
-  emit_simple(CanonKind::dwell, 0, block_.get('p'));
+  emit(Dwell{block_.get('p')});
 }
 
 void Interpreter::Impl::do_modes() {
   const int plane = block_.g_code(GGroup::plane);
   if (plane >= 0) {
     modal_.plane = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
-    CanonCommand& command = make(CanonKind::select_plane);
-    command.plane = modal_.plane;
-    command.ivalue = static_cast<int>(modal_.plane);
-    emit(command);
+    emit(SelectPlane{modal_.plane});
   }
   const int units = block_.g_code(GGroup::units);
   if (units >= 0) change_units(units == 200 ? Units::inches : Units::mm);
@@ -275,7 +268,6 @@ void Interpreter::Impl::do_modes() {
   }
   const int path = block_.g_code(GGroup::path_control);
   if (path >= 0) {
-    CanonCommand& command = make(CanonKind::set_motion_control_mode);
     if (path == 610) {
       modal_.control = MotionMode::exact_path;
     } else if (path == 611) {
@@ -285,10 +277,8 @@ void Interpreter::Impl::do_modes() {
       modal_.tolerance = block_.has('p') ? block_.get('p') : 0.0;
       modal_.naive_tolerance = block_.has('q') ? block_.get('q') : modal_.tolerance;
     }
-    command.ivalue = static_cast<int>(modal_.control);
-    command.value = modal_.tolerance;
-    emit(command);
-    if (path == 640) emit_simple(CanonKind::set_naivecam_tolerance, 0, modal_.naive_tolerance);
+    emit(SetMotionControlMode{modal_.control, modal_.tolerance});
+    if (path == 640) emit(SetNaivecamTolerance{modal_.naive_tolerance});
   }
   const int distance = block_.g_code(GGroup::distance);
   if (distance == 900 && modal_.incremental) {
@@ -342,14 +332,14 @@ void Interpreter::Impl::do_non_modal() {
 bool Interpreter::Impl::do_stop() {
   switch (block_.m_code(MGroup::stopping)) {
     case 0:
-      emit_simple(CanonKind::program_stop);
+      emit(ProgramStop{});
       return true;
     case 1:
-      emit_simple(CanonKind::optional_program_stop);
+      emit(OptionalProgramStop{});
       return true;
     case 60:
-      emit_simple(CanonKind::pallet_shuttle);
-      emit_simple(CanonKind::program_stop);
+      emit(PalletShuttle{});
+      emit(ProgramStop{});
       return true;
     case 2:
     case 30:
@@ -365,33 +355,30 @@ bool Interpreter::Impl::do_stop() {
 void Interpreter::Impl::program_end_reset() {
   select_coord_system_quiet(1);
   emit_g5x();
-  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
+  emit(SetXyRotation{rotation_deg_});
   if (modal_.plane != Plane::xy) {
     modal_.plane = Plane::xy;
-    CanonCommand& command = make(CanonKind::select_plane);
-    command.plane = Plane::xy;
-    command.ivalue = static_cast<int>(Plane::xy);
-    emit(command);
+    emit(SelectPlane{Plane::xy});
   }
   modal_.incremental = false;
   modal_.feed_mode = FeedMode::units_per_minute;
-  emit_simple(CanonKind::set_feed_mode, 0);
+  emit(SetFeedMode{FeedRateMode::per_minute});
   modal_.feed_rate = 0;
-  emit_simple(CanonKind::set_feed_rate, 0, 0.0);
+  emit(SetFeedRate{0.0});
   if (!modal_.feed_override) {
     // LinuxCNC re-enables only the feed override here; the speed override stays as it was.
     modal_.feed_override = true;
-    emit_simple(CanonKind::set_feed_override_enable, 1);
+    emit(SetFeedOverrideEnable{true});
   }
   modal_.spindle = SpindleDir::stopped;
-  emit_simple(CanonKind::stop_spindle_turning);
-  emit_simple(CanonKind::set_spindle_mode, 0, 0.0);
-  if (modal_.mist) emit_simple(CanonKind::mist_off);
-  if (modal_.flood) emit_simple(CanonKind::flood_off);
+  emit(StopSpindleTurning{});
+  emit(SetSpindleMode{0.0});
+  if (modal_.mist) emit(MistOff{});
+  if (modal_.flood) emit(FloodOff{});
   modal_.mist = modal_.flood = false;
   modal_.motion = 10;
-  if (block_.m_code(MGroup::stopping) == 30) emit_simple(CanonKind::pallet_shuttle);
-  emit_simple(CanonKind::program_end);
+  if (block_.m_code(MGroup::stopping) == 30) emit(PalletShuttle{});
+  emit(ProgramEnd{});
 }
 
 }  // namespace cncd::interp

@@ -26,6 +26,7 @@ inline constexpr char kAxisLetters[kAxes + 1] = "xyzabcuvw";
 
 enum class FeedMode : int { units_per_minute = 0, inverse_time = 1, units_per_rev = 2 };
 enum class SpindleDir : int { stopped = 0, clockwise = 1, counterclockwise = -1 };
+enum class StraightKind : bool { traverse, feed };
 
 // Modal state LinuxCNC keeps between blocks.
 struct ModalState {
@@ -151,10 +152,10 @@ struct Interpreter::Impl {
   // motion.cpp
   void do_motion();
   Pose target_from_words() const;
-  void straight(CanonKind kind, const Pose& end);
+  void straight(StraightKind kind, const Pose& end);
   void arc(bool clockwise, const Pose& end);
   void set_inverse_time_rate(double length);
-  void emit_straight(CanonKind kind, const Pose& end);
+  void emit_straight(StraightKind kind, const Pose& end);
 
   // offsets.cpp, setup_codes.cpp
   void do_g10();
@@ -194,15 +195,17 @@ struct Interpreter::Impl {
   LineSource& source() { return sources_.back(); }
 
   // emit helpers
-  CanonCommand& make(CanonKind kind);
-  // Every canonical command leaves here; one carrying a number that is not finite (a position
-  // that overflowed) fails the block instead.
-  void emit(const CanonCommand& command);
+  // Every canonical command leaves here, with the current line; one carrying a number that is
+  // not finite (a position that overflowed) fails the block instead.
+  template <class Op>
+  void emit(Op&& op) {
+    emit_command(CanonCommand{current_line_, std::forward<Op>(op)});
+  }
+  void emit_command(const CanonCommand& command);
   // Jumps back to the start of a loop; fails once loops have run max_loops_without_motion
   // times in a row without a move or dwell (an endless loop that would never end).
   void loop_back(std::int64_t offset, int line_before);
   void emit_comment(const std::string& text);
-  void emit_simple(CanonKind kind, int ivalue = 0, double value = 0);
 
   double to_program_units(double machine_value) const;
   Units tool_table_units() const;
@@ -216,7 +219,6 @@ struct Interpreter::Impl {
   std::vector<LineSource> sources_;  // back() is being read; subroutine files are pushed
   std::string program_name_;
   CanonSink* sink_ = nullptr;
-  CanonCommand command_;
   std::optional<InterpError> error_;
   std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
   bool parameter_file_refused_ = false;      // never written then

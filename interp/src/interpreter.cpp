@@ -1,6 +1,7 @@
 #include "cncd/interp/interpreter.hpp"
 
 #include <cmath>
+#include <variant>
 
 #include "failure.hpp"
 #include "interp_state.hpp"
@@ -67,48 +68,63 @@ void Interpreter::Impl::reset_modal_state() {
   seen_percent_ = false;
 }
 
-CanonCommand& Interpreter::Impl::make(CanonKind kind) {
-  command_.kind = kind;
-  command_.line = current_line_;
-  command_.ivalue = 0;
-  command_.value = 0;
-  command_.value2 = 0;
-  command_.text.clear();
-  return command_;
+namespace {
+
+bool finite(const Pose& pose) {
+  bool all = true;
+  for (const double v : pose)
+    all = all && std::isfinite(v);
+  return all;
 }
 
-void Interpreter::Impl::emit(const CanonCommand& command) {
-  bool finite = std::isfinite(command.first_end) && std::isfinite(command.second_end) &&
-                std::isfinite(command.first_axis) && std::isfinite(command.second_axis) &&
-                std::isfinite(command.axis_end_point) && std::isfinite(command.value) &&
-                std::isfinite(command.value2);
-  for (const double v : command.pos)
-    finite = finite && std::isfinite(v);
-  if (!finite) fail("Result is not a finite number (overflow)");
-  if (command.kind <= CanonKind::dwell) loops_without_motion_ = 0;  // a move or a dwell
+bool finite(const CanonOp& op) {
+  return std::visit(Overloaded{
+                        [](const StraightTraverse& c) { return finite(c.end); },
+                        [](const StraightFeed& c) { return finite(c.end); },
+                        [](const ArcFeed& c) { return finite(c.end()) && finite(c.center()); },
+                        [](const Dwell& c) { return std::isfinite(c.seconds); },
+                        [](const SetFeedRate& c) { return std::isfinite(c.rate); },
+                        [](const SetG5xOffset& c) { return finite(c.offset); },
+                        [](const SetG92Offset& c) { return finite(c.offset); },
+                        [](const SetXyRotation& c) { return std::isfinite(c.degrees); },
+                        [](const UseToolLengthOffset& c) { return finite(c.offset); },
+                        [](const SetMotionControlMode& c) { return std::isfinite(c.tolerance); },
+                        [](const SetNaivecamTolerance& c) { return std::isfinite(c.tolerance); },
+                        [](const SetSpindleSpeed& c) { return std::isfinite(c.rpm); },
+                        [](const SetSpindleMode& c) { return std::isfinite(c.css_max_rpm); },
+                        [](const OrientSpindle& c) { return std::isfinite(c.angle_deg); },
+                        [](const SetToolTableEntry& c) {
+                          return finite(c.offset) && std::isfinite(c.front_angle) &&
+                                 std::isfinite(c.back_angle);
+                        },
+                        [](const auto&) { return true; },  // no number in it
+                    },
+                    op);
+}
+
+}  // namespace
+
+void Interpreter::Impl::emit_command(const CanonCommand& command) {
+  if (!finite(command.op)) fail("Result is not a finite number (overflow)");
+  const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
+                     std::holds_alternative<StraightFeed>(command.op) ||
+                     std::holds_alternative<ArcFeed>(command.op) ||
+                     std::holds_alternative<Dwell>(command.op);
+  if (moves) loops_without_motion_ = 0;  // a move or a dwell
   sink_->emit(command);
 }
 
-void Interpreter::Impl::emit_simple(CanonKind kind, int ivalue, double value) {
-  CanonCommand& command = make(kind);
-  command.ivalue = ivalue;
-  command.value = value;
-  emit(command);
-}
-
 void Interpreter::Impl::emit_comment(const std::string& text) {
-  CanonCommand& command = make(CanonKind::comment);
-  command.text = text;
-  emit(command);
+  emit(Comment{text});
 }
 
 void Interpreter::Impl::emit_preamble() {
-  emit_simple(CanonKind::use_length_units, static_cast<int>(modal_.units));
+  emit(UseLengthUnits{modal_.units});
   emit_g5x();
   emit_g92();
-  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
-  emit_simple(CanonKind::set_feed_reference);
-  emit_simple(CanonKind::on_reset);
+  emit(SetXyRotation{rotation_deg_});
+  emit(SetFeedReference{});
+  emit(OnReset{});
   preamble_done_ = true;
 }
 
@@ -149,7 +165,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
       // The active origin was changed between programs: the canon layer learns it first.
       emit_g5x();
       if (resend_g92_) emit_g92();
-      emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
+      emit(SetXyRotation{rotation_deg_});
     }
     resend_g5x_ = false;
     resend_g92_ = false;
@@ -171,7 +187,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
         return Step::block;
       }
       if (seen_percent_) {
-        emit_simple(CanonKind::finish);
+        emit(Finish{});
         ended_ = true;
         return Step::end;
       }

@@ -78,10 +78,12 @@ Pose Interpreter::Impl::target_from_words() const {
   return end;
 }
 
-void Interpreter::Impl::emit_straight(CanonKind kind, const Pose& end) {
-  CanonCommand& command = make(kind);
-  command.pos = end;
-  emit(command);
+void Interpreter::Impl::emit_straight(StraightKind kind, const Pose& end) {
+  if (kind == StraightKind::feed) {
+    emit(StraightFeed{end});
+  } else {
+    emit(StraightTraverse{end});
+  }
   pos_ = end;
 }
 
@@ -89,11 +91,11 @@ void Interpreter::Impl::emit_straight(CanonKind kind, const Pose& end) {
 // rate as the current feed.
 void Interpreter::Impl::set_inverse_time_rate(double length) {
   modal_.feed_rate = length * block_.get('f');
-  emit_simple(CanonKind::set_feed_rate, 0, modal_.feed_rate);
+  emit(SetFeedRate{modal_.feed_rate});
 }
 
-void Interpreter::Impl::straight(CanonKind kind, const Pose& end) {
-  if (kind == CanonKind::straight_feed && modal_.feed_mode == FeedMode::inverse_time) {
+void Interpreter::Impl::straight(StraightKind kind, const Pose& end) {
+  if (kind == StraightKind::feed && modal_.feed_mode == FeedMode::inverse_time) {
     set_inverse_time_rate(straight_length(pos_, end));
   }
   emit_straight(kind, end);
@@ -140,7 +142,7 @@ void Interpreter::Impl::do_motion() {
   // An explicit G0/G1 moves (possibly nowhere); a modal one only with axis words.
   if (!axis_words && explicit_code < 0) return;
   const Pose end = target_from_words();
-  straight(code == 0 ? CanonKind::straight_traverse : CanonKind::straight_feed, end);
+  straight(code == 0 ? StraightKind::traverse : StraightKind::feed, end);
 }
 
 }  // namespace cncd::interp

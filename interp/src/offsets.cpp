@@ -85,16 +85,11 @@ void Interpreter::Impl::load_coord_system(int index) {
 }
 
 void Interpreter::Impl::emit_g5x() {
-  CanonCommand& command = make(CanonKind::set_g5x_offset);
-  command.ivalue = modal_.coord_system;
-  command.pos = g5x_offset_;
-  emit(command);
+  emit(SetG5xOffset{modal_.coord_system, g5x_offset_});
 }
 
 void Interpreter::Impl::emit_g92() {
-  CanonCommand& command = make(CanonKind::set_g92_offset);
-  command.pos = g92_offset_;
-  emit(command);
+  emit(SetG92Offset{g92_offset_});
 }
 
 void Interpreter::Impl::select_coord_system_quiet(int index) {
@@ -109,7 +104,7 @@ void Interpreter::Impl::select_coord_system(int index) {
   select_coord_system_quiet(index);
   emit_g5x();
   emit_g92();
-  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
+  emit(SetXyRotation{rotation_deg_});
 }
 
 void Interpreter::Impl::change_units(Units units) {
@@ -126,7 +121,7 @@ void Interpreter::Impl::change_units(Units units) {
     }
     modal_.units = units;
   }
-  emit_simple(CanonKind::use_length_units, static_cast<int>(units));
+  emit(UseLengthUnits{units});
 }
 
 void Interpreter::Impl::apply_tool_length(int code) {
@@ -173,9 +168,7 @@ void Interpreter::Impl::apply_tool_length(int code) {
   tool_offset_ = offset;
   tool_offset_machine_ = machine;
   modal_.tool_length_code = code;
-  CanonCommand& command = make(CanonKind::use_tool_length_offset);
-  command.pos = tool_offset_;
-  emit(command);
+  emit(UseToolLengthOffset{tool_offset_});
 }
 
 // LinuxCNC's canon order: the G92 offset applies inside the XY rotation, the G5x origin and

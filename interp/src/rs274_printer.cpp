@@ -1,6 +1,7 @@
 #include "cncd/interp/rs274_printer.hpp"
 
 #include <cstdio>
+#include <variant>
 
 #include "cncd/interp/fixed_text.hpp"
 
@@ -32,8 +33,8 @@ const char* plane_name(Plane plane) {
   }
 }
 
-const char* units_name(int units) {
-  switch (static_cast<Units>(units)) {
+const char* units_name(Units units) {
+  switch (units) {
     case Units::inches:
       return "CANON_UNITS_INCHES";
     case Units::cm:
@@ -44,233 +45,187 @@ const char* units_name(int units) {
   }
 }
 
-// The fixed-name commands: "NAME()" or "NAME(0)" for the spindle-indexed ones.
-const char* simple_name(CanonKind kind) {
-  switch (kind) {
-    case CanonKind::start_spindle_clockwise:
-      return "START_SPINDLE_CLOCKWISE(0)";
-    case CanonKind::start_spindle_counterclockwise:
-      return "START_SPINDLE_COUNTERCLOCKWISE(0)";
-    case CanonKind::stop_spindle_turning:
-      return "STOP_SPINDLE_TURNING(0)";
-    case CanonKind::mist_on:
-      return "MIST_ON()";
-    case CanonKind::mist_off:
-      return "MIST_OFF()";
-    case CanonKind::flood_on:
-      return "FLOOD_ON()";
-    case CanonKind::flood_off:
-      return "FLOOD_OFF()";
-    case CanonKind::program_stop:
-      return "PROGRAM_STOP()";
-    case CanonKind::optional_program_stop:
-      return "OPTIONAL_PROGRAM_STOP()";
-    case CanonKind::program_end:
-      return "PROGRAM_END()";
-    case CanonKind::pallet_shuttle:
-      return "PALLET_SHUTTLE()";
-    case CanonKind::on_reset:
-      return "ON_RESET()";
-    case CanonKind::finish:
-      return "FINISH()";
-    case CanonKind::start_change:
-      return "START_CHANGE()";
-    case CanonKind::set_feed_reference:
-      return "SET_FEED_REFERENCE(CANON_XYZ)";
-    default:
-      return nullptr;
+// Offsets in the tool table's layout: X Y Z, A B C and U V W in groups of three.
+void append_offset_groups(std::string& out, const Pose& pose, const char* group_separator) {
+  for (int axis = 0; axis < kAxes; ++axis) {
+    if (axis > 0) out += axis % 3 == 0 ? group_separator : " ";
+    append_fixed4(out, pose[static_cast<std::size_t>(axis)]);
   }
+}
+
+// A number as rs274 prints it: %.4f, or an integer.
+void append_value(std::string& out, double value) {
+  append_fixed4(out, value);
+}
+
+void append_value(std::string& out, int value) {
+  append_int(out, value);
+}
+
+// Arguments separated by ", ".
+template <class... Values>
+void append_args(std::string& out, Values... values) {
+  bool first = true;
+  ((out += first ? "" : ", ", first = false, append_value(out, values)), ...);
+}
+
+void append_arc(std::string& out, const ArcFeed& c, int axes) {
+  out += "ARC_FEED(";
+  append_args(out, c.first_end, c.second_end, c.first_axis, c.second_axis, c.rotation,
+              c.axis_end_point);
+  for (int axis = 3; axis < axes; ++axis) {
+    out += ", ";
+    append_fixed4(out, c.abc_uvw[static_cast<std::size_t>(axis - 3)]);
+  }
+  out += ')';
+}
+
+void append_motion_control_mode(std::string& out, const SetMotionControlMode& c) {
+  switch (c.mode) {
+    case MotionMode::exact_stop:
+      out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)";
+      break;
+    case MotionMode::exact_path:
+      out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)";
+      break;
+    case MotionMode::continuous:
+    default:
+      out += "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, ";
+      append_printf(out, "%.6f", c.tolerance);
+      out += ')';
+      break;
+  }
+}
+
+void append_tool_table_entry(std::string& out, const SetToolTableEntry& c) {
+  out += "SET_TOOL_TABLE_ENTRY(";
+  append_args(out, c.pocket, c.tool);
+  out += ", ";
+  append_offset_groups(out, c.offset, " ");
+  out += ", ";
+  append_args(out, c.front_angle, c.back_angle, c.orientation);
+  out += ')';
+}
+
+template <class Value>
+void append_call(std::string& out, const char* name_and_paren, Value value) {
+  out += name_and_paren;
+  append_value(out, value);
+  out += ')';
+}
+
+void append_text_call(std::string& out, const char* name, const std::string& text) {
+  out += name;
+  out += "(\"";
+  out += text;
+  out += "\")";
+}
+
+void append_pose_call(std::string& out, const char* name_and_paren, const Pose& pose, int axes) {
+  out += name_and_paren;
+  append_pose(out, pose, axes);
+  out += ')';
 }
 
 // Appends the command's text without its newline; `out` keeps its capacity from one command
 // to the next, so printing a long program allocates nothing per command.
-void append_rs274(std::string& out, const CanonCommand& c, int axes) {
-  if (const char* name = simple_name(c.kind)) {
-    out += name;
-    return;
-  }
-  switch (c.kind) {
-    case CanonKind::straight_traverse:
-    case CanonKind::straight_feed:
-      out += c.kind == CanonKind::straight_traverse ? "STRAIGHT_TRAVERSE(" : "STRAIGHT_FEED(";
-      append_pose(out, c.pos, axes);
-      break;
-    case CanonKind::arc_feed: {
-      out += "ARC_FEED(";
-      append_fixed4(out, c.first_end);
-      out += ", ";
-      append_fixed4(out, c.second_end);
-      out += ", ";
-      append_fixed4(out, c.first_axis);
-      out += ", ";
-      append_fixed4(out, c.second_axis);
-      out += ", ";
-      append_int(out, c.rotation);
-      out += ", ";
-      append_fixed4(out, c.axis_end_point);
-      for (int axis = 3; axis < axes; ++axis) {
-        out += ", ";
-        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
-      }
-      break;
-    }
-    case CanonKind::dwell:
-      out += "DWELL(";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::set_feed_rate:
-      out += "SET_FEED_RATE(";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::set_feed_mode:
-      out += "SET_FEED_MODE(0, ";
-      append_int(out, c.ivalue);
-      break;
-    case CanonKind::select_plane:
-      out += "SELECT_PLANE(";
-      out += plane_name(c.plane);
-      break;
-    case CanonKind::use_length_units:
-      out += "USE_LENGTH_UNITS(";
-      out += units_name(c.ivalue);
-      break;
-    case CanonKind::set_g5x_offset:
-      out += "SET_G5X_OFFSET(";
-      append_int(out, c.ivalue);
-      out += ", ";
-      append_pose(out, c.pos, axes);
-      break;
-    case CanonKind::set_g92_offset:
-      out += "SET_G92_OFFSET(";
-      append_pose(out, c.pos, axes);
-      break;
-    case CanonKind::set_xy_rotation:
-      out += "SET_XY_ROTATION(";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::use_tool_length_offset:
-      out += "USE_TOOL_LENGTH_OFFSET(";
-      for (int axis = 0; axis < kAxes; ++axis) {
-        if (axis > 0) out += axis % 3 == 0 ? ", " : " ";
-        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
-      }
-      break;
-    case CanonKind::set_motion_control_mode:
-      switch (static_cast<MotionMode>(c.ivalue)) {
-        case MotionMode::exact_stop:
-          out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP";
-          break;
-        case MotionMode::exact_path:
-          out += "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH";
-          break;
-        case MotionMode::continuous:
-        default:
-          out += "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, ";
-          append_printf(out, "%.6f", c.value);
-          break;
-      }
-      break;
-    case CanonKind::set_naivecam_tolerance:
-      out += "SET_NAIVECAM_TOLERANCE(";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::set_spindle_speed:
-      out += "SET_SPINDLE_SPEED(0, ";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::orient_spindle:
-      out += "ORIENT_SPINDLE(0, ";
-      append_fixed4(out, c.value);
-      out += ", ";
-      append_int(out, c.ivalue);
-      break;
-    case CanonKind::set_tool_table_entry:
-      out += "SET_TOOL_TABLE_ENTRY(";
-      append_int(out, c.ivalue);
-      out += ", ";
-      append_int(out, c.ivalue2);
-      out += ", ";
-      for (int axis = 0; axis < kAxes; ++axis) {
-        if (axis > 0) out += ' ';
-        append_fixed4(out, c.pos[static_cast<std::size_t>(axis)]);
-      }
-      out += ", ";
-      append_fixed4(out, c.value);
-      out += ", ";
-      append_fixed4(out, c.value2);
-      out += ", ";
-      append_int(out, c.ivalue3);
-      break;
-    case CanonKind::set_spindle_mode:
-      out += "SET_SPINDLE_MODE(0 ";
-      append_fixed4(out, c.value);
-      break;
-    case CanonKind::select_tool:
-      out += "SELECT_TOOL(";
-      append_int(out, c.ivalue);
-      break;
-    case CanonKind::change_tool:
-      out += "CHANGE_TOOL(";
-      append_int(out, c.ivalue);
-      break;
-    case CanonKind::change_tool_number:
-      out += "CHANGE_TOOL_NUMBER(";
-      append_int(out, c.ivalue);
-      break;
-    case CanonKind::set_feed_override_enable:
-      out += c.ivalue != 0 ? "ENABLE_FEED_OVERRIDE()" : "DISABLE_FEED_OVERRIDE()";
-      return;
-    case CanonKind::set_spindle_override_enable:
-      out += c.ivalue != 0 ? "ENABLE_SPEED_OVERRIDE(0)" : "DISABLE_SPEED_OVERRIDE(0)";
-      return;
-    case CanonKind::set_adaptive_feed_enable:
-      out += c.ivalue != 0 ? "ENABLE_ADAPTIVE_FEED()" : "DISABLE_ADAPTIVE_FEED()";
-      return;
-    case CanonKind::set_feed_hold_enable:
-      out += c.ivalue != 0 ? "ENABLE_FEED_HOLD()" : "DISABLE_FEED_HOLD()";
-      return;
-    case CanonKind::comment:
-      out += "COMMENT(\"";
-      out += c.text;
-      out += "\")";
-      return;
-    case CanonKind::message:
-    case CanonKind::debug_message:
-      out += "MESSAGE(\"";
-      out += c.text;
-      out += "\")";
-      return;
-    case CanonKind::start_spindle_clockwise:
-    case CanonKind::start_spindle_counterclockwise:
-    case CanonKind::stop_spindle_turning:
-    case CanonKind::mist_on:
-    case CanonKind::mist_off:
-    case CanonKind::flood_on:
-    case CanonKind::flood_off:
-    case CanonKind::program_stop:
-    case CanonKind::optional_program_stop:
-    case CanonKind::program_end:
-    case CanonKind::pallet_shuttle:
-    case CanonKind::on_reset:
-    case CanonKind::finish:
-    case CanonKind::start_change:
-    case CanonKind::set_feed_reference:
-      return;  // handled above; listed so the compiler checks coverage
-  }
-  out += ')';
+void append_rs274(std::string& out, const CanonOp& op, int axes) {
+  std::visit(
+      Overloaded{
+          [&](const StraightTraverse& c) {
+            append_pose_call(out, "STRAIGHT_TRAVERSE(", c.end, axes);
+          },
+          [&](const StraightFeed& c) { append_pose_call(out, "STRAIGHT_FEED(", c.end, axes); },
+          [&](const ArcFeed& c) { append_arc(out, c, axes); },
+          [&](const Dwell& c) { append_call(out, "DWELL(", c.seconds); },
+          [&](const SetFeedRate& c) { append_call(out, "SET_FEED_RATE(", c.rate); },
+          [&](const SetFeedMode& c) {
+            append_call(out, "SET_FEED_MODE(0, ", static_cast<int>(c.mode));
+          },
+          [&](const SetFeedReference&) { out += "SET_FEED_REFERENCE(CANON_XYZ)"; },
+          [&](const SelectPlane& c) {
+            out += "SELECT_PLANE(";
+            out += plane_name(c.plane);
+            out += ')';
+          },
+          [&](const UseLengthUnits& c) {
+            out += "USE_LENGTH_UNITS(";
+            out += units_name(c.units);
+            out += ')';
+          },
+          [&](const SetG5xOffset& c) {
+            out += "SET_G5X_OFFSET(";
+            append_value(out, c.system);
+            out += ", ";
+            append_pose(out, c.offset, axes);
+            out += ')';
+          },
+          [&](const SetG92Offset& c) { append_pose_call(out, "SET_G92_OFFSET(", c.offset, axes); },
+          [&](const SetXyRotation& c) { append_call(out, "SET_XY_ROTATION(", c.degrees); },
+          [&](const UseToolLengthOffset& c) {
+            out += "USE_TOOL_LENGTH_OFFSET(";
+            append_offset_groups(out, c.offset, ", ");
+            out += ')';
+          },
+          [&](const SetMotionControlMode& c) { append_motion_control_mode(out, c); },
+          [&](const SetNaivecamTolerance& c) {
+            append_call(out, "SET_NAIVECAM_TOLERANCE(", c.tolerance);
+          },
+          [&](const StartSpindleClockwise&) { out += "START_SPINDLE_CLOCKWISE(0)"; },
+          [&](const StartSpindleCounterclockwise&) { out += "START_SPINDLE_COUNTERCLOCKWISE(0)"; },
+          [&](const StopSpindleTurning&) { out += "STOP_SPINDLE_TURNING(0)"; },
+          [&](const SetSpindleSpeed& c) { append_call(out, "SET_SPINDLE_SPEED(0, ", c.rpm); },
+          [&](const SetSpindleMode& c) { append_call(out, "SET_SPINDLE_MODE(0 ", c.css_max_rpm); },
+          [&](const MistOn&) { out += "MIST_ON()"; },
+          [&](const MistOff&) { out += "MIST_OFF()"; },
+          [&](const FloodOn&) { out += "FLOOD_ON()"; },
+          [&](const FloodOff&) { out += "FLOOD_OFF()"; },
+          [&](const SelectTool& c) { append_call(out, "SELECT_TOOL(", c.tool); },
+          [&](const ChangeTool& c) { append_call(out, "CHANGE_TOOL(", c.tool); },
+          [&](const ChangeToolNumber& c) { append_call(out, "CHANGE_TOOL_NUMBER(", c.tool); },
+          [&](const SetFeedOverrideEnable& c) {
+            out += c.on ? "ENABLE_FEED_OVERRIDE()" : "DISABLE_FEED_OVERRIDE()";
+          },
+          [&](const SetSpindleOverrideEnable& c) {
+            out += c.on ? "ENABLE_SPEED_OVERRIDE(0)" : "DISABLE_SPEED_OVERRIDE(0)";
+          },
+          [&](const SetAdaptiveFeedEnable& c) {
+            out += c.on ? "ENABLE_ADAPTIVE_FEED()" : "DISABLE_ADAPTIVE_FEED()";
+          },
+          [&](const SetFeedHoldEnable& c) {
+            out += c.on ? "ENABLE_FEED_HOLD()" : "DISABLE_FEED_HOLD()";
+          },
+          [&](const Comment& c) { append_text_call(out, "COMMENT", c.text); },
+          [&](const Message& c) { append_text_call(out, "MESSAGE", c.text); },
+          [&](const DebugMessage& c) { append_text_call(out, "MESSAGE", c.text); },
+          [&](const ProgramStop&) { out += "PROGRAM_STOP()"; },
+          [&](const OptionalProgramStop&) { out += "OPTIONAL_PROGRAM_STOP()"; },
+          [&](const ProgramEnd&) { out += "PROGRAM_END()"; },
+          [&](const PalletShuttle&) { out += "PALLET_SHUTTLE()"; },
+          [&](const OnReset&) { out += "ON_RESET()"; },
+          [&](const Finish&) { out += "FINISH()"; },
+          [&](const StartChange&) { out += "START_CHANGE()"; },
+          [&](const OrientSpindle& c) {
+            out += "ORIENT_SPINDLE(0, ";
+            append_args(out, c.angle_deg, c.mode);
+            out += ')';
+          },
+          [&](const SetToolTableEntry& c) { append_tool_table_entry(out, c); },
+      },
+      op);
 }
 
 }  // namespace
 
 std::string format_rs274(const CanonCommand& command, int axes) {
   std::string out;
-  append_rs274(out, command, axes);
+  append_rs274(out, command.op, axes);
   return out;
 }
 
 void Rs274Printer::emit(const CanonCommand& command) {
   buffer_.clear();
-  append_rs274(buffer_, command, axes_);
+  append_rs274(buffer_, command.op, axes_);
   buffer_ += '\n';
   out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
 }

@@ -83,7 +83,7 @@ void Interpreter::Impl::set_coord_system_data(int l, int system) {
   rotate_xy(fixed, -rotation_deg_);
   pos_ = fixed;
   emit_g5x();
-  emit_simple(CanonKind::set_xy_rotation, 0, rotation_deg_);
+  emit(SetXyRotation{rotation_deg_});
 }
 
 void Interpreter::Impl::set_tool_data(int l, int tool) {
@@ -116,14 +116,8 @@ void Interpreter::Impl::set_tool_data(int l, int tool) {
   if (block_.has('q')) entry.orientation = to_int(block_.get('q'));
   if (auto problem = tools_.set(entry)) fail(*problem, block_.g_column[0]);
   auto report = [&](int pocket) {
-    CanonCommand& command = make(CanonKind::set_tool_table_entry);
-    command.ivalue = pocket;
-    command.ivalue2 = entry.number;
-    command.ivalue3 = entry.orientation;
-    command.pos = entry.offset;
-    command.value = entry.front_angle;
-    command.value2 = entry.back_angle;
-    emit(command);
+    emit(SetToolTableEntry{pocket, entry.number, entry.offset, entry.front_angle, entry.back_angle,
+                           entry.orientation});
   };
   report(entry.pocket);
   if (tool == tool_in_spindle_) report(0);  // the spindle is pocket 0
@@ -146,7 +140,7 @@ void Interpreter::Impl::do_home(int code) {
     const auto a = static_cast<std::size_t>(axis);
     intermediate[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
   }
-  straight(CanonKind::straight_traverse, intermediate);
+  straight(StraightKind::traverse, intermediate);
   // The stored point is in machine coordinates: the whole point is taken to program
   // coordinates, then only the named axes (or all) move there.
   const Pose home = machine_to_program(read_offset_parameters(base));
@@ -155,7 +149,7 @@ void Interpreter::Impl::do_home(int code) {
     if (any && !block_.has(kAxisLetters[axis])) continue;
     end[static_cast<std::size_t>(axis)] = home[static_cast<std::size_t>(axis)];
   }
-  straight(CanonKind::straight_traverse, end);
+  straight(StraightKind::traverse, end);
 }
 
 }  // namespace cncd::interp

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <variant>
 
 namespace cncd::interp {
 namespace {
@@ -12,24 +13,6 @@ double millimetres(Units units) {
 
 bool is_linear(std::size_t axis) {
   return axis <= 2 || axis >= 6;
-}
-
-struct ArcAxes {
-  std::size_t first;
-  std::size_t second;
-  std::size_t normal;
-};
-
-ArcAxes arc_axes(Plane plane) {
-  switch (plane) {
-    case Plane::xz:
-      return {2, 0, 1};
-    case Plane::yz:
-      return {1, 2, 0};
-    case Plane::xy:
-    default:
-      return {0, 1, 2};
-  }
 }
 
 }  // namespace
@@ -70,52 +53,26 @@ Pose MachineTracker::to_machine_units(const Pose& program) const {
 
 CanonCommand MachineTracker::to_machine(const CanonCommand& command) {
   CanonCommand out = command;
-  switch (command.kind) {
-    case CanonKind::use_length_units:
-      program_units_ = static_cast<Units>(command.ivalue);
-      break;
-    case CanonKind::set_g5x_offset:
-      g5x_ = to_machine_units(command.pos);
-      break;
-    case CanonKind::set_g92_offset:
-      g92_ = to_machine_units(command.pos);
-      break;
-    case CanonKind::set_xy_rotation:
-      rotation_deg_ = command.value;
-      break;
-    case CanonKind::use_tool_length_offset:
-      tool_ = to_machine_units(command.pos);
-      break;
-    case CanonKind::set_feed_rate:
-      feed_ = command.value * length_factor();
-      out.value = feed_;
-      break;
-    case CanonKind::straight_traverse:
-    case CanonKind::straight_feed:
-      out.pos = machine_pose(command.pos);
-      break;
-    case CanonKind::arc_feed: {
-      const ArcAxes axes = arc_axes(command.plane);
-      Pose end = command.pos;
-      end[axes.first] = command.first_end;
-      end[axes.second] = command.second_end;
-      end[axes.normal] = command.axis_end_point;
-      Pose center = end;
-      center[axes.first] = command.first_axis;
-      center[axes.second] = command.second_axis;
-      const Pose machine_end = machine_pose(end);
-      const Pose machine_center = machine_pose(center);
-      out.pos = machine_end;
-      out.first_end = machine_end[axes.first];
-      out.second_end = machine_end[axes.second];
-      out.axis_end_point = machine_end[axes.normal];
-      out.first_axis = machine_center[axes.first];
-      out.second_axis = machine_center[axes.second];
-      break;
-    }
-    default:
-      break;
-  }
+  std::visit(Overloaded{
+                 [&](const UseLengthUnits& c) { program_units_ = c.units; },
+                 [&](const SetG5xOffset& c) { g5x_ = to_machine_units(c.offset); },
+                 [&](const SetG92Offset& c) { g92_ = to_machine_units(c.offset); },
+                 [&](const SetXyRotation& c) { rotation_deg_ = c.degrees; },
+                 [&](const UseToolLengthOffset& c) { tool_ = to_machine_units(c.offset); },
+                 [&](SetFeedRate& c) {
+                   feed_ = c.rate * length_factor();
+                   c.rate = feed_;
+                 },
+                 [&](StraightTraverse& c) { c.end = machine_pose(c.end); },
+                 [&](StraightFeed& c) { c.end = machine_pose(c.end); },
+                 [&](ArcFeed& c) {
+                   const Pose machine_center = machine_pose(c.center());
+                   c.set_end(machine_pose(c.end()));
+                   c.set_center(machine_center);
+                 },
+                 [](const auto&) {},
+             },
+             out.op);
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <string_view>
+#include <variant>
 
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/soft_limits.hpp"
@@ -14,7 +15,6 @@
 namespace cncd::pipeline {
 
 using interp::CanonCommand;
-using interp::CanonKind;
 using interp::kAxes;
 using interp::Pose;
 
@@ -59,17 +59,16 @@ class CheckSink final : public interp::CanonSink {
 
   void emit(const CanonCommand& command) override {
     if (options_.trace) options_.trace->emit(command);
-    switch (command.kind) {
-      case CanonKind::dwell:
-        ++report_.dwells;
-        break;
-      case CanonKind::change_tool:
-      case CanonKind::change_tool_number:
-        if (command.ivalue > 0) report_.tools.insert(command.ivalue);
-        break;
-      default:
-        break;
-    }
+    auto tool = [&](int number) {
+      if (number > 0) report_.tools.insert(number);
+    };
+    std::visit(interp::Overloaded{
+                   [&](const interp::Dwell&) { ++report_.dwells; },
+                   [&](const interp::ChangeTool& c) { tool(c.tool); },
+                   [&](const interp::ChangeToolNumber& c) { tool(c.tool); },
+                   [](const auto&) {},
+               },
+               command.op);
     feeder_.emit(command);
     while (!feeder_.pending.empty()) {
       const motion::Move move = feeder_.pending.front();

@@ -3,6 +3,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 
 #include "cncd/config/ini_file.hpp"
 #include "cncd/interp/interpreter.hpp"
@@ -11,33 +12,24 @@
 namespace cncd::pipeline {
 namespace {
 
-// Remembers the first command that moves an axis.
+// Remembers the first command that moves an axis, as "a rapid move", "a feed move", "an arc".
 class MoveSink final : public interp::CanonSink {
  public:
   void emit(const interp::CanonCommand& command) override {
-    if (first_ || (command.kind != interp::CanonKind::straight_traverse &&
-                   command.kind != interp::CanonKind::straight_feed &&
-                   command.kind != interp::CanonKind::arc_feed)) {
-      return;
-    }
-    first_ = command.kind;
+    if (first_) return;
+    first_ = std::visit(interp::Overloaded{
+                            [](const interp::StraightTraverse&) { return "a rapid move"; },
+                            [](const interp::StraightFeed&) { return "a feed move"; },
+                            [](const interp::ArcFeed&) { return "an arc"; },
+                            [](const auto&) { return static_cast<const char*>(nullptr); },
+                        },
+                        command.op);
   }
-  const std::optional<interp::CanonKind>& first() const { return first_; }
+  const char* first() const { return first_; }
 
  private:
-  std::optional<interp::CanonKind> first_;
+  const char* first_ = nullptr;
 };
-
-const char* describe_move(interp::CanonKind kind) {
-  switch (kind) {
-    case interp::CanonKind::straight_traverse:
-      return "a rapid move";
-    case interp::CanonKind::arc_feed:
-      return "an arc";
-    default:
-      return "a feed move";
-  }
-}
 
 }  // namespace
 
@@ -78,7 +70,7 @@ std::vector<config::Problem> check_startup_code(const config::MachineConfig& con
   } else if (sink.first()) {
     problems.push_back(ini_problem(
         config, section, key,
-        std::string("it makes ") + describe_move(*sink.first()) +
+        std::string("it makes ") + sink.first() +
             ", and it runs before every program and MDI command; set modes only (G17 G21 "
             "G40 G49 G54 G80 G90 G94 ...)"));
   }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <variant>
 
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/interp/to_machine.hpp"
@@ -22,7 +23,15 @@ class MachineSink final : public CanonSink {
  public:
   void emit(const CanonCommand& command) override {
     const CanonCommand out = tracker_.to_machine(command);
-    checksum_ += out.pos[0] + static_cast<double>(out.text.size());
+    checksum_ += std::visit(Overloaded{
+                                [](const StraightTraverse& c) { return c.end[0]; },
+                                [](const StraightFeed& c) { return c.end[0]; },
+                                [](const ArcFeed& c) { return c.first_end; },
+                                [](const Comment& c) { return static_cast<double>(c.text.size()); },
+                                [](const Message& c) { return static_cast<double>(c.text.size()); },
+                                [](const auto&) { return 0.0; },
+                            },
+                            out.op);
   }
   double checksum() const { return checksum_; }
 

@@ -4,8 +4,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "cncd/interp/interpreter.hpp"
@@ -250,14 +252,23 @@ TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   struct Machine final : CanonSink {
     void emit(const CanonCommand& command) override {
       const CanonCommand m = tracker.to_machine(command);
-      if (m.kind == CanonKind::straight_traverse || m.kind == CanonKind::straight_feed ||
-          m.kind == CanonKind::arc_feed) {
-        moves.push_back(m);
+      std::optional<Pose> end;
+      if (const auto* arc = std::get_if<ArcFeed>(&m.op)) {
+        arcs.push_back(*arc);
+        end = arc->end();
+      } else if (const auto* traverse = std::get_if<StraightTraverse>(&m.op)) {
+        end = traverse->end;
+      } else if (const auto* feed = std::get_if<StraightFeed>(&m.op)) {
+        end = feed->end;
+      }
+      if (end) {
+        moves.push_back(*end);
         feeds.push_back(tracker.feed_per_minute());
       }
     }
     MachineTracker tracker{Units::mm};
-    std::vector<CanonCommand> moves;
+    std::vector<Pose> moves;  // end points
+    std::vector<ArcFeed> arcs;
     std::vector<double> feeds;
   } machine;
   Interpreter interp;
@@ -267,13 +278,14 @@ TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   const auto error = run_program(interp, machine);
   ASSERT_FALSE(error) << error->to_string();
   ASSERT_EQ(machine.moves.size(), 4U);
-  EXPECT_NEAR(machine.moves[0].pos[0], 10 + 25.4, 1e-9);
-  EXPECT_NEAR(machine.moves[0].pos[1], 20 + 25.4, 1e-9);
-  EXPECT_NEAR(machine.moves[0].pos[2], 30 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.moves[0][0], 10 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.moves[0][1], 20 + 25.4, 1e-9);
+  EXPECT_NEAR(machine.moves[0][2], 30 + 25.4, 1e-9);
   EXPECT_NEAR(machine.feeds[0], 254.0, 1e-9);
-  EXPECT_NEAR(machine.moves[1].pos[0], 10 + 2 * 25.4, 1e-9);    // G92 shifted X by 1 inch
-  EXPECT_NEAR(machine.moves[2].pos[2], 30 + 0.5 * 25.4, 1e-9);  // tool length offset
-  const CanonCommand& arc = machine.moves[3];
+  EXPECT_NEAR(machine.moves[1][0], 10 + 2 * 25.4, 1e-9);    // G92 shifted X by 1 inch
+  EXPECT_NEAR(machine.moves[2][2], 30 + 0.5 * 25.4, 1e-9);  // tool length offset
+  ASSERT_EQ(machine.arcs.size(), 1U);
+  const ArcFeed& arc = machine.arcs[0];
   EXPECT_NEAR(arc.first_end, 10 + 3 * 25.4, 1e-9);
   EXPECT_NEAR(arc.first_axis, 10 + 2.5 * 25.4, 1e-9);
   EXPECT_NEAR(arc.second_axis, 20 + 25.4, 1e-9);

@@ -3,6 +3,7 @@
 
 #include <sstream>
 #include <string>
+#include <variant>
 
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/interp/rs274_printer.hpp"
@@ -16,7 +17,7 @@ double x_of(const std::string& expression) {
   EXPECT_FALSE(interp.open_string("G0 X" + expression + "\nM2\n", "expr.ngc"));
   struct Sink final : CanonSink {
     void emit(const CanonCommand& command) override {
-      if (command.kind == CanonKind::straight_traverse) x = command.pos[0];
+      if (const auto* traverse = std::get_if<StraightTraverse>(&command.op)) x = traverse->end[0];
     }
     double x = -999;
   } sink;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "cncd/interp/interpreter.hpp"
@@ -13,7 +14,8 @@ namespace {
 class MoveRecorder final : public CanonSink {
  public:
   void emit(const CanonCommand& command) override {
-    if (command.kind == CanonKind::straight_traverse || command.kind == CanonKind::straight_feed) {
+    if (std::holds_alternative<StraightTraverse>(command.op) ||
+        std::holds_alternative<StraightFeed>(command.op)) {
       moves.push_back(format_rs274(command, 3));
     }
     all.push_back(format_rs274(command));

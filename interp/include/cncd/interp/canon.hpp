@@ -1,12 +1,13 @@
 // The canonical machining commands the interpreter emits (NIST RS274NGC vocabulary, as
-// LinuxCNC names them). Positions are in the program's current length units (the last
-// USE_LENGTH_UNITS) and in program coordinates, exactly what LinuxCNC's canon layer receives;
-// to_machine.hpp turns them into machine moves.
+// LinuxCNC names them), one type per command with its arguments as named fields. Positions are
+// in the program's current length units (the last UseLengthUnits) and in program coordinates,
+// exactly what LinuxCNC's canon layer receives; to_machine.hpp turns them into machine moves.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <string>
+#include <variant>
 
 namespace cncd::interp {
 
@@ -16,69 +17,157 @@ using Pose = std::array<double, kAxes>;
 enum class Plane : std::uint8_t { xy = 1, yz = 2, xz = 3 };  // CANON_PLANE_XY/YZ/XZ
 enum class Units : std::uint8_t { inches = 1, mm = 2, cm = 3 };
 enum class MotionMode : std::uint8_t { exact_stop = 1, exact_path = 2, continuous = 3 };
+// SET_FEED_MODE's mode: inverse time (G93) is per minute here, its rate set move by move.
+enum class FeedRateMode : int { per_minute = 0, per_revolution = 1 };
 
-enum class CanonKind : std::uint8_t {
-  straight_traverse,
-  straight_feed,
-  arc_feed,
-  dwell,
-  set_feed_rate,
-  set_feed_mode,  // ivalue: 0 units/min, 1 inverse time; 2 units/rev
-  set_feed_reference,
-  select_plane,
-  use_length_units,
-  set_g5x_offset,           // ivalue: coordinate system 1..9; pose
-  set_g92_offset,           // pose
-  set_xy_rotation,          // value: degrees
-  use_tool_length_offset,   // pose
-  set_motion_control_mode,  // ivalue: MotionMode; value: tolerance
-  set_naivecam_tolerance,
-  start_spindle_clockwise,
-  start_spindle_counterclockwise,
-  stop_spindle_turning,
-  set_spindle_speed,  // value: rpm
-  set_spindle_mode,
-  mist_on,
-  mist_off,
-  flood_on,
-  flood_off,
-  select_tool,               // ivalue: tool number (pocket prepared)
-  change_tool,               // ivalue: tool number
-  change_tool_number,        // M61
-  set_feed_override_enable,  // ivalue 0/1 (M50 etc.)
-  set_spindle_override_enable,
-  set_adaptive_feed_enable,
-  set_feed_hold_enable,
-  comment,                // text
-  message,                // text: (MSG,...)
-  debug_message,          // text: (DEBUG,...)
-  program_stop,           // M0
-  optional_program_stop,  // M1
-  program_end,            // M2/M30
-  pallet_shuttle,         // M60 (stop)
-  on_reset,
-  finish,                // the program ended with a closing '%'
-  start_change,          // M6: the tool change begins (emitted before CHANGE_TOOL)
-  orient_spindle,        // value: angle in degrees; ivalue: LinuxCNC's orientation mode
-  set_tool_table_entry,  // ivalue: pocket, ivalue2: tool, pos: offsets (tool table units),
-                         // value/value2: front/back angle, ivalue3: orientation
+struct StraightTraverse {
+  Pose end{};
 };
-
-struct CanonCommand {
-  CanonKind kind = CanonKind::comment;
-  std::int32_t line = 0;  // 1-based source line number in its file
-  Pose pos{};             // end point / offset values
-  // ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point, a,b,c,u,v,w)
-  double first_end = 0, second_end = 0, first_axis = 0, second_axis = 0, axis_end_point = 0;
+struct StraightFeed {
+  Pose end{};
+};
+// ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point,
+// a, b, c, u, v, w): "first" and "second" are the plane's axes (XY: X Y, YZ: Y Z, XZ: Z X),
+// the axis point is on its normal; rotation > 0 counterclockwise, |rotation| turns.
+struct ArcFeed {
+  double first_end = 0;
+  double second_end = 0;
+  double first_axis = 0;  // the center
+  double second_axis = 0;
   int rotation = 0;
-  Plane plane = Plane::xy;  // plane of an arc
-  double value = 0;         // feed rate, dwell seconds, spindle speed, tolerance, rotation angle
-  double value2 = 0;        // second number (naivecam tolerance ...)
-  int ivalue = 0;
-  int ivalue2 = 0;  // SET_TOOL_TABLE_ENTRY: tool number
-  int ivalue3 = 0;  // SET_TOOL_TABLE_ENTRY: orientation
+  double axis_end_point = 0;
+  Plane plane = Plane::xy;
+  std::array<double, 6> abc_uvw{};  // end of A B C U V W
+
+  // The end point and the center (the end with the center's two plane coordinates) as poses.
+  Pose end() const;
+  Pose center() const;
+  void set_end(const Pose& end);
+  void set_center(const Pose& center);
+};
+struct Dwell {
+  double seconds = 0;
+};
+struct SetFeedRate {
+  double rate = 0;  // length units per minute (per revolution under G95)
+};
+struct SetFeedMode {
+  FeedRateMode mode = FeedRateMode::per_minute;
+};
+struct SetFeedReference {};  // always CANON_XYZ
+struct SelectPlane {
+  Plane plane = Plane::xy;
+};
+struct UseLengthUnits {
+  Units units = Units::mm;
+};
+struct SetG5xOffset {
+  int system = 1;  // 1..9 = G54..G59.3
+  Pose offset{};
+};
+struct SetG92Offset {
+  Pose offset{};
+};
+struct SetXyRotation {
+  double degrees = 0;
+};
+struct UseToolLengthOffset {
+  Pose offset{};
+};
+struct SetMotionControlMode {
+  MotionMode mode = MotionMode::continuous;
+  double tolerance = 0;  // G64 P
+};
+struct SetNaivecamTolerance {
+  double tolerance = 0;  // G64 Q
+};
+struct StartSpindleClockwise {};
+struct StartSpindleCounterclockwise {};
+struct StopSpindleTurning {};
+struct SetSpindleSpeed {
+  double rpm = 0;
+};
+struct SetSpindleMode {
+  double css_max_rpm = 0;  // 0: constant speed (G97)
+};
+struct MistOn {};
+struct MistOff {};
+struct FloodOn {};
+struct FloodOff {};
+struct SelectTool {  // T: the tool prepared
+  int tool = 0;
+};
+struct ChangeTool {  // M6
+  int tool = 0;
+};
+struct ChangeToolNumber {  // M61
+  int tool = 0;
+};
+struct SetFeedOverrideEnable {  // M50 and M48/M49
+  bool on = true;
+};
+struct SetSpindleOverrideEnable {
+  bool on = true;
+};
+struct SetAdaptiveFeedEnable {
+  bool on = false;
+};
+struct SetFeedHoldEnable {
+  bool on = true;
+};
+struct Comment {
   std::string text;
 };
+struct Message {  // (MSG,...) and (DEBUG,...)
+  std::string text;
+};
+struct DebugMessage {
+  std::string text;
+};
+struct ProgramStop {};          // M0
+struct OptionalProgramStop {};  // M1
+struct ProgramEnd {};           // M2/M30
+struct PalletShuttle {};        // M60 (then a stop), M30
+struct OnReset {};
+struct Finish {};       // the program ended with a closing '%'
+struct StartChange {};  // M6: the tool change begins (before ChangeTool)
+struct OrientSpindle {
+  double angle_deg = 0;
+  int mode = 0;  // LinuxCNC's orientation mode
+};
+struct SetToolTableEntry {
+  int pocket = 0;
+  int tool = 0;
+  Pose offset{};  // tool table units
+  double front_angle = 0;
+  double back_angle = 0;
+  int orientation = 0;
+};
+
+// The moves and the dwell come first.
+using CanonOp =
+    std::variant<StraightTraverse, StraightFeed, ArcFeed, Dwell, SetFeedRate, SetFeedMode,
+                 SetFeedReference, SelectPlane, UseLengthUnits, SetG5xOffset, SetG92Offset,
+                 SetXyRotation, UseToolLengthOffset, SetMotionControlMode, SetNaivecamTolerance,
+                 StartSpindleClockwise, StartSpindleCounterclockwise, StopSpindleTurning,
+                 SetSpindleSpeed, SetSpindleMode, MistOn, MistOff, FloodOn, FloodOff, SelectTool,
+                 ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
+                 SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage,
+                 ProgramStop, OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish,
+                 StartChange, OrientSpindle, SetToolTableEntry>;
+
+struct CanonCommand {
+  std::int32_t line = 0;  // 1-based source line number in its file
+  CanonOp op;
+};
+
+// A visitor from lambdas: std::visit(Overloaded{[](const ArcFeed&) {...}, ...}, command.op).
+template <class... Fs>
+struct Overloaded : Fs... {
+  using Fs::operator()...;
+};
+template <class... Fs>
+Overloaded(Fs...) -> Overloaded<Fs...>;
 
 // Receives canonical commands in program order. Called on the interpreter's thread.
 class CanonSink {
