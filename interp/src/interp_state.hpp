@@ -197,9 +197,13 @@ struct Interpreter::Impl {
   // emit helpers
   // Every canonical command leaves here, with the current line; one carrying a number that is
   // not finite (a position that overflowed) fails the block instead.
+  // Assigned over the last command: the same alternative again is assigned field by field,
+  // without building and destroying a whole CanonOp.
   template <class Op>
   void emit(Op&& op) {
-    emit_command(CanonCommand{current_line_, std::forward<Op>(op)});
+    command_.line = current_line_;
+    command_.op = std::forward<Op>(op);
+    emit_command(command_);
   }
   void emit_command(const CanonCommand& command);
   // Jumps back to the start of a loop; fails once loops have run max_loops_without_motion
@@ -219,6 +223,7 @@ struct Interpreter::Impl {
   std::vector<LineSource> sources_;  // back() is being read; subroutine files are pushed
   std::string program_name_;
   CanonSink* sink_ = nullptr;
+  CanonCommand command_;
   std::optional<InterpError> error_;
   std::optional<InterpError> config_error_;  // unreadable parameter file or tool table
   bool parameter_file_refused_ = false;      // never written then
