@@ -195,7 +195,8 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
       emit(StartSpindleClockwise{});
     }
   };
-  auto restart = [&] { start_spindle(modal_.spindle == SpindleDir::counterclockwise); };
+  const bool restart_counterclockwise = modal_.spindle == SpindleDir::counterclockwise;
+  auto restart = [&] { start_spindle(restart_counterclockwise); };
 
   traverse(current_c);
   if (current_c != g.r) traverse(g.r);
