@@ -13,16 +13,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::map<std::string, std::string>& fake_env() {
-  static std::map<std::string, std::string> env;
-  return env;
-}
-
-const char* lookup(const char* name) {
-  const auto it = fake_env().find(name);
-  return it == fake_env().end() ? nullptr : it->second.c_str();
-}
-
 class ProgramDirsTest : public TempDirTest {
  protected:
   void SetUp() override {
@@ -35,7 +25,7 @@ class ProgramDirsTest : public TempDirTest {
 
   LoadResult load(const std::string& display, const std::string& cncd) {
     LoadOptions options;
-    options.getenv = lookup;
+    options.getenv = fake_getenv;
     return load_machine_config(
         write("conf/mill.ini", minimal_ini() + "[DISPLAY]\n" + display + "[CNCD]\n" + cncd),
         options);

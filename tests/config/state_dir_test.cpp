@@ -10,17 +10,6 @@
 namespace cncd::config::test {
 namespace {
 
-// The environment the loader sees; a captureless lookup reads it.
-std::map<std::string, std::string>& fake_env() {
-  static std::map<std::string, std::string> env;
-  return env;
-}
-
-const char* lookup(const char* name) {
-  const auto it = fake_env().find(name);
-  return it == fake_env().end() ? nullptr : it->second.c_str();
-}
-
 class StateDirTest : public TempDirTest {
  protected:
   void SetUp() override {
@@ -31,7 +20,7 @@ class StateDirTest : public TempDirTest {
   LoadResult load(const std::string& cncd_section, const std::string& state_files,
                   const std::filesystem::path& state_dir = {}) {
     LoadOptions options;
-    options.getenv = lookup;
+    options.getenv = fake_getenv;
     options.state_dir = state_dir;
     // POSITION_FILE goes into the [TRAJ] section the minimal machine already has.
     std::string ini = minimal_ini();

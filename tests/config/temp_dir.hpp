@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -54,7 +55,31 @@ inline bool any_contains(const std::vector<Problem>& problems, const std::string
   });
 }
 
-// A minimal valid machine; tests append or replace sections to break it.
+// The environment the loader sees in tests that set LoadOptions::getenv to fake_getenv.
+inline std::map<std::string, std::string>& fake_env() {
+  static std::map<std::string, std::string> env;
+  return env;
+}
+
+inline const char* fake_getenv(const char* name) {
+  const auto it = fake_env().find(name);
+  return it == fake_env().end() ? nullptr : it->second.c_str();
+}
+
+// The INI text with its line `line` (1-based) replaced by `text`.
+inline std::string replace_line(std::string ini, int line, const std::string& text) {
+  std::size_t start = 0;
+  for (int i = 1; i < line; ++i)
+    start = ini.find('\n', start) + 1;
+  const std::size_t end = ini.find('\n', start);
+  return ini.replace(start, end - start, text);
+}
+
+// A minimal valid machine; tests append or replace sections to break it. Its line numbers:
+// [EMCMOT] SERVO_PERIOD 4, [TRAJ] COORDINATES 6, LINEAR_UNITS 7, ANGULAR_UNITS 8, [KINS] 9,
+// KINEMATICS 10, JOINTS 11, [AXIS_X] 12 (MIN_LIMIT 13, MAX_LIMIT 14, MAX_VELOCITY 15,
+// MAX_ACCELERATION 16), [AXIS_Y] 17, [AXIS_Z] 22, [JOINT_0] 27 (MIN_LIMIT 28, MAX_LIMIT 29,
+// MAX_VELOCITY 30, MAX_ACCELERATION 31), [JOINT_1] 32, [JOINT_2] 37 .. 41.
 inline std::string minimal_ini(const std::string& extra_joint_keys = "") {
   std::string ini =
       "[EMC]\nMACHINE = test\n"
@@ -72,5 +97,19 @@ inline std::string minimal_ini(const std::string& extra_joint_keys = "") {
   }
   return ini;
 }
+
+// Tests of one machine INI file, m.ini, whose problems are reported at its lines.
+class MachineIniTest : public TempDirTest {
+ protected:
+  LoadResult load(const std::string& ini) { return load_machine_config(write("m.ini", ini)); }
+  // The problems of an INI that must fail to load.
+  std::vector<std::string> problems_of(const std::string& ini) {
+    const auto result = load(ini);
+    EXPECT_FALSE(result.ok());
+    EXPECT_EQ(result.config.has_value(), result.problems.empty());
+    return strings(result.problems);
+  }
+  std::string at(int line) const { return TempDirTest::at("m.ini", line); }
+};
 
 }  // namespace cncd::config::test

@@ -7,28 +7,7 @@
 namespace cncd::config::test {
 namespace {
 
-// Line numbers of minimal_ini(): [EMCMOT] SERVO_PERIOD 4, [TRAJ] COORDINATES 6,
-// LINEAR_UNITS 7, [KINS] 9, KINEMATICS 10, JOINTS 11, [AXIS_X] 12 (MIN_LIMIT 13, MAX_LIMIT 14,
-// MAX_VELOCITY 15, MAX_ACCELERATION 16), [AXIS_Y] 17, [AXIS_Z] 22, [JOINT_0] 27 (MIN_LIMIT 28,
-// MAX_LIMIT 29, MAX_VELOCITY 30, MAX_ACCELERATION 31), [JOINT_1] 32, [JOINT_2] 37.
-std::string replace_line(std::string ini, int line, const std::string& text) {
-  std::size_t start = 0;
-  for (int i = 1; i < line; ++i)
-    start = ini.find('\n', start) + 1;
-  const std::size_t end = ini.find('\n', start);
-  return ini.replace(start, end - start, text);
-}
-
-class ValidationTest : public TempDirTest {
- protected:
-  std::vector<std::string> problems_of(const std::string& ini) {
-    const auto result = load_machine_config(write("m.ini", ini));
-    EXPECT_FALSE(result.ok());
-    EXPECT_EQ(result.config.has_value(), result.problems.empty());
-    return strings(result.problems);
-  }
-  std::string at(int line) const { return TempDirTest::at("m.ini", line); }
-};
+using ValidationTest = MachineIniTest;
 
 TEST_F(ValidationTest, MinimalIniIsValid) {
   const auto result = load_machine_config(write("m.ini", minimal_ini()));

@@ -8,28 +8,7 @@
 namespace cncd::config::test {
 namespace {
 
-// Line numbers of minimal_ini(): [TRAJ] COORDINATES 6, LINEAR_UNITS 7, ANGULAR_UNITS 8,
-// [KINS] KINEMATICS 10, JOINTS 11, [AXIS_X] 12 (MIN_LIMIT 13, MAX_LIMIT 14), [JOINT_0] 27
-// (MIN_LIMIT 28, MAX_LIMIT 29, MAX_VELOCITY 30, MAX_ACCELERATION 31), [JOINT_1] 32,
-// [JOINT_2] 37 .. 41.
-std::string replace_line(std::string ini, int line, const std::string& text) {
-  std::size_t start = 0;
-  for (int i = 1; i < line; ++i)
-    start = ini.find('\n', start) + 1;
-  const std::size_t end = ini.find('\n', start);
-  return ini.replace(start, end - start, text);
-}
-
-class WorkableConfigTest : public TempDirTest {
- protected:
-  LoadResult load(const std::string& ini) { return load_machine_config(write("m.ini", ini)); }
-  std::vector<std::string> problems_of(const std::string& ini) {
-    const auto result = load(ini);
-    EXPECT_FALSE(result.ok());
-    return strings(result.problems);
-  }
-  std::string at(int line) const { return TempDirTest::at("m.ini", line); }
-};
+using WorkableConfigTest = MachineIniTest;
 
 TEST_F(WorkableConfigTest, HomeOutsideTheJointLimitsIsRefused) {
   EXPECT_EQ(
