@@ -52,9 +52,7 @@ Measured run(std::vector<Move> moves, Move::PathMode mode, double p, const AxisP
   }
   Measured r;
   r.periods = m.run_until_idle();
-  const auto peak = peaks(m, start);
-  EXPECT_LE(peak.velocity, 1.001);
-  EXPECT_LE(peak.acceleration, 1.001);
+  expect_within_limits(m, start);
   EXPECT_DOUBLE_EQ(m.status().commanded[0], moves.back().end[0]);
   EXPECT_DOUBLE_EQ(m.status().commanded[1], moves.back().end[1]);
   EXPECT_EQ(m.status().moves_done, moves.size());

@@ -67,15 +67,7 @@ Program random_program(std::mt19937& rng, int count, bool contour = false) {
       const double r = 0.5 + 15 * unit(rng);
       const double sweep = 0.1 + 4 * unit(rng);
       const double side = unit(rng) < 0.5 ? 1 : -1;
-      const double cx = at[0] - side * r * std::sin(heading);
-      const double cy = at[1] + side * r * std::cos(heading);
-      const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
-      move.end[0] = cx + r * std::cos(a1);
-      move.end[1] = cy + r * std::sin(a1);
-      heading += side * sweep;
-      move.center_first = cx;
-      move.center_second = cy;
-      move.turns = side > 0 ? 1 : -1;
+      tangent_arc(move, move.end[0], move.end[1], heading, r, sweep, side);
       if (unit(rng) < 0.3 && !contour) move.end[2] += (unit(rng) - 0.5) * 6;  // a helix
     }
     prog.from.push_back(at);
@@ -128,9 +120,7 @@ Recorded run_program(VirtualMachine& m, const Program& prog, int pause_at, int o
 // done.
 void expect_limits_and_exact_end(const VirtualMachine& m, const AxisPose& start,
                                  const Program& prog) {
-  const auto p = peaks(m, start);
-  EXPECT_LE(p.velocity, 1.001);
-  EXPECT_LE(p.acceleration, 1.001);
+  expect_within_limits(m, start);
   for (int axis = 0; axis < 3; ++axis)
     EXPECT_DOUBLE_EQ(m.status().commanded[axis], prog.moves.back().end[axis]);
   EXPECT_EQ(m.status().moves_done, prog.moves.size());
@@ -241,9 +231,7 @@ TEST(Blend, CornersAreRoundedWithinTheToleranceAndFaster) {
       corners.push_back(move.end);
     }
     periods[k] = m.run_until_idle();
-    const auto p = peaks(m, start);
-    EXPECT_LE(p.velocity, 1.001);
-    EXPECT_LE(p.acceleration, 1.001);
+    expect_within_limits(m, start);
     EXPECT_DOUBLE_EQ(m.status().commanded[0], 100);
     EXPECT_DOUBLE_EQ(m.status().commanded[1], 100);
     double nearest = 1e9;  // of the corners inside the path, the closest approach
@@ -296,9 +284,7 @@ TEST(Blend, CollinearLinesWithinQAreMerged) {
     for (const auto& move : moves)
       m.queue(move);
     m.run_until_idle();
-    const auto p = peaks(m, start);
-    EXPECT_LE(p.velocity, 1.001);
-    EXPECT_LE(p.acceleration, 1.001);
+    expect_within_limits(m, start);
     EXPECT_DOUBLE_EQ(m.status().commanded[0], 20);
     EXPECT_EQ(m.status().moves_done, 200u);
     // Within Q + P of the programmed steps.
@@ -332,16 +318,7 @@ TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
       const double r = 5 + 10 * unit(rng);
       const double sweep = 0.3 + unit(rng);
       const double side = unit(rng) < 0.5 ? 1 : -1;
-      const double cx = x - side * r * std::sin(heading);
-      const double cy = y + side * r * std::cos(heading);
-      const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
-      x = cx + r * std::cos(a1);
-      y = cy + r * std::sin(a1);
-      heading += side * sweep;
-      move.kind = Move::Kind::arc;
-      move.center_first = cx;
-      move.center_second = cy;
-      move.turns = side > 0 ? 1 : -1;
+      tangent_arc(move, x, y, heading, r, sweep, side);
     }
     move.end = {x, y, 0, 0, 0, 0, 0, 0, 0};
     chain.push_back(move);
@@ -356,9 +333,7 @@ TEST(Blend, SmallKinksBetweenLinesAndArcsAreCrossedAtSpeed) {
       m.queue(move);
     }
     periods[k] = m.run_until_idle();
-    const auto p = peaks(m, start);
-    EXPECT_LE(p.velocity, 1.001);
-    EXPECT_LE(p.acceleration, 1.001);
+    expect_within_limits(m, start);
     EXPECT_DOUBLE_EQ(m.status().commanded[0], chain.back().end[0]);
     EXPECT_DOUBLE_EQ(m.status().commanded[1], chain.back().end[1]);
   }

@@ -48,6 +48,13 @@ Checked check(const FeedbackChecks& checks, const Feedbacks& fb, std::uint64_t c
   return c;
 }
 
+// A failed check that names `joint` and says `text`.
+void expect_fault(const Checked& c, int joint, const char* text) {
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.fault.joint, joint);
+  EXPECT_STREQ(c.fault.text, text);
+}
+
 class FeedbackChecksTest : public ::testing::Test {
  protected:
   config::MachineConfig config_ = test::small_mill();  // FERROR 1, MIN_FERROR 0.5
@@ -65,55 +72,48 @@ TEST_F(FeedbackChecksTest, PositionThatIsNotANumberFails) {
   record(checks_, 1, 0);
   Feedbacks fb = at(0);
   fb[2].position = std::nan("");
-  const Checked c = check(checks_, fb, 2);
-  EXPECT_FALSE(c.ok);
-  EXPECT_EQ(c.fault.joint, 2);
-  EXPECT_STREQ(c.fault.text, "joint 2: feedback position is not a number");
+  expect_fault(check(checks_, fb, 2), 2, "joint 2: feedback position is not a number");
 }
 
-TEST_F(FeedbackChecksTest, DriveFaultAndStaleFeedbackFail) {
+// A flag of one joint's feedback that fails the check, with limit switches of
+// `limits_ignored` (a bit per joint) ignored, and what the fault says.
+struct BadFlag {
+  bool drivers::JointFeedback::*flag;
+  int joint;
+  std::uint32_t limits_ignored;
+  const char* text;
+};
+
+TEST_F(FeedbackChecksTest, DriveFaultStaleFeedbackAndLimitSwitchesFail) {
   record(checks_, 1, 0);
-  Feedbacks fb = at(0);
-  fb[1].fault = true;
-  Checked c = check(checks_, fb, 2);
-  EXPECT_FALSE(c.ok);
-  EXPECT_EQ(c.fault.joint, 1);
-  EXPECT_STREQ(c.fault.text, "joint 1: drive fault");
-  fb[1].fault = false;
-  fb[0].stale = true;
-  c = check(checks_, fb, 2);
-  EXPECT_FALSE(c.ok);
-  EXPECT_EQ(c.fault.joint, 0);
-  EXPECT_STREQ(c.fault.text, "joint 0: feedback is stale");
+  using drivers::JointFeedback;
+  for (const BadFlag& bad : {
+           BadFlag{&JointFeedback::fault, 1, 0, "joint 1: drive fault"},
+           BadFlag{&JointFeedback::stale, 0, 0, "joint 0: feedback is stale"},
+           BadFlag{&JointFeedback::max_limit, 1, 0, "joint 1: maximum limit switch tripped"},
+           BadFlag{&JointFeedback::min_limit, 0, 1u << 1, "joint 0: minimum limit switch tripped"},
+       }) {
+    Feedbacks fb = at(0);
+    fb[static_cast<std::size_t>(bad.joint)].*bad.flag = true;
+    expect_fault(check(checks_, fb, 2, bad.limits_ignored), bad.joint, bad.text);
+  }
 }
 
-TEST_F(FeedbackChecksTest, LimitSwitchFailsUnlessIgnored) {
+TEST_F(FeedbackChecksTest, IgnoredLimitSwitchPasses) {
   record(checks_, 1, 0);
   Feedbacks fb = at(0);
   fb[1].max_limit = true;
-  Checked c = check(checks_, fb, 2);
-  EXPECT_FALSE(c.ok);
-  EXPECT_STREQ(c.fault.text, "joint 1: maximum limit switch tripped");
   EXPECT_TRUE(check(checks_, fb, 2, 1u << 1).ok);
-  fb[1].max_limit = false;
-  fb[0].min_limit = true;
-  c = check(checks_, fb, 2, 1u << 1);
-  EXPECT_FALSE(c.ok);
-  EXPECT_STREQ(c.fault.text, "joint 0: minimum limit switch tripped");
 }
 
 TEST_F(FeedbackChecksTest, FollowingErrorLimitGrowsWithSpeed) {
   // At rest the limit is MIN_FERROR (0.5).
   record(checks_, 1, 0);
-  Checked c = check(checks_, at(0.6), 2);
-  EXPECT_FALSE(c.ok);
-  EXPECT_STREQ(c.fault.text, "joint 0: following error 0.6000 exceeds 0.5000");
+  expect_fault(check(checks_, at(0.6), 2), 0, "joint 0: following error 0.6000 exceeds 0.5000");
   // At 180 mm/s, 90 % of X's MAX_VELOCITY, FERROR (1) scales to 0.9 on X.
   record(checks_, 2, 0, 180);
   EXPECT_TRUE(check(checks_, at(0.6), 3).ok);
-  c = check(checks_, at(-0.95), 3);
-  EXPECT_FALSE(c.ok);
-  EXPECT_STREQ(c.fault.text, "joint 0: following error 0.9500 exceeds 0.9000");
+  expect_fault(check(checks_, at(-0.95), 3), 0, "joint 0: following error 0.9500 exceeds 0.9000");
 }
 
 TEST_F(FeedbackChecksTest, LateFeedbackIsJudgedAgainstTheCommandItAnswers) {
@@ -127,9 +127,7 @@ TEST_F(FeedbackChecksTest, LateFeedbackIsJudgedAgainstTheCommandItAnswers) {
   fb = at(2);
   for (auto& joint : fb)
     joint.command_cycle = 4;
-  const Checked c = check(checks_, fb, 11);
-  EXPECT_FALSE(c.ok);
-  EXPECT_STREQ(c.fault.text,
+  expect_fault(check(checks_, fb, 11), 0,
                "joint 0: following error 2.0000 exceeds 0.5000 (against the command of 6 periods "
                "ago)");
   // Between two commands it answers, anywhere counts.
@@ -150,23 +148,13 @@ TEST_F(FeedbackChecksTest, CommandsSentWithTheDrivesOffAreNotFollowed) {
 }
 
 // A driver that only has words for its fault (the checks never move it).
-class WordyDriver final : public drivers::Driver {
+class WordyDriver final : public test::FakeDriver {
  public:
-  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
-    return "";
-  }
-  void enable() override {}
-  void disable() override {}
-  void write(const drivers::JointCommand*, int) noexcept override {}
-  void read(drivers::JointFeedback*, int) noexcept override {}
-  void read_inputs(drivers::MachineInputs&) noexcept override {}
+  WordyDriver() : FakeDriver("wordy") {}
   bool fault_reason(char* out, std::size_t size) const noexcept override {
     std::snprintf(out, size, "%s", "bus silent for 40 ms");
     return true;
   }
-  std::int64_t feedback_deadline_ns() const noexcept override { return 0; }
-  std::uint32_t capabilities() const noexcept override { return 0; }
-  const char* name() const noexcept override { return "wordy"; }
 };
 
 TEST(FeedbackChecks, DriveFaultCarriesTheDriversOwnWords) {

@@ -34,6 +34,14 @@ Homing::Result run(Homing& homing, JointIo& io, const Drive& drive, int max_peri
   return Homing::Result::running;
 }
 
+// Joint 0 searches its home switch at 20 mm/s and latches at 2 mm/s.
+config::MachineConfig switch_search_mill() {
+  auto config = test::small_mill();
+  config.joints[0].home_search_vel = 20;
+  config.joints[0].home_latch_vel = 2;
+  return config;
+}
+
 TEST(HomingUnit, ImmediateHomingRenamesThePositionAndMovesToHome) {
   auto config = test::small_mill();
   config.joints[0].home_offset = 3;
@@ -75,9 +83,7 @@ TEST(HomingUnit, LatchesTheSwitchEdgeAsHomeOffset) {
 }
 
 TEST(HomingUnit, SwitchSearchWithoutASwitchIsRefused) {
-  auto config = test::small_mill();
-  config.joints[0].home_search_vel = 20;
-  config.joints[0].home_latch_vel = 2;
+  const auto config = switch_search_mill();
   Homing homing(config, kDt, 0);  // no driver reports a home switch
   JointIo io;
   EXPECT_FALSE(homing.start(1u << 0, io));
@@ -86,9 +92,7 @@ TEST(HomingUnit, SwitchSearchWithoutASwitchIsRefused) {
 }
 
 TEST(HomingUnit, AbortStopsTheSearchAndLeavesTheJointUnhomed) {
-  auto config = test::small_mill();
-  config.joints[0].home_search_vel = 20;
-  config.joints[0].home_latch_vel = 2;
+  const auto config = switch_search_mill();
   Homing homing(config, kDt, 0b111);
   JointIo io;
   const Drive drive;  // the switch is never reached
@@ -108,9 +112,7 @@ TEST(HomingUnit, AbortStopsTheSearchAndLeavesTheJointUnhomed) {
 }
 
 TEST(HomingUnit, StopNowForgetsHomingAtOnce) {
-  auto config = test::small_mill();
-  config.joints[0].home_search_vel = 20;
-  config.joints[0].home_latch_vel = 2;
+  const auto config = switch_search_mill();
   Homing homing(config, kDt, 0b111);
   JointIo io;
   ASSERT_TRUE(homing.start(1u << 0, io));

@@ -1,6 +1,7 @@
 // Per-joint status: switch inputs, drive flags, the driver's name and soft-limit flags as the
 // servo thread publishes them.
 #include <cstring>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +13,11 @@ namespace {
 using motion::Command;
 using motion::MachineState;
 using motion::Move;
+
+// One flag of the small mill's three joints, in joint order.
+std::vector<bool> flags(const motion::Status& s, bool motion::JointStatus::*flag) {
+  return {s.joints[0].*flag, s.joints[1].*flag, s.joints[2].*flag};
+}
 
 TEST(JointStatus, NamesTheDriverAndFollowsTheEnable) {
   VirtualMachine m(small_mill());
@@ -38,12 +44,8 @@ TEST(JointStatus, LimitSwitchesAsReadEachPeriod) {
   m.sim().set_limit(2, true, false);
   m.cycles(1);
   auto s = m.status();
-  EXPECT_FALSE(s.joints[0].min_limit);
-  EXPECT_FALSE(s.joints[0].max_limit);
-  EXPECT_FALSE(s.joints[1].min_limit);
-  EXPECT_TRUE(s.joints[1].max_limit);
-  EXPECT_TRUE(s.joints[2].min_limit);
-  EXPECT_FALSE(s.joints[2].max_limit);
+  EXPECT_EQ(flags(s, &motion::JointStatus::min_limit), (std::vector<bool>{false, false, true}));
+  EXPECT_EQ(flags(s, &motion::JointStatus::max_limit), (std::vector<bool>{false, true, false}));
   EXPECT_STREQ(s.fault_reason, "");
 
   // On, the tripped switch latches a fault and the drives go off; the flag stays as read.
@@ -69,12 +71,8 @@ TEST(JointStatus, DriveFaultAndStaleFeedback) {
   m.sim().set_stale(0, true);
   m.cycles(1);
   auto s = m.status();
-  EXPECT_TRUE(s.joints[0].stale);
-  EXPECT_FALSE(s.joints[0].drive_fault);
-  EXPECT_FALSE(s.joints[1].stale);
-  EXPECT_FALSE(s.joints[1].drive_fault);
-  EXPECT_TRUE(s.joints[2].drive_fault);
-  EXPECT_FALSE(s.joints[2].stale);
+  EXPECT_EQ(flags(s, &motion::JointStatus::stale), (std::vector<bool>{true, false, false}));
+  EXPECT_EQ(flags(s, &motion::JointStatus::drive_fault), (std::vector<bool>{false, false, true}));
   m.sim().set_fault(2, false);
   m.sim().set_stale(0, false);
   m.cycles(1);

@@ -23,17 +23,13 @@ using motion::Move;
 // first-order lag of `lag_s` seconds (0: at once); commands sent with the drives off do not
 // move it. Its feedback names that command's cycle, or 0 when `names_cycle` is false (then
 // it claims to answer the latest command, as feedback did before drivers could say).
-class LateDriver final : public drivers::Driver {
+class LateDriver final : public FakeDriver {
  public:
   LateDriver(int delay, double period_s, double lag_s, bool names_cycle = true)
-      : delay_(static_cast<std::size_t>(delay)),
+      : FakeDriver("late", drivers::kCapPositionFeedback),
+        delay_(static_cast<std::size_t>(delay)),
         alpha_(lag_s > 0 ? 1.0 - std::exp(-period_s / lag_s) : 1.0),
         names_cycle_(names_cycle) {}
-  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
-    return "";
-  }
-  void enable() override {}
-  void disable() override {}
   void write(const JointCommand* commands, int count) noexcept override {
     std::array<JointCommand, drivers::kMaxJoints> block{};
     std::copy_n(commands, std::min(count, drivers::kMaxJoints), block.begin());
@@ -58,8 +54,6 @@ class LateDriver final : public drivers::Driver {
   std::int64_t feedback_deadline_ns() const noexcept override {
     return static_cast<std::int64_t>(delay_) * 1'000'000;
   }
-  std::uint32_t capabilities() const noexcept override { return drivers::kCapPositionFeedback; }
-  const char* name() const noexcept override { return "late"; }
 
  private:
   std::size_t delay_;
@@ -74,17 +68,13 @@ class LateDriver final : public drivers::Driver {
 // right after each: it follows its target through a first-order lag of `lag_s`, and its
 // feedback, refreshed at each update, names the command just written and, when
 // `names_previous`, the one before, which it had the whole update to follow.
-class SlowBusDriver final : public drivers::Driver {
+class SlowBusDriver final : public FakeDriver {
  public:
   SlowBusDriver(int update, double period_s, double lag_s, bool names_previous)
-      : update_(update),
+      : FakeDriver("slow bus", drivers::kCapPositionFeedback),
+        update_(update),
         alpha_(lag_s > 0 ? 1.0 - std::exp(-period_s / lag_s) : 1.0),
         names_previous_(names_previous) {}
-  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
-    return "";
-  }
-  void enable() override {}
-  void disable() override {}
   void write(const JointCommand* commands, int count) noexcept override {
     std::copy_n(commands, std::min(count, drivers::kMaxJoints), latest_.begin());
   }
@@ -105,8 +95,6 @@ class SlowBusDriver final : public drivers::Driver {
     }
   }
   std::int64_t feedback_deadline_ns() const noexcept override { return 2LL * update_ * 1'000'000; }
-  std::uint32_t capabilities() const noexcept override { return drivers::kCapPositionFeedback; }
-  const char* name() const noexcept override { return "slow bus"; }
 
  private:
   int update_;

@@ -3,7 +3,6 @@
 // its limits at every period, ending exactly at the programmed end; G61.1 still stops.
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <random>
 #include <vector>
 
@@ -86,17 +85,7 @@ std::vector<Move> tangent_chain(std::mt19937& rng, int count, bool continuous) {
       const double r = 1 + 14 * unit(rng);
       const double sweep = 0.05 + 3 * unit(rng);
       const bool ccw = unit(rng) < 0.5;
-      const double side = ccw ? 1 : -1;
-      const double cx = x - side * r * std::sin(heading);
-      const double cy = y + side * r * std::cos(heading);
-      const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
-      x = cx + r * std::cos(a1);
-      y = cy + r * std::sin(a1);
-      heading += side * sweep;
-      move.kind = Move::Kind::arc;
-      move.center_first = cx;
-      move.center_second = cy;
-      move.turns = ccw ? 1 : -1;
+      tangent_arc(move, x, y, heading, r, sweep, ccw ? 1 : -1);
       if (unit(rng) < 0.2) z += 3 * unit(rng);
     }
     move.end = {x, y, z, 0, 0, 0, 0, 0, 0};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -139,12 +140,32 @@ Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start) {
   return p;
 }
 
+void expect_within_limits(const VirtualMachine& m, const motion::AxisPose& start) {
+  const Peaks p = peaks(m, start);
+  EXPECT_LE(p.velocity, 1.001);
+  EXPECT_LE(p.acceleration, 1.001);
+}
+
 motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed) {
   motion::Move m;
   m.kind = kind;
   m.end = {x, y, z, 0, 0, 0, 0, 0, 0};
   m.feed = feed;
   return m;
+}
+
+void tangent_arc(motion::Move& move, double& x, double& y, double& heading, double r, double sweep,
+                 double side) {
+  const double cx = x - side * r * std::sin(heading);
+  const double cy = y + side * r * std::cos(heading);
+  const double a1 = heading - side * std::numbers::pi / 2 + side * sweep;
+  x = cx + r * std::cos(a1);
+  y = cy + r * std::sin(a1);
+  heading += side * sweep;
+  move.kind = motion::Move::Kind::arc;
+  move.center_first = cx;
+  move.center_second = cy;
+  move.turns = side > 0 ? 1 : -1;
 }
 
 }  // namespace cncd::test

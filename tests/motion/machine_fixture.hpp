@@ -15,16 +15,32 @@ namespace cncd::test {
 // X/Y 200 mm/s and 2000 mm/s², Z 100 mm/s and 1000 mm/s², limits ±1000 (Z -500..500).
 config::MachineConfig small_mill();
 
-// Sits between the servo loop and a driver and keeps every period's motor commands.
-class RecordingDriver final : public drivers::Driver {
+// A driver with no hardware behind it: configures, enables and disables at once, ignores its
+// commands and leaves feedback as it is. Test drivers override what they act out.
+class FakeDriver : public drivers::Driver {
  public:
-  RecordingDriver(drivers::Driver& inner, std::uint32_t capabilities)
-      : inner_(inner), capabilities_(capabilities) {}
+  explicit FakeDriver(const char* name, std::uint32_t capabilities = 0)
+      : name_(name), capabilities_(capabilities) {}
   std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
     return "";
   }
   void enable() override {}
   void disable() override {}
+  void write(const drivers::JointCommand*, int) noexcept override {}
+  void read(drivers::JointFeedback*, int) noexcept override {}
+  std::uint32_t capabilities() const noexcept override { return capabilities_; }
+  const char* name() const noexcept override { return name_; }
+
+ private:
+  const char* name_;
+  std::uint32_t capabilities_;
+};
+
+// Sits between the servo loop and a driver and keeps every period's motor commands.
+class RecordingDriver final : public FakeDriver {
+ public:
+  RecordingDriver(drivers::Driver& inner, std::uint32_t capabilities)
+      : FakeDriver("recording", capabilities), inner_(inner) {}
   void write(const drivers::JointCommand* commands, int count) noexcept override;
   void read(drivers::JointFeedback* feedback, int count) noexcept override {
     inner_.read(feedback, count);
@@ -36,8 +52,6 @@ class RecordingDriver final : public drivers::Driver {
   std::int64_t feedback_deadline_ns() const noexcept override {
     return inner_.feedback_deadline_ns();
   }
-  std::uint32_t capabilities() const noexcept override { return capabilities_; }
-  const char* name() const noexcept override { return "recording"; }
   const std::vector<motion::JointArray>& written() const { return written_; }
   // Whether the last write enabled the drives.
   bool enabled() const { return enabled_; }
@@ -45,7 +59,6 @@ class RecordingDriver final : public drivers::Driver {
 
  private:
   drivers::Driver& inner_;
-  std::uint32_t capabilities_;
   std::vector<motion::JointArray> written_;
   bool enabled_ = false;
 };
@@ -106,7 +119,16 @@ struct Peaks {
   double acceleration = 0;
 };
 Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start);
+// Every axis stayed within its velocity and acceleration limits (and 0.1 % for rounding) on
+// the way from `start` through the recorded trajectory.
+void expect_within_limits(const VirtualMachine& m, const motion::AxisPose& start);
 
 motion::Move line_to(motion::Move::Kind kind, double x, double y, double z, double feed = 0);
+
+// Makes `move` an arc in XY from (x, y), tangent there to `heading` (radians), of radius `r`,
+// turning `sweep` radians counterclockwise (side 1) or clockwise (side -1); moves (x, y) and
+// `heading` on to its end. The caller sets move.end.
+void tangent_arc(motion::Move& move, double& x, double& y, double& heading, double r, double sweep,
+                 double side);
 
 }  // namespace cncd::test

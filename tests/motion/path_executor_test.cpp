@@ -284,9 +284,10 @@ TEST(PathExecutor, SteepJerkFallsBackToTrapezoids) {
 namespace cncd::motion {
 namespace {
 
-// A lowered limit brakes to the new speed within a period's arithmetic: what is left over
-// must not keep the path "moving" at a speed of 1e-16 forever, never paused, never aborted.
-TEST(PathExecutor, LoweredOverrideThenAbortComesToRest) {
+// Calls check(path, pose, ratio) for each feed override ratio from 5 % to 99 % on a path 130
+// periods into a long line, 97 periods after its override was lowered to that ratio.
+template <typename Check>
+void for_each_slowed_path(Check check) {
   const auto config = test::small_mill();
   for (int percent = 5; percent < 100; ++percent) {
     const double ratio = percent / 100.0;
@@ -298,32 +299,30 @@ TEST(PathExecutor, LoweredOverrideThenAbortComesToRest) {
     path->set_overrides(ratio, 1.0);
     for (int k = 0; k < 97; ++k)
       path->advance(kDt, pose, false);
-    path->abort();
-    const PathRun r = run(*path, pose, 2000);
-    EXPECT_LT(r.periods, 2000) << "override " << ratio;
-    EXPECT_EQ(path->motion(), MotionState::idle) << "override " << ratio;
-    EXPECT_FALSE(path->pending()) << "override " << ratio;
+    check(*path, pose, ratio);
   }
 }
 
+// A lowered limit brakes to the new speed within a period's arithmetic: what is left over
+// must not keep the path "moving" at a speed of 1e-16 forever, never paused, never aborted.
+TEST(PathExecutor, LoweredOverrideThenAbortComesToRest) {
+  for_each_slowed_path([](PathExecutor& path, AxisPose& pose, double ratio) {
+    path.abort();
+    const PathRun r = run(path, pose, 2000);
+    EXPECT_LT(r.periods, 2000) << "override " << ratio;
+    EXPECT_EQ(path.motion(), MotionState::idle) << "override " << ratio;
+    EXPECT_FALSE(path.pending()) << "override " << ratio;
+  });
+}
+
 TEST(PathExecutor, LoweredOverrideThenPauseHolds) {
-  const auto config = test::small_mill();
-  for (int percent = 5; percent < 100; ++percent) {
-    const double ratio = percent / 100.0;
-    auto path = make(config);
-    AxisPose pose{};
-    ASSERT_TRUE(path->segments().push(line(at(0), at(137.3, 11.9), 97.1)));
-    for (int k = 0; k < 130; ++k)
-      path->advance(kDt, pose, false);
-    path->set_overrides(ratio, 1.0);
-    for (int k = 0; k < 97; ++k)
-      path->advance(kDt, pose, false);
-    path->pause();
+  for_each_slowed_path([](PathExecutor& path, AxisPose& pose, double ratio) {
+    path.pause();
     for (int k = 0; k < 300; ++k)
-      path->advance(kDt, pose, false);
-    EXPECT_EQ(path->motion(), MotionState::paused) << "override " << ratio;
-    EXPECT_EQ(path->velocity(), 0.0) << "override " << ratio;
-  }
+      path.advance(kDt, pose, false);
+    EXPECT_EQ(path.motion(), MotionState::paused) << "override " << ratio;
+    EXPECT_EQ(path.velocity(), 0.0) << "override " << ratio;
+  });
 }
 
 }  // namespace

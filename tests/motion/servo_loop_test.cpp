@@ -223,21 +223,14 @@ TEST(ServoLoop, AMoveThatDoesNotStartHereIsAFaultNotAJump) {
 }
 
 // Reports a position that is not a number, as a broken drive might.
-class NanDriver final : public drivers::Driver {
+class NanDriver final : public FakeDriver {
  public:
-  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
-    return "";
-  }
-  void enable() override {}
-  void disable() override {}
-  void write(const drivers::JointCommand*, int) noexcept override {}
+  NanDriver() : FakeDriver("nan") {}
   void read(drivers::JointFeedback* feedback, int count) noexcept override {
     for (int i = 0; i < count; ++i)
       feedback[i] = drivers::JointFeedback{};
     if (broken) feedback[1].position = std::nan("");
   }
-  std::uint32_t capabilities() const noexcept override { return 0; }
-  const char* name() const noexcept override { return "nan"; }
   bool broken = false;
 };
 
@@ -284,13 +277,9 @@ TEST(ServoLoop, ANonFiniteSetPointIsAFaultAndNeverSentToADriver) {
 }
 
 // Keeps what the loop writes, and reports a position that is not a number when `broken`.
-class NanRecordingDriver final : public drivers::Driver {
+class NanRecordingDriver final : public FakeDriver {
  public:
-  std::string configure(const config::MachineConfig&, const std::vector<int>&) override {
-    return "";
-  }
-  void enable() override {}
-  void disable() override {}
+  NanRecordingDriver() : FakeDriver("nan") {}
   void write(const drivers::JointCommand* commands, int count) noexcept override {
     for (int i = 0; i < count; ++i)
       all_finite =
@@ -301,8 +290,6 @@ class NanRecordingDriver final : public drivers::Driver {
       feedback[i] = drivers::JointFeedback{};
     if (broken) feedback[1].position = std::nan("");
   }
-  std::uint32_t capabilities() const noexcept override { return 0; }
-  const char* name() const noexcept override { return "nan"; }
   bool broken = false;
   bool all_finite = true;
 };
