@@ -6,91 +6,18 @@
 // stops the jog, waits for the axis to stop and estops. Prints figures; never fails on timing.
 //
 //   cncd_open_stop_bench [TRIES=200] [LINES=2000000] [FLOOD=0|1]
-#include <fcntl.h>
-#include <poll.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <string>
-#include <thread>
-#include <vector>
+
+#include "bench_client.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-struct Conn {
-  int fd = -1;
-  std::string buffer;
-};
-
-int connect_to(const std::string& path) {
-  sockaddr_un addr{};
-  addr.sun_family = AF_UNIX;
-  std::strncpy(addr.sun_path, path.c_str(), sizeof addr.sun_path - 1);
-  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
-    close(fd);
-    return -1;
-  }
-  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
-  return fd;
-}
-
-bool send_line(const Conn& c, const std::string& line) {
-  const std::string data = line + "\n";
-  std::size_t sent = 0;
-  while (sent < data.size()) {
-    const ssize_t n = send(c.fd, data.data() + sent, data.size() - sent, MSG_NOSIGNAL);
-    if (n < 0 && errno == EAGAIN) {
-      pollfd p{c.fd, POLLOUT, 0};
-      poll(&p, 1, 100);
-      continue;
-    }
-    if (n <= 0) return false;
-    sent += static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-// Reads whatever is there; returns complete lines.
-std::vector<std::string> read_lines(Conn& c) {
-  char chunk[65536];
-  const ssize_t n = read(c.fd, chunk, sizeof chunk);
-  if (n > 0) c.buffer.append(chunk, static_cast<std::size_t>(n));
-  std::vector<std::string> lines;
-  std::size_t nl;
-  while ((nl = c.buffer.find('\n')) != std::string::npos) {
-    lines.push_back(c.buffer.substr(0, nl));
-    c.buffer.erase(0, nl + 1);
-  }
-  return lines;
-}
-
-// The next answer (a line with an "id") on `c`, skipping notifications; "" after `limit`.
-std::string read_answer(Conn& c, std::chrono::seconds limit = std::chrono::seconds(10)) {
-  const auto deadline = Clock::now() + limit;
-  while (Clock::now() < deadline) {
-    for (auto& line : read_lines(c)) {
-      if (line.find("\"id\"") != std::string::npos) return line;
-    }
-    pollfd p{c.fd, POLLIN, 0};
-    poll(&p, 1, 100);
-  }
-  return "";
-}
+using namespace cncd::bench;
 
 std::string request(const char* method, const std::string& params = "") {
   return std::string(R"({"jsonrpc":"2.0","id":1,"method":")") + method + "\"" +
@@ -106,12 +33,6 @@ double timed(Conn& c, const std::string& line) {
     std::exit(1);
   }
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
 void print(const char* what, const std::vector<double>& ms) {
@@ -133,13 +54,8 @@ int main(int argc, char** argv) {
   const long lines = argc > 2 ? std::atol(argv[2]) : 2'000'000;
   const bool flood = argc > 3 && std::atoi(argv[3]) != 0;
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("cncd-bench-" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = bench_dir({".var", ".tbl"});
   const fs::path examples = fs::path(CNCD_SOURCE_DIR) / "config/examples";
-  for (const char* ext : {".var", ".tbl"}) {
-    fs::copy_file(examples / (std::string("sim_mm") + ext), dir / (std::string("sim_mm") + ext),
-                  fs::copy_options::overwrite_existing);
-  }
   // Programs open from the bench's own directory.
   std::string ini = slurp(examples / "sim_mm.ini");
   if (const auto at = ini.find("\nPROGRAM_PREFIX = "); at != std::string::npos)
@@ -158,22 +74,8 @@ int main(int argc, char** argv) {
     out << "M2\n";
   }
   const std::string sock = (dir / "cncd.sock").string();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const std::string ini_path = (dir / "sim_mm.ini").string();
-    execl(CNCD_BINARY, CNCD_BINARY, "--ini", ini_path.c_str(), "--socket", sock.c_str(),
-          "--state-dir", dir.c_str(), "--log-level", "error", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  Conn control;
-  for (int i = 0; i < 500 && control.fd < 0; ++i) {
-    control.fd = connect_to(sock);
-    if (control.fd < 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  if (control.fd < 0) {
-    std::fprintf(stderr, "cncd did not start\n");
-    return 1;
-  }
+  const pid_t pid = start_cncd(dir, sock, {"--state-dir", dir.string(), "--log-level", "error"});
+  Conn control = connect_when_up(sock);
   std::vector<double> reference_ms;
   for (int i = 0; i < 50; ++i)
     reference_ms.push_back(timed(control, request("machine.estop")));

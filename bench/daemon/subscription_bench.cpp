@@ -3,89 +3,29 @@
 // run as the reference. Prints figures; never fails on timing.
 //
 //   cncd_subscription_bench [CLIENTS=256] [ROUNDS=20] [INTERVAL_MS=10]
-#include <fcntl.h>
-#include <poll.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <sys/wait.h>
-#include <unistd.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <filesystem>
-#include <string>
-#include <thread>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "bench_client.hpp"
+
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using namespace cncd::bench;
 
-struct Conn {
-  int fd = -1;
-  std::string buffer;
-};
-
-int connect_to(const std::string& path) {
-  sockaddr_un addr{};
-  addr.sun_family = AF_UNIX;
-  std::strncpy(addr.sun_path, path.c_str(), sizeof addr.sun_path - 1);
-  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
-    close(fd);
-    return -1;
-  }
-  // Reads never block: every wait is a poll with a time limit.
-  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
-  return fd;
-}
-
-void send_line(const Conn& c, const std::string& line) {
-  const std::string data = line + "\n";
-  if (send(c.fd, data.data(), data.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(data.size())) {
+void send_or_exit(const Conn& c, const std::string& line) {
+  if (!send_line(c, line)) {
     std::perror("send");
     std::exit(1);
   }
 }
 
-// Reads whatever is there; returns complete lines.
-std::vector<std::string> read_lines(Conn& c) {
-  char chunk[65536];
-  const ssize_t n = read(c.fd, chunk, sizeof chunk);
-  if (n > 0) c.buffer.append(chunk, static_cast<std::size_t>(n));
-  std::vector<std::string> lines;
-  std::size_t nl;
-  while ((nl = c.buffer.find('\n')) != std::string::npos) {
-    lines.push_back(c.buffer.substr(0, nl));
-    c.buffer.erase(0, nl + 1);
+void answer_or_exit(Conn& c) {
+  if (read_answer(c).empty()) {
+    std::fprintf(stderr, "no answer from cncd within 10 s\n");
+    std::exit(1);
   }
-  return lines;
-}
-
-// The next answer (a line with an "id") on `c`, skipping notifications.
-void read_answer(Conn& c) {
-  const auto deadline = Clock::now() + std::chrono::seconds(10);
-  while (Clock::now() < deadline) {
-    pollfd p{c.fd, POLLIN, 0};
-    poll(&p, 1, 100);
-    for (const auto& line : read_lines(c)) {
-      if (line.find("\"id\"") != std::string::npos) return;
-    }
-  }
-  std::fprintf(stderr, "no answer from cncd within 10 s\n");
-  std::exit(1);
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
 }  // namespace
@@ -95,43 +35,25 @@ int main(int argc, char** argv) {
   const int rounds = argc > 2 ? std::atoi(argv[2]) : 20;
   const int interval_ms = argc > 3 ? std::atoi(argv[3]) : 10;
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("cncd-bench-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  for (const char* ext : {".ini", ".var", ".tbl"}) {
-    fs::copy_file(fs::path(CNCD_SOURCE_DIR) / "config/examples" / (std::string("sim_mm") + ext),
-                  dir / (std::string("sim_mm") + ext), fs::copy_options::overwrite_existing);
-  }
+  const fs::path dir = bench_dir({".ini", ".var", ".tbl"});
   const std::string sock = (dir / "cncd.sock").string();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const std::string ini = (dir / "sim_mm.ini").string();
-    execl(CNCD_BINARY, CNCD_BINARY, "--ini", ini.c_str(), "--socket", sock.c_str(), "--log-level",
-          "warn", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  Conn control;
-  for (int i = 0; i < 500 && control.fd < 0; ++i) {
-    control.fd = connect_to(sock);
-    if (control.fd < 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  if (control.fd < 0) {
-    std::fprintf(stderr, "cncd did not start\n");
-    return 1;
-  }
+  const pid_t pid = start_cncd(dir, sock, {"--log-level", "warn"});
+  Conn control = connect_when_up(sock);
   std::vector<Conn> subs(static_cast<std::size_t>(clients));
   for (auto& c : subs) {
     c.fd = connect_to(sock);
-    send_line(c, R"({"jsonrpc":"2.0","id":1,"method":"status.subscribe","params":{"interval_ms":)" +
+    send_or_exit(c,
+                 R"({"jsonrpc":"2.0","id":1,"method":"status.subscribe","params":{"interval_ms":)" +
                      std::to_string(interval_ms) + R"(,"fields":["state"]}})");
-    read_answer(c);
+    answer_or_exit(c);
   }
   // Reference: plain request round trips on one connection.
   std::vector<double> round_trip_ms;
   for (int i = 0; i < 200; ++i) {
     const auto t0 = Clock::now();
-    send_line(control,
-              R"({"jsonrpc":"2.0","id":2,"method":"status.get","params":{"fields":["state"]}})");
-    read_answer(control);
+    send_or_exit(control,
+                 R"({"jsonrpc":"2.0","id":2,"method":"status.get","params":{"fields":["state"]}})");
+    answer_or_exit(control);
     round_trip_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -149,9 +71,9 @@ int main(int argc, char** argv) {
     const bool to_estop = r % 2 == 1;
     const std::string want = to_estop ? "\"state\":\"estop\"" : "\"state\":\"off\"";
     const auto t0 = Clock::now();
-    send_line(control, std::string(R"({"jsonrpc":"2.0","id":3,"method":")") +
-                           (to_estop ? "machine.estop" : "machine.reset") + "\"}");
-    read_answer(control);
+    send_or_exit(control, std::string(R"({"jsonrpc":"2.0","id":3,"method":")") +
+                              (to_estop ? "machine.estop" : "machine.reset") + "\"}");
+    answer_or_exit(control);
     std::vector<bool> seen(subs.size(), false);
     std::size_t remaining = subs.size();
     while (remaining > 0) {
