@@ -1,8 +1,10 @@
 // Expressions, parameters and line syntax, checked through the canonical output.
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include "cncd/interp/interpreter.hpp"
@@ -34,6 +36,23 @@ std::string error_of(const std::string& program) {
   return error ? error->message : std::string();
 }
 
+// The canonical commands of `program`, which must run to its end, as rs274 prints them.
+std::string canon_of(const std::string& program, const std::string& name = "<mdi>") {
+  Interpreter interp;
+  EXPECT_FALSE(interp.open_string(program, name));
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  const auto error = run_program(interp, printer);
+  EXPECT_FALSE(error) << error->to_string();
+  return out.str();
+}
+
+// Each program's first error as LinuxCNC words it ("" when it runs to its end).
+void expect_errors(std::initializer_list<std::pair<const char*, const char*>> cases) {
+  for (const auto& [program, message] : cases)
+    EXPECT_EQ(error_of(program), message) << program;
+}
+
 TEST(Expressions, PrecedenceIsLinuxCncs) {
   EXPECT_DOUBLE_EQ(x_of("[2**3+1*2 EQ 10]"), 1.0);
   EXPECT_DOUBLE_EQ(x_of("[2**3**2]"), 64.0);  // left-associative
@@ -58,80 +77,69 @@ TEST(Expressions, FunctionsWorkInDegrees) {
 }
 
 TEST(Expressions, UnaryMinusBeforeParameterOrBracket) {
-  Interpreter interp;
-  ASSERT_FALSE(interp.open_string("#1=2\nG0 X-#1 Y-[1+2]\nM2\n"));
-  std::ostringstream out;
-  Rs274Printer printer(out);
-  ASSERT_FALSE(run_program(interp, printer));
-  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(-2.0000, -3.0000, 0.0000"), std::string::npos);
+  const std::string canon = canon_of("#1=2\nG0 X-#1 Y-[1+2]\nM2\n");
+  EXPECT_NE(canon.find("STRAIGHT_TRAVERSE(-2.0000, -3.0000, 0.0000"), std::string::npos);
 }
 
 TEST(Parameters, AssignmentTakesEffectAfterTheLine) {
   EXPECT_DOUBLE_EQ(x_of("#1"), 0.0);
-  Interpreter interp;
-  ASSERT_FALSE(interp.open_string("#1=5 G0 X#1\nG0 Y#1\nM2\n"));
-  std::ostringstream out;
-  Rs274Printer printer(out);
-  ASSERT_FALSE(run_program(interp, printer));
-  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000"), std::string::npos);
-  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(0.0000, 5.0000, 0.0000"), std::string::npos);
+  const std::string canon = canon_of("#1=5 G0 X#1\nG0 Y#1\nM2\n");
+  EXPECT_NE(canon.find("STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000"), std::string::npos);
+  EXPECT_NE(canon.find("STRAIGHT_TRAVERSE(0.0000, 5.0000, 0.0000"), std::string::npos);
 }
 
 TEST(Errors, Wording) {
-  EXPECT_EQ(error_of("G0 X[1/0]\nM2\n"), "Attempt to divide by zero");
-  EXPECT_EQ(error_of("G0 G1 X1\nM2\n"), "Two g codes used from same modal group");
-  EXPECT_EQ(error_of("M3 M4\nM2\n"), "Two m codes used from same modal group");
-  EXPECT_EQ(error_of("G7.5\nM2\n"), "Unknown g code used");
-  EXPECT_EQ(error_of("F-1\nM2\n"), "Negative f word used");
-  EXPECT_EQ(error_of("X1\nM2\n"), "Cannot use axis values without a g code that uses them");
+  expect_errors({
+      {"G0 X[1/0]\nM2\n", "Attempt to divide by zero"},
+      {"G0 G1 X1\nM2\n", "Two g codes used from same modal group"},
+      {"M3 M4\nM2\n", "Two m codes used from same modal group"},
+      {"G7.5\nM2\n", "Unknown g code used"},
+      {"F-1\nM2\n", "Negative f word used"},
+      {"X1\nM2\n", "Cannot use axis values without a g code that uses them"},
+  });
 }
 
 TEST(Errors, UnsupportedFeaturesAreRejected) {
-  EXPECT_EQ(error_of("G41 D1\nM2\n"), "G41 is not supported");
-  EXPECT_EQ(error_of("G33 Z-1 K1\nM2\n"), "G33 is not supported");
-  EXPECT_EQ(error_of("G38.2 Z-1 F1\nM2\n"), "G38.2 is not supported");
-  EXPECT_EQ(error_of("G76 P1 Z-1\nM2\n"), "G76 is not supported");
-  EXPECT_EQ(error_of("G5.1 X1 I1\nM2\n"), "G5.1 is not supported");
+  expect_errors({
+      {"G41 D1\nM2\n", "G41 is not supported"},
+      {"G33 Z-1 K1\nM2\n", "G33 is not supported"},
+      {"G38.2 Z-1 F1\nM2\n", "G38.2 is not supported"},
+      {"G76 P1 Z-1\nM2\n", "G76 is not supported"},
+      {"G5.1 X1 I1\nM2\n", "G5.1 is not supported"},
+  });
 }
 
 TEST(Comments, LastCommentOfALineAndMessages) {
-  Interpreter interp;
-  ASSERT_FALSE(interp.open_string("(first)(second)\n(MSG, Hello There)\nG0 X1 ; trailing\nM2\n"));
-  std::ostringstream out;
-  Rs274Printer printer(out);
-  ASSERT_FALSE(run_program(interp, printer));
-  EXPECT_NE(out.str().find("COMMENT(\"second\")"), std::string::npos);
-  EXPECT_EQ(out.str().find("COMMENT(\"first\")"), std::string::npos);
-  EXPECT_NE(out.str().find("MESSAGE(\" Hello There\")"), std::string::npos);
+  const std::string canon = canon_of("(first)(second)\n(MSG, Hello There)\nG0 X1 ; trailing\nM2\n");
+  EXPECT_NE(canon.find("COMMENT(\"second\")"), std::string::npos);
+  EXPECT_EQ(canon.find("COMMENT(\"first\")"), std::string::npos);
+  EXPECT_NE(canon.find("MESSAGE(\" Hello There\")"), std::string::npos);
 }
 
 // Fanuc-style posts put the program number first: LinuxCNC ignores a bare O-word, and the
 // comments after it.
 TEST(ProgramNumbers, ABareOWordIsIgnoredWithItsComments) {
-  Interpreter interp;
-  ASSERT_FALSE(interp.open_string(
-      "%\nO0001 (PART NAME)\nN5 O0002\no<named> (MSG,hidden)\nO3 ;note\nG0 X1\nM2\n%\n",
-      "number.ngc"));
-  std::ostringstream out;
-  Rs274Printer printer(out);
-  const auto error = run_program(interp, printer);
-  ASSERT_FALSE(error) << error->to_string();
-  EXPECT_EQ(out.str().find("COMMENT"), std::string::npos) << out.str();
-  EXPECT_EQ(out.str().find("MESSAGE"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(1.0000"), std::string::npos) << out.str();
+  const std::string canon =
+      canon_of("%\nO0001 (PART NAME)\nN5 O0002\no<named> (MSG,hidden)\nO3 ;note\nG0 X1\nM2\n%\n",
+               "number.ngc");
+  EXPECT_EQ(canon.find("COMMENT"), std::string::npos) << canon;
+  EXPECT_EQ(canon.find("MESSAGE"), std::string::npos) << canon;
+  EXPECT_NE(canon.find("STRAIGHT_TRAVERSE(1.0000"), std::string::npos) << canon;
 }
 
 TEST(ProgramNumbers, AnythingButACommentAfterABareOWordIsRefused) {
-  EXPECT_EQ(error_of("O0001 G0 X1\nM2\n"), "Unknown control command in o word");
-  EXPECT_EQ(error_of("O0001 X1\nM2\n"), "Unknown control command in o word");
-  EXPECT_EQ(error_of("O0001 (NAME) G0 X1\nM2\n"), "Unexpected character after O-word");
-  EXPECT_EQ(error_of("O0001 (NAME\nM2\n"), "Unclosed comment found");
-  EXPECT_EQ(error_of("O0001 (a(b))\nM2\n"), "Nested comment found");
-  // Only block delete and a line number may come before an O-word.
-  EXPECT_EQ(error_of("G0 X1 O0001\nM2\n"), "Bad character 'o' used");
-  EXPECT_EQ(error_of("(NAME) O0001\nM2\n"), "Bad character 'o' used");
-  EXPECT_EQ(error_of("G0 X1 O100 call\nM2\n"), "Bad character 'o' used");
-  EXPECT_EQ(error_of("/N10 O0001\nM2\n"), "");
+  expect_errors({
+      {"O0001 G0 X1\nM2\n", "Unknown control command in o word"},
+      {"O0001 X1\nM2\n", "Unknown control command in o word"},
+      {"O0001 (NAME) G0 X1\nM2\n", "Unexpected character after O-word"},
+      {"O0001 (NAME\nM2\n", "Unclosed comment found"},
+      {"O0001 (a(b))\nM2\n", "Nested comment found"},
+      // Only block delete and a line number may come before an O-word.
+      {"G0 X1 O0001\nM2\n", "Bad character 'o' used"},
+      {"(NAME) O0001\nM2\n", "Bad character 'o' used"},
+      {"G0 X1 O100 call\nM2\n", "Bad character 'o' used"},
+      {"/N10 O0001\nM2\n", ""},
+  });
 }
 
 }  // namespace

@@ -27,19 +27,20 @@ TEST(InterpreterState, ActiveCodesAsLinuxCncNumbersThem) {
   Interpreter interp;
   run(interp, "G20 G91 G18 G59.1 G61.1 G98 G93 F1 G1 X1 M3 S100 M7");
   const InterpState s = interp.state();
-  EXPECT_EQ(s.gcodes[1], 10);
-  EXPECT_EQ(s.gcodes[3], 180);
-  EXPECT_EQ(s.gcodes[5], 200);
-  EXPECT_EQ(s.gcodes[6], 910);
-  EXPECT_EQ(s.gcodes[7], 930);
-  EXPECT_EQ(s.gcodes[8], 591);
-  EXPECT_EQ(s.gcodes[9], 490);
-  EXPECT_EQ(s.gcodes[10], 980);
-  EXPECT_EQ(s.gcodes[11], 611);
-  EXPECT_EQ(s.gcodes[16], -1);
-  EXPECT_EQ(s.mcodes[2], 3);
-  EXPECT_EQ(s.mcodes[4], 7);
-  EXPECT_EQ(s.mcodes[5], -1);
+  // {index, code}
+  for (const auto& [index, code] : {std::pair{1, 10},
+                                    {3, 180},
+                                    {5, 200},
+                                    {6, 910},
+                                    {7, 930},
+                                    {8, 591},
+                                    {9, 490},
+                                    {10, 980},
+                                    {11, 611},
+                                    {16, -1}})
+    EXPECT_EQ(s.gcodes[index], code) << "gcodes[" << index << "]";
+  for (const auto& [index, code] : {std::pair{2, 3}, {4, 7}, {5, -1}})
+    EXPECT_EQ(s.mcodes[index], code) << "mcodes[" << index << "]";
   EXPECT_EQ(s.coord_system, 7);
   EXPECT_EQ(s.speed, 100.0);
 }

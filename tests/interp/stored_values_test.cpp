@@ -72,14 +72,18 @@ TEST(StoredValues, ExpressionsThatAreNotFiniteNeverGetThatFar) {
             "1:24: Result is not a finite number (overflow)");
 }
 
+// The error of an MDI block refused because a value is beyond the bound.
+void expect_out_of_range(const std::string& error) {
+  EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
+  EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+}
+
 TEST(StoredValues, G10OriginsBeyondTheBoundAreRefusedAndChangeNothing) {
   Interpreter interp;
   for (const char* block : {"G10 L2 P1 X5 Y[10**10]", "G10 L20 P1 X5 Y[-10**10]",
                             "G10 L2 P1 X5 R[10**10]", "G10 L2 P2 X5 Y[10**299*10]"}) {
     SCOPED_TRACE(block);
-    const std::string error = mdi_error(interp, block);
-    EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
-    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    expect_out_of_range(mdi_error(interp, block));
     double rotation = 0;
     EXPECT_EQ(interp.coord_system_origin(1, &rotation)[0], 0.0);
     EXPECT_EQ(interp.coord_system_origin(2)[0], 0.0);
@@ -94,9 +98,7 @@ TEST(StoredValues, G92AndG52BeyondTheBoundAreRefusedAndChangeNothing) {
   Interpreter interp;
   for (const char* block : {"G92 X[10**299*10]", "G92 X1 Y[-10**10]", "G52 Z[10**10]"}) {
     SCOPED_TRACE(block);
-    const std::string error = mdi_error(interp, block);
-    EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
-    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    expect_out_of_range(mdi_error(interp, block));
     const InterpState s = interp.state();
     for (double v : s.g92_offset)
       EXPECT_EQ(v, 0.0);
@@ -112,17 +114,13 @@ TEST(StoredValues, ToolDataAndToolLengthsBeyondTheBoundAreRefused) {
   for (const char* block : {"G10 L1 P1 Z[10**10]", "G10 L10 P1 Z[-10**10]",
                             "G10 L11 P1 Z[10**299*10]", "G10 L1 P1 Z1 R[10**10]"}) {
     SCOPED_TRACE(block);
-    const std::string error = mdi_error(interp, block);
-    EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
-    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    expect_out_of_range(mdi_error(interp, block));
     EXPECT_FALSE(interp.tool(1).has_value());
   }
   EXPECT_EQ(mdi_error(interp, "G10 L1 P1 Z5"), "");
   for (const char* block : {"G43.1 Z[10**10]", "G43.1 X[-10**299*10]"}) {
     SCOPED_TRACE(block);
-    const std::string error = mdi_error(interp, block);
-    EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
-    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    expect_out_of_range(mdi_error(interp, block));
     EXPECT_EQ(interp.state().tool_offset[2], 0.0);
   }
 }
