@@ -9,12 +9,13 @@ namespace {
 
 using nlohmann::json;
 
-const std::vector<std::string> kMethods = {
-    "status.get",       "status.subscribe", "status.unsubscribe", "errors.list",   "system.info",
-    "machine.estop",    "machine.off",      "machine.home",       "jog.start",     "jog.stop",
-    "jog.increment",    "mdi.execute",      "program.open",       "program.run",   "program.step",
-    "program.pause",    "program.resume",   "program.abort",      "override.feed", "override.rapid",
-    "override.spindle", "tool.list",        "tool.set",           "offsets.get",   "offsets.set"};
+// Every served method but machine.reset and machine.on, which would bring the machine up.
+std::vector<std::string> methods() {
+  std::vector<std::string> methods = served_methods();
+  std::erase(methods, "machine.reset");
+  std::erase(methods, "machine.on");
+  return methods;
+}
 
 std::vector<json> odd_values() {
   return {nullptr,
@@ -67,7 +68,7 @@ TEST_F(MachineTest, OddParamsToEveryMethodGetAnAnswer) {
     return r;
   };
   constexpr std::size_t kBatch = 200;  // within the 256 a batch may hold
-  for (const auto& method : kMethods) {
+  for (const auto& method : methods()) {
     for (std::size_t first = 0; first < params.size(); first += kBatch) {
       json batch = json::array();
       for (std::size_t i = first; i < std::min(params.size(), first + kBatch); ++i)
