@@ -2,6 +2,7 @@
 // and in real time.
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -52,15 +53,28 @@ double ramp(double from, double to, double t, double seconds) {
   return from + (to - from) * (1 - std::cos(u * M_PI)) / 2;
 }
 
-TEST(GpioStepgen, PulseCountsAndTimingInVirtualTime) {
-  TempDir dir;
-  const auto loaded = load_machine(dir, 2, stepgen_keys(), gpio_section(dir), kBaseNs);
-  ASSERT_TRUE(loaded.ok());
-  GpioDriver driver;
-  driver.use_manual_clock(true);
-  ASSERT_EQ(driver.configure(*loaded.config, {0, 1}), "");
-  driver.enable();
-  std::int64_t now_ns = 0;
+// A gpio step/dir driver on the first joints of a machine whose lines go to dir_/steps.vcd, in
+// virtual time: each test advances now_ns_ itself.
+class GpioStepgenTest : public ::testing::Test {
+ protected:
+  void start(int joints, const std::string& extra_keys = "") {
+    loaded_ = load_machine(dir_, joints, stepgen_keys(extra_keys), gpio_section(dir_), kBaseNs);
+    ASSERT_TRUE(loaded_.ok());
+    driver_.use_manual_clock(true);
+    std::vector<int> indexes(static_cast<std::size_t>(joints));
+    std::iota(indexes.begin(), indexes.end(), 0);
+    ASSERT_EQ(driver_.configure(*loaded_.config, indexes), "");
+    driver_.enable();
+  }
+
+  TempDir dir_;
+  config::LoadResult loaded_;
+  GpioDriver driver_;
+  std::int64_t now_ns_ = 0;
+};
+
+TEST_F(GpioStepgenTest, PulseCountsAndTimingInVirtualTime) {
+  ASSERT_NO_FATAL_FAILURE(start(2));
   std::vector<double> previous{0, 0};
   // Out to X 5 / Y -3, back through zero to X -2.37 / Y 1.5, then hold still.
   const struct {
@@ -71,24 +85,24 @@ TEST(GpioStepgen, PulseCountsAndTimingInVirtualTime) {
     for (double t = 0; t < m.seconds; t += 1e-3) {
       const std::vector<double> p{ramp(start[0], m.x, t + 1e-3, m.seconds),
                                   ramp(start[1], m.y, t + 1e-3, m.seconds)};
-      servo_period(driver, p, previous, now_ns);
+      servo_period(driver_, p, previous, now_ns_);
       previous = p;
     }
   }
   JointFeedback fb[2];
-  driver.read(fb, 2);
-  driver.disable();
-  EXPECT_EQ(driver.step_count(0), -237);
-  EXPECT_EQ(driver.step_count(1), 150);
+  driver_.read(fb, 2);
+  driver_.disable();
+  EXPECT_EQ(driver_.step_count(0), -237);
+  EXPECT_EQ(driver_.step_count(1), 150);
   EXPECT_DOUBLE_EQ(fb[0].position, -2.37);
   EXPECT_DOUBLE_EQ(fb[1].position, 1.5);
   EXPECT_FALSE(fb[0].stale);
 
-  const auto changes = read_vcd(dir.path() / "steps.vcd");
+  const auto changes = read_vcd(dir_.path() / "steps.vcd");
   for (int j = 0; j < 2; ++j) {
     const StepStats s = step_stats(changes, j);
     SCOPED_TRACE("joint " + std::to_string(j));
-    EXPECT_EQ(s.net_steps, driver.step_count(j));
+    EXPECT_EQ(s.net_steps, driver_.step_count(j));
     EXPECT_GE(s.direction_changes, 1);
     EXPECT_GE(s.min_high_ns, 20'000);
     EXPECT_GE(s.min_low_ns, 15'000);
@@ -100,31 +114,24 @@ TEST(GpioStepgen, PulseCountsAndTimingInVirtualTime) {
   EXPECT_EQ(step_stats(changes, 1).rising_edges, 750);
 }
 
-TEST(GpioStepgen, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
-  TempDir dir;
-  const auto loaded = load_machine(dir, 1, stepgen_keys(), gpio_section(dir), kBaseNs);
-  ASSERT_TRUE(loaded.ok());
-  GpioDriver driver;
-  driver.use_manual_clock(true);
-  ASSERT_EQ(driver.configure(*loaded.config, {0}), "");
-  driver.enable();
-  std::int64_t now_ns = 0;
+TEST_F(GpioStepgenTest, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
+  ASSERT_NO_FATAL_FAILURE(start(1));
   JointCommand off{10, 0, false};
   for (int i = 0; i < 20; ++i) {
-    driver.write(&off, 1);
+    driver_.write(&off, 1);
     for (int k = 0; k < 100; ++k)
-      driver.run_base_period(now_ns += kBaseNs);
+      driver_.run_base_period(now_ns_ += kBaseNs);
   }
-  EXPECT_EQ(driver.step_count(0), 1000) << "the first command places the motor without stepping";
+  EXPECT_EQ(driver_.step_count(0), 1000) << "the first command places the motor without stepping";
   JointCommand on{10.5, 0, true};
   for (int i = 0; i < 50; ++i) {
-    driver.write(&on, 1);
+    driver_.write(&on, 1);
     for (int k = 0; k < 100; ++k)
-      driver.run_base_period(now_ns += kBaseNs);
+      driver_.run_base_period(now_ns_ += kBaseNs);
   }
-  driver.disable();
-  EXPECT_EQ(driver.step_count(0), 1050);
-  const auto changes = read_vcd(dir.path() / "steps.vcd");
+  driver_.disable();
+  EXPECT_EQ(driver_.step_count(0), 1050);
+  const auto changes = read_vcd(dir_.path() / "steps.vcd");
   int enable_edges = 0;
   for (const auto& c : changes)
     if (c.signal == "j0_enable" && c.level == 1) ++enable_edges;
@@ -132,32 +139,23 @@ TEST(GpioStepgen, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
   EXPECT_EQ(step_stats(changes, 0).rising_edges, 50);
 }
 
-TEST(GpioStepgen, StepgenLimitsBoundTheStepRate) {
-  TempDir dir;
-  const auto loaded =
-      load_machine(dir, 1, stepgen_keys("STEPGEN_MAXVEL = 10\nSTEPGEN_MAXACCEL = 200\n"),
-                   gpio_section(dir), kBaseNs);
-  ASSERT_TRUE(loaded.ok());
-  GpioDriver driver;
-  driver.use_manual_clock(true);
-  ASSERT_EQ(driver.configure(*loaded.config, {0}), "");
-  driver.enable();
-  std::int64_t now_ns = 0;
+TEST_F(GpioStepgenTest, StepgenLimitsBoundTheStepRate) {
+  ASSERT_NO_FATAL_FAILURE(start(1, "STEPGEN_MAXVEL = 10\nSTEPGEN_MAXACCEL = 200\n"));
   JointCommand start{0, 0, true};
-  driver.write(&start, 1);
-  driver.run_base_period(now_ns);
+  driver_.write(&start, 1);
+  driver_.run_base_period(now_ns_);
   // A 20 mm jump: at 10 mm/s and 200 mm/s^2 it takes 2.05 s, never faster.
   JointCommand jump{20, 0, true};
-  driver.write(&jump, 1);
+  driver_.write(&jump, 1);
   std::int64_t after_1s = 0;
   for (int k = 1; k <= 300'000; ++k) {
-    driver.run_base_period(now_ns += kBaseNs);
-    if (k == 100'000) after_1s = driver.step_count(0);
+    driver_.run_base_period(now_ns_ += kBaseNs);
+    if (k == 100'000) after_1s = driver_.step_count(0);
   }
-  driver.disable();
+  driver_.disable();
   EXPECT_LE(after_1s, 1000);  // at most 10 mm/s * 1 s
   EXPECT_GE(after_1s, 900);   // after 0.05 s of acceleration it runs at full speed
-  EXPECT_EQ(driver.step_count(0), 2000);
+  EXPECT_EQ(driver_.step_count(0), 2000);
 }
 
 TEST(GpioStepgen, RealTimeBaseThreadReachesTheCommand) {
