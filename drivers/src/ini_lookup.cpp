@@ -7,13 +7,14 @@
 #include <cstdlib>
 
 namespace cncd::drivers {
-namespace {
 
 std::string upper(std::string text) {
   for (char& c : text)
     c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return text;
 }
+
+namespace {
 
 // LinuxCNC reads numbers with sscanf, so "25000  # ns" is 25000.
 std::optional<double> parse_real(const std::string& text) {

@@ -45,4 +45,7 @@ class IniLookup {
 
 std::string joint_section(int joint);
 
+// `text` in ASCII upper case: choice values are compared in any case.
+std::string upper(std::string text);
+
 }  // namespace cncd::drivers

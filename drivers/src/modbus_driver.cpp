@@ -17,12 +17,6 @@
 namespace cncd::drivers {
 namespace {
 
-std::string upper(std::string text) {
-  for (char& c : text)
-    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return text;
-}
-
 BusSettings read_bus(IniLookup& ini, int number) {
   BusSettings b;
   b.section = "MODBUS_" + std::to_string(number);
