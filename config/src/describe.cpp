@@ -27,15 +27,8 @@ const char* linear_name(LinearUnits units) {
 }
 
 const char* angular_name(AngularUnits units) {
-  switch (units) {
-    case AngularUnits::radian:
-      return "radian";
-    case AngularUnits::grad:
-      return "grad";
-    case AngularUnits::degree:
-      break;
-  }
-  return "degree";
+  if (units == AngularUnits::radian) return "radian";
+  return units == AngularUnits::grad ? "grad" : "degree";
 }
 
 void line(std::string& out, const std::string& text) {

@@ -1,7 +1,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <numbers>
+#include <utility>
 
 #include "loader.hpp"
 #include "text.hpp"
@@ -13,20 +15,31 @@ bool near(double value, double target) {
   return std::fabs(value - target) <= 1e-6 * target;
 }
 
-// LINEAR_UNITS may also be written as LinuxCNC's factor (machine units per mm).
-void load_linear_units(TypedReader& r, MachineConfig& c) {
+// LINEAR_UNITS and ANGULAR_UNITS may also be written as LinuxCNC's factor (machine units per
+// mm or per degree). True when the key holds a number: then `units` is the one of `factors` it
+// is near, or a problem says it is none of `names`.
+template <typename Units>
+bool load_units_factor(TypedReader& r, const char* key,
+                       std::initializer_list<std::pair<double, Units>> factors,
+                       const std::string& names, Units& units) {
   double factor = 0;
-  if (const IniEntry* e = r.entry("TRAJ", "LINEAR_UNITS");
-      e != nullptr && parse_number(strip_trailing_comment(e->value), factor) == NumberError::none) {
-    if (near(factor, 1.0)) {
-      c.linear_units = LinearUnits::mm;
-    } else if (near(factor, 1.0 / 25.4)) {
-      c.linear_units = LinearUnits::inch;
-    } else {
-      r.problem(
-          "TRAJ", "LINEAR_UNITS",
-          "factor " + e->value + " is neither mm (1) nor inch (" + format_number(1.0 / 25.4) + ")");
+  const IniEntry* e = r.entry("TRAJ", key);
+  if (e == nullptr || parse_number(strip_trailing_comment(e->value), factor) != NumberError::none)
+    return false;
+  for (const auto& [value, named] : factors) {
+    if (near(factor, value)) {
+      units = named;
+      return true;
     }
+  }
+  r.problem("TRAJ", key, "factor " + e->value + " is " + names);
+  return true;
+}
+
+void load_linear_units(TypedReader& r, MachineConfig& c) {
+  if (load_units_factor(
+          r, "LINEAR_UNITS", {{1.0, LinearUnits::mm}, {1.0 / 25.4, LinearUnits::inch}},
+          "neither mm (1) nor inch (" + format_number(1.0 / 25.4) + ")", c.linear_units)) {
     return;
   }
   const auto units = r.choice("TRAJ", "LINEAR_UNITS");
@@ -54,19 +67,11 @@ void load_planner_type(TypedReader& r, MachineConfig& c) {
 }
 
 void load_angular_units(TypedReader& r, MachineConfig& c) {
-  double factor = 0;
-  if (const IniEntry* e = r.entry("TRAJ", "ANGULAR_UNITS");
-      e != nullptr && parse_number(strip_trailing_comment(e->value), factor) == NumberError::none) {
-    if (near(factor, 1.0)) {
-      c.angular_units = AngularUnits::degree;
-    } else if (near(factor, std::numbers::pi / 180.0)) {
-      c.angular_units = AngularUnits::radian;
-    } else if (near(factor, 0.9)) {
-      c.angular_units = AngularUnits::grad;
-    } else {
-      r.problem("TRAJ", "ANGULAR_UNITS",
-                "factor " + e->value + " is none of degree (1), radian, grad (0.9)");
-    }
+  if (load_units_factor(r, "ANGULAR_UNITS",
+                        {{1.0, AngularUnits::degree},
+                         {std::numbers::pi / 180.0, AngularUnits::radian},
+                         {0.9, AngularUnits::grad}},
+                        "none of degree (1), radian, grad (0.9)", c.angular_units)) {
     return;
   }
   const auto units = r.choice("TRAJ", "ANGULAR_UNITS");
