@@ -110,6 +110,14 @@ class MachineIniTest : public TempDirTest {
     return strings(result.problems);
   }
   std::string at(int line) const { return TempDirTest::at("m.ini", line); }
+  // The problems of minimal_ini() with its line `line` replaced by `text`.
+  std::vector<std::string> problems_with(int line, const std::string& text) {
+    return problems_of(replace_line(minimal_ini(), line, text));
+  }
+  // One problem, reported at line `line` of m.ini.
+  std::vector<std::string> problem_at(int line, const std::string& message) const {
+    return {at(line) + ": " + message};
+  }
 };
 
 }  // namespace cncd::config::test

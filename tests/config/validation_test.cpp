@@ -15,8 +15,8 @@ TEST_F(ValidationTest, MinimalIniIsValid) {
 }
 
 TEST_F(ValidationTest, NonNumericNumber) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 30, "MAX_VELOCITY = fast")),
-            std::vector<std::string>{at(30) + ": [JOINT_0] MAX_VELOCITY: 'fast' is not a number"});
+  EXPECT_EQ(problems_with(30, "MAX_VELOCITY = fast"),
+            problem_at(30, "[JOINT_0] MAX_VELOCITY: 'fast' is not a number"));
 }
 
 TEST_F(ValidationTest, TrailingCommentAfterNumberIsAcceptedButJunkIsNot) {
@@ -24,9 +24,8 @@ TEST_F(ValidationTest, TrailingCommentAfterNumberIsAcceptedButJunkIsNot) {
       write("m.ini", replace_line(minimal_ini(), 30, "MAX_VELOCITY = 40   # mm/s")));
   ASSERT_TRUE(ok.ok()) << ::testing::PrintToString(strings(ok.problems));
   EXPECT_EQ(ok.config->joints[0].max_velocity, 40);
-  EXPECT_EQ(
-      problems_of(replace_line(minimal_ini(), 30, "MAX_VELOCITY = 40 mm/s")),
-      std::vector<std::string>{at(30) + ": [JOINT_0] MAX_VELOCITY: '40 mm/s' is not a number"});
+  EXPECT_EQ(problems_with(30, "MAX_VELOCITY = 40 mm/s"),
+            problem_at(30, "[JOINT_0] MAX_VELOCITY: '40 mm/s' is not a number"));
 }
 
 TEST_F(ValidationTest, VelocitiesAndAccelerationsMustBePositive) {
@@ -70,25 +69,27 @@ TEST_F(ValidationTest, JointLimitsMustIncludeAxisLimits) {
 }
 
 TEST_F(ValidationTest, ServoAndBasePeriods) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 4, "SERVO_PERIOD = 10000")),
-            std::vector<std::string>{at(4) + ": [EMCMOT] SERVO_PERIOD: 10000 is out of range: must "
-                                             "be between 50000 and 100000000 ns"});
   EXPECT_EQ(
-      problems_of(replace_line(minimal_ini(), 4, "SERVO_PERIOD = 1000000\nBASE_PERIOD = 2000000")),
-      std::vector<std::string>{at(5) + ": [EMCMOT] BASE_PERIOD: 2000000 ns must not be longer "
-                                       "than SERVO_PERIOD 1000000 ns"});
+      problems_with(4, "SERVO_PERIOD = 10000"),
+      problem_at(
+          4,
+          "[EMCMOT] SERVO_PERIOD: 10000 is out of range: must be between 50000 and 100000000 ns"));
+  EXPECT_EQ(
+      problems_with(4, "SERVO_PERIOD = 1000000\nBASE_PERIOD = 2000000"),
+      problem_at(
+          5, "[EMCMOT] BASE_PERIOD: 2000000 ns must not be longer than SERVO_PERIOD 1000000 ns"));
   const auto equal = load_machine_config(write(
       "eq.ini", replace_line(minimal_ini(), 4, "SERVO_PERIOD = 1000000\nBASE_PERIOD = 1000000")));
   EXPECT_TRUE(equal.ok()) << ::testing::PrintToString(strings(equal.problems));
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 4, "SERVO_PERIOD = 1000000.5")),
-            std::vector<std::string>{at(4) +
-                                     ": [EMCMOT] SERVO_PERIOD: '1000000.5' is not a whole number"});
+  EXPECT_EQ(problems_with(4, "SERVO_PERIOD = 1000000.5"),
+            problem_at(4, "[EMCMOT] SERVO_PERIOD: '1000000.5' is not a whole number"));
 }
 
 TEST_F(ValidationTest, UnknownUnits) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 7, "LINEAR_UNITS = furlong")),
-            std::vector<std::string>{at(7) + ": [TRAJ] LINEAR_UNITS: unknown value 'furlong'; "
-                                             "expected one of mm, metric, inch, in, imperial"});
+  EXPECT_EQ(problems_with(7, "LINEAR_UNITS = furlong"),
+            problem_at(7,
+                       "[TRAJ] LINEAR_UNITS: unknown value 'furlong'; expected one of mm, metric, "
+                       "inch, in, imperial"));
 }
 
 TEST_F(ValidationTest, JointsMustMatchCoordinates) {
@@ -96,13 +97,13 @@ TEST_F(ValidationTest, JointsMustMatchCoordinates) {
                                      "JOINTS = 2")),
             std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 2 does not match "
                                               "COORDINATES XYYZ, which names 4 joints"});
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 10, "KINEMATICS = trivkins coordinates=XYYZ")),
-            std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 3 is too few: trivkins "
-                                              "coordinates=XYYZ needs 4 joints"});
   EXPECT_EQ(
-      problems_of(replace_line(minimal_ini(), 11, "JOINTS = 2")),
-      std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 2 is too few for the 3 axes "
-                                        "of COORDINATES XYZ"});
+      problems_with(10, "KINEMATICS = trivkins coordinates=XYYZ"),
+      problem_at(11,
+                 "[KINS] JOINTS: JOINTS = 3 is too few: trivkins coordinates=XYYZ needs 4 joints"));
+  EXPECT_EQ(
+      problems_with(11, "JOINTS = 2"),
+      problem_at(11, "[KINS] JOINTS: JOINTS = 2 is too few for the 3 axes of COORDINATES XYZ"));
 }
 
 TEST_F(ValidationTest, JointSectionNames) {
@@ -161,9 +162,11 @@ TEST_F(ValidationTest, UnknownDriver) {
 }
 
 TEST_F(ValidationTest, UnsupportedKinematics) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 10, "KINEMATICS = corexykins")),
-            std::vector<std::string>{at(10) + ": [KINS] KINEMATICS: kinematics 'corexykins' is not "
-                                              "supported; cncd supports trivkins"});
+  EXPECT_EQ(
+      problems_with(10, "KINEMATICS = corexykins"),
+      problem_at(
+          10,
+          "[KINS] KINEMATICS: kinematics 'corexykins' is not supported; cncd supports trivkins"));
 }
 
 TEST_F(ValidationTest, DisplayOverrideLimitsAreRead) {
@@ -206,9 +209,8 @@ TEST_F(ValidationTest, MissingKinsKeys) {
 }
 
 TEST_F(ValidationTest, BadCoordinateLetter) {
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 6, "COORDINATES = X Q Z")),
-            std::vector<std::string>{at(6) + ": [TRAJ] COORDINATES: 'X Q Z': 'Q' is not an axis "
-                                             "letter (XYZABCUVW)"});
+  EXPECT_EQ(problems_with(6, "COORDINATES = X Q Z"),
+            problem_at(6, "[TRAJ] COORDINATES: 'X Q Z': 'Q' is not an axis letter (XYZABCUVW)"));
 }
 
 TEST_F(ValidationTest, RepeatedSectionThatSaysSomethingElse) {
@@ -254,33 +256,36 @@ TEST_F(ValidationTest, JerkLimitAndPlannerType) {
     return load_machine_config(
         write("m.ini", replace_line(minimal_ini(), 7, "LINEAR_UNITS = mm\n" + lines)));
   };
-  auto plain = load("");
-  ASSERT_TRUE(plain.ok());
-  EXPECT_FALSE(plain.config->scurve);
-  auto jerk = load("MAX_LINEAR_JERK = 50000");
-  ASSERT_TRUE(jerk.ok());
-  EXPECT_TRUE(jerk.config->scurve);
-  EXPECT_EQ(jerk.config->max_linear_jerk, 50000);
-  EXPECT_TRUE(jerk.warnings.empty());
-  auto typed = load("PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 50000");
-  ASSERT_TRUE(typed.ok());
-  EXPECT_TRUE(typed.config->scurve);
-  auto off = load("PLANNER_TYPE = 0\nMAX_LINEAR_JERK = 50000");
-  ASSERT_TRUE(off.ok());
-  EXPECT_FALSE(off.config->scurve);
-  ASSERT_EQ(off.warnings.size(), 1u);
-  EXPECT_NE(strings(off.warnings)[0].find("MAX_LINEAR_JERK is not applied"), std::string::npos);
-  auto low = load("PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 0.5");
-  ASSERT_TRUE(low.ok());
-  EXPECT_FALSE(low.config->scurve);
-  ASSERT_EQ(low.warnings.size(), 1u);
-  EXPECT_EQ(strings(low.warnings)[0],
-            at(8) +
-                ": [TRAJ] PLANNER_TYPE: PLANNER_TYPE = 1 (S-curve) needs MAX_LINEAR_JERK >= 1 "
-                "(got 0.5): planning trapezoidal profiles");
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 7, "LINEAR_UNITS = mm\nPLANNER_TYPE = 2")),
-            std::vector<std::string>{at(8) + ": [TRAJ] PLANNER_TYPE: 2 is out of range: must be "
-                                             "between 0 and 1"});
+  // Whether each combination plans S-curve profiles, and the warnings it gives.
+  const struct {
+    const char* lines;
+    bool scurve;
+    std::vector<std::string> warnings;
+  } cases[] = {
+      {"", false, {}},
+      {"MAX_LINEAR_JERK = 50000", true, {}},
+      {"PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 50000", true, {}},
+      {"PLANNER_TYPE = 0\nMAX_LINEAR_JERK = 50000", false, {"MAX_LINEAR_JERK is not applied"}},
+      {"PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 0.5", false, {"needs MAX_LINEAR_JERK >= 1"}},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.lines);
+    const auto result = load(c.lines);
+    ASSERT_TRUE(result.ok());
+    EXPECT_EQ(result.config->scurve, c.scurve);
+    const auto warnings = strings(result.warnings);
+    ASSERT_EQ(warnings.size(), c.warnings.size());
+    for (std::size_t k = 0; k < warnings.size(); ++k)
+      EXPECT_NE(warnings[k].find(c.warnings[k]), std::string::npos) << warnings[k];
+  }
+  EXPECT_EQ(load("MAX_LINEAR_JERK = 50000").config->max_linear_jerk, 50000);
+  EXPECT_EQ(
+      strings(load("PLANNER_TYPE = 1\nMAX_LINEAR_JERK = 0.5").warnings),
+      std::vector<std::string>{
+          at(8) + ": [TRAJ] PLANNER_TYPE: PLANNER_TYPE = 1 (S-curve) needs MAX_LINEAR_JERK >= 1 "
+                  "(got 0.5): planning trapezoidal profiles"});
+  EXPECT_EQ(problems_with(7, "LINEAR_UNITS = mm\nPLANNER_TYPE = 2"),
+            problem_at(8, "[TRAJ] PLANNER_TYPE: 2 is out of range: must be between 0 and 1"));
 }
 
 }  // namespace

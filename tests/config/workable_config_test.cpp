@@ -11,10 +11,10 @@ namespace {
 using WorkableConfigTest = MachineIniTest;
 
 TEST_F(WorkableConfigTest, HomeOutsideTheJointLimitsIsRefused) {
-  EXPECT_EQ(
-      problems_of(replace_line(minimal_ini(), 31, "MAX_ACCELERATION = 500\nHOME = 150")),
-      std::vector<std::string>{at(32) + ": [JOINT_0] HOME: 150 is above MAX_LIMIT 100: "
-                                        "homing would leave the joint beyond its soft limit"});
+  EXPECT_EQ(problems_with(31, "MAX_ACCELERATION = 500\nHOME = 150"),
+            problem_at(32,
+                       "[JOINT_0] HOME: 150 is above MAX_LIMIT 100: homing would leave the joint "
+                       "beyond its soft limit"));
   // Joint limits not given are the axis limits; HOME not given is 0.
   auto ini = replace_line(minimal_ini(), 13, "MIN_LIMIT = 10");
   ini = replace_line(ini, 28, "");
@@ -59,10 +59,10 @@ TEST_F(WorkableConfigTest, GantryLoads) {
 
 TEST_F(WorkableConfigTest, JointOfAnAxisWithoutItsSectionIsRefused) {
   // [JOINT_2] written as [JOINT_3]: LinuxCNC would drive Z at 1 mm/s without joint limits.
-  EXPECT_EQ(problems_of(replace_line(minimal_ini(), 37, "[JOINT_3]")),
-            std::vector<std::string>{at(11) + ": [KINS] JOINTS: JOINTS = 3, but joint 2 (axis Z) "
-                                              "has no [JOINT_2] section; the file has [JOINT_3] "
-                                              "instead, which JOINTS leaves out"});
+  EXPECT_EQ(problems_with(37, "[JOINT_3]"),
+            problem_at(11,
+                       "[KINS] JOINTS: JOINTS = 3, but joint 2 (axis Z) has no [JOINT_2] section; "
+                       "the file has [JOINT_3] instead, which JOINTS leaves out"));
   // A lathe converted from LinuxCNC 2.7 keeps a joint for the Y it does not have: a warning.
   const auto lathe =
       load(replace_line(replace_line(minimal_ini(), 6, "COORDINATES = X Z"), 32, "[SPARE]"));
