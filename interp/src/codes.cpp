@@ -79,53 +79,27 @@ CodeInfo g_code_info(int code) {
 }
 
 CodeInfo m_code_info(int code) {
-  auto make = [](MGroup group, bool supported) {
-    return CodeInfo{static_cast<std::int8_t>(group), supported};
+  // M codes first .. last, their group and whether they are supported.
+  struct Codes {
+    int first;
+    int last;
+    MGroup group;
+    bool supported;
   };
-  switch (code) {
-    case 0:
-    case 1:
-    case 2:
-    case 30:
-    case 60:
-      return make(MGroup::stopping, true);
-    case 3:
-    case 4:
-    case 5:
-      return make(MGroup::spindle, true);
-    case 19:
-      return make(MGroup::spindle, false);
-    case 6:
-    case 61:
-      return make(MGroup::tool_change, true);
-    case 7:
-    case 8:
-    case 9:
-      return make(MGroup::coolant, true);
-    case 48:
-    case 49:
-    case 50:
-    case 51:
-    case 52:
-    case 53:
-      return make(MGroup::overrides, true);
-    case 62:
-    case 63:
-    case 64:
-    case 65:
-    case 66:
-    case 67:
-    case 68:
-      return make(MGroup::io, false);
-    case 70:
-    case 71:
-    case 72:
-    case 73:
-      return make(MGroup::io, false);
-    default:
-      if (code >= 100 && code <= 199) return make(MGroup::user, false);
-      return {};
+  static constexpr Codes kCodes[] = {
+      {0, 2, MGroup::stopping, true},      {30, 30, MGroup::stopping, true},
+      {60, 60, MGroup::stopping, true},    {3, 5, MGroup::spindle, true},
+      {19, 19, MGroup::spindle, false},    {6, 6, MGroup::tool_change, true},
+      {61, 61, MGroup::tool_change, true}, {7, 9, MGroup::coolant, true},
+      {48, 53, MGroup::overrides, true},   {62, 68, MGroup::io, false},
+      {70, 73, MGroup::io, false},         {100, 199, MGroup::user, false},
+  };
+  for (const Codes& codes : kCodes) {
+    if (code >= codes.first && code <= codes.last) {
+      return CodeInfo{static_cast<std::int8_t>(codes.group), codes.supported};
+    }
   }
+  return {};
 }
 
 }  // namespace cncd::interp

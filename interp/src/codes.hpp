@@ -10,32 +10,32 @@ namespace cncd::interp {
 // Modal groups as LinuxCNC numbers them (G: 0..15, M: 4..10).
 enum class GGroup : std::int8_t {
   none = -1,
-  non_modal = 0,
-  motion = 1,
-  plane = 2,
-  distance = 3,
-  arc_distance = 4,
-  feed_mode = 5,
-  units = 6,
-  cutter_comp = 7,
-  tool_length = 8,
+  non_modal,  // 0, then counting up
+  motion,
+  plane,
+  distance,
+  arc_distance,
+  feed_mode,
+  units,
+  cutter_comp,
+  tool_length,  // 8
   retract = 10,
   coord_system = 12,
-  path_control = 13,
-  spindle_mode = 14,
-  lathe_diameter = 15,
+  path_control,
+  spindle_mode,
+  lathe_diameter,  // 15
 };
 inline constexpr int kGGroups = 16;
 
 enum class MGroup : std::int8_t {
   none = -1,
-  stopping = 4,
-  io = 5,
-  tool_change = 6,
-  spindle = 7,
-  coolant = 8,
-  overrides = 9,
-  user = 10,
+  stopping = 4,  // then counting up
+  io,
+  tool_change,
+  spindle,
+  coolant,
+  overrides,
+  user,  // 10
 };
 inline constexpr int kMGroups = 11;
 

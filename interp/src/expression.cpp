@@ -32,30 +32,14 @@ enum class Op : int {
 
 // LinuxCNC's precedence: ** > * / MOD > + - > comparisons > AND OR XOR; all left-associative.
 int precedence(Op op) {
-  switch (op) {
-    case Op::power:
-      return 5;
-    case Op::times:
-    case Op::divide:
-    case Op::mod:
-      return 4;
-    case Op::plus:
-    case Op::minus:
-      return 3;
-    case Op::eq:
-    case Op::ne:
-    case Op::gt:
-    case Op::ge:
-    case Op::lt:
-    case Op::le:
-      return 2;
-    case Op::and_:
-    case Op::or_:
-    case Op::xor_:
-      return 1;
-    case Op::none:
-      break;
+  if (op == Op::power) return 5;
+  if (op == Op::times || op == Op::divide || op == Op::mod) return 4;
+  if (op == Op::plus || op == Op::minus) return 3;
+  if (op == Op::eq || op == Op::ne || op == Op::gt || op == Op::ge || op == Op::lt ||
+      op == Op::le) {
+    return 2;
   }
+  if (op == Op::and_ || op == Op::or_ || op == Op::xor_) return 1;
   return 0;
 }
 

@@ -29,23 +29,24 @@ Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
     std::error_code ec;
     return !std::filesystem::exists(path, ec) && !ec;
   };
-  if (!options_.parameter_file.empty() && missing(options_.parameter_file)) {
-    load_warnings_.push_back(options_.parameter_file.string() +
-                             ": parameter file does not exist; default parameters are used");
-  } else if (!options_.parameter_file.empty()) {
-    if (auto problem = parameters_.load(options_.parameter_file)) {
-      config_error_ = InterpError{options_.parameter_file.string(), 0, 0, *problem};
-      parameter_file_refused_ = true;
+  // Loads `path` when given: nothing when it is not there, else the problem that refused it.
+  auto load = [&](const std::filesystem::path& path, const char* when_missing,
+                  auto&& read) -> std::optional<std::string> {
+    if (path.empty()) return std::nullopt;
+    if (missing(path)) {
+      load_warnings_.push_back(path.string() + when_missing);
+      return std::nullopt;
     }
-  }
-  if (!options_.tool_table.empty() && missing(options_.tool_table)) {
-    load_warnings_.push_back(options_.tool_table.string() +
-                             ": tool table does not exist; the table is empty");
-  } else if (!options_.tool_table.empty()) {
-    if (auto problem = tools_.load(options_.tool_table)) {
-      config_error_ = InterpError{options_.tool_table.string(), 0, 0, *problem};
-    }
-  }
+    auto problem = read(path);
+    if (problem) config_error_ = InterpError{path.string(), 0, 0, *problem};
+    return problem;
+  };
+  parameter_file_refused_ =
+      load(options_.parameter_file, ": parameter file does not exist; default parameters are used",
+           [&](const std::filesystem::path& path) { return parameters_.load(path); })
+          .has_value();
+  load(options_.tool_table, ": tool table does not exist; the table is empty",
+       [&](const std::filesystem::path& path) { return tools_.load(path); });
   reset_modal_state();
 }
 

@@ -6,27 +6,13 @@ namespace cncd::interp {
 
 namespace {
 int plane_code(Plane plane) {
-  switch (plane) {
-    case Plane::yz:
-      return 190;
-    case Plane::xz:
-      return 180;
-    case Plane::xy:
-    default:
-      return 170;
-  }
+  if (plane == Plane::yz) return 190;
+  return plane == Plane::xz ? 180 : 170;
 }
 
 int path_control_code(MotionMode mode) {
-  switch (mode) {
-    case MotionMode::exact_stop:
-      return 611;
-    case MotionMode::exact_path:
-      return 610;
-    case MotionMode::continuous:
-    default:
-      return 640;
-  }
+  if (mode == MotionMode::exact_stop) return 611;
+  return mode == MotionMode::exact_path ? 610 : 640;
 }
 
 bool any_nonzero(const Pose& pose) {
