@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -72,23 +73,31 @@ TEST(StoredValues, ExpressionsThatAreNotFiniteNeverGetThatFar) {
             "1:24: Result is not a finite number (overflow)");
 }
 
-// The error of an MDI block refused because a value is beyond the bound.
-void expect_out_of_range(const std::string& error) {
-  EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
-  EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+// Each of the MDI `blocks` is refused because a value is beyond the bound, and unchanged()
+// checks that it changed nothing.
+template <typename Unchanged>
+void expect_all_refused(Interpreter& interp, std::initializer_list<const char*> blocks,
+                        Unchanged unchanged) {
+  for (const char* block : blocks) {
+    SCOPED_TRACE(block);
+    const std::string error = mdi_error(interp, block);
+    EXPECT_TRUE(starts_with(error, "MDI:1:")) << error;
+    EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+    unchanged();
+  }
 }
 
 TEST(StoredValues, G10OriginsBeyondTheBoundAreRefusedAndChangeNothing) {
   Interpreter interp;
-  for (const char* block : {"G10 L2 P1 X5 Y[10**10]", "G10 L20 P1 X5 Y[-10**10]",
-                            "G10 L2 P1 X5 R[10**10]", "G10 L2 P2 X5 Y[10**299*10]"}) {
-    SCOPED_TRACE(block);
-    expect_out_of_range(mdi_error(interp, block));
-    double rotation = 0;
-    EXPECT_EQ(interp.coord_system_origin(1, &rotation)[0], 0.0);
-    EXPECT_EQ(interp.coord_system_origin(2)[0], 0.0);
-    EXPECT_EQ(rotation, 0.0);
-  }
+  expect_all_refused(interp,
+                     {"G10 L2 P1 X5 Y[10**10]", "G10 L20 P1 X5 Y[-10**10]",
+                      "G10 L2 P1 X5 R[10**10]", "G10 L2 P2 X5 Y[10**299*10]"},
+                     [&] {
+                       double rotation = 0;
+                       EXPECT_EQ(interp.coord_system_origin(1, &rotation)[0], 0.0);
+                       EXPECT_EQ(interp.coord_system_origin(2)[0], 0.0);
+                       EXPECT_EQ(rotation, 0.0);
+                     });
   // In inches, the bound is on the machine's value (mm here).
   EXPECT_NE(mdi_error(interp, "G20 G10 L2 P1 X[10**9/25]").find("out of range"), std::string::npos);
   EXPECT_EQ(mdi_error(interp, "G21"), "");
@@ -96,14 +105,12 @@ TEST(StoredValues, G10OriginsBeyondTheBoundAreRefusedAndChangeNothing) {
 
 TEST(StoredValues, G92AndG52BeyondTheBoundAreRefusedAndChangeNothing) {
   Interpreter interp;
-  for (const char* block : {"G92 X[10**299*10]", "G92 X1 Y[-10**10]", "G52 Z[10**10]"}) {
-    SCOPED_TRACE(block);
-    expect_out_of_range(mdi_error(interp, block));
+  expect_all_refused(interp, {"G92 X[10**299*10]", "G92 X1 Y[-10**10]", "G52 Z[10**10]"}, [&] {
     const InterpState s = interp.state();
     for (double v : s.g92_offset)
       EXPECT_EQ(v, 0.0);
     EXPECT_EQ(s.gcodes[16], -1);  // G92 not switched on either
-  }
+  });
   // The machine still answers normally after the refusals.
   EXPECT_EQ(mdi_error(interp, "G92 X2"), "");
   EXPECT_EQ(interp.state().g92_offset[0], -2.0);
@@ -111,18 +118,13 @@ TEST(StoredValues, G92AndG52BeyondTheBoundAreRefusedAndChangeNothing) {
 
 TEST(StoredValues, ToolDataAndToolLengthsBeyondTheBoundAreRefused) {
   Interpreter interp;
-  for (const char* block : {"G10 L1 P1 Z[10**10]", "G10 L10 P1 Z[-10**10]",
-                            "G10 L11 P1 Z[10**299*10]", "G10 L1 P1 Z1 R[10**10]"}) {
-    SCOPED_TRACE(block);
-    expect_out_of_range(mdi_error(interp, block));
-    EXPECT_FALSE(interp.tool(1).has_value());
-  }
+  expect_all_refused(interp,
+                     {"G10 L1 P1 Z[10**10]", "G10 L10 P1 Z[-10**10]", "G10 L11 P1 Z[10**299*10]",
+                      "G10 L1 P1 Z1 R[10**10]"},
+                     [&] { EXPECT_FALSE(interp.tool(1).has_value()); });
   EXPECT_EQ(mdi_error(interp, "G10 L1 P1 Z5"), "");
-  for (const char* block : {"G43.1 Z[10**10]", "G43.1 X[-10**299*10]"}) {
-    SCOPED_TRACE(block);
-    expect_out_of_range(mdi_error(interp, block));
-    EXPECT_EQ(interp.state().tool_offset[2], 0.0);
-  }
+  expect_all_refused(interp, {"G43.1 Z[10**10]", "G43.1 X[-10**299*10]"},
+                     [&] { EXPECT_EQ(interp.state().tool_offset[2], 0.0); });
 }
 
 TEST(StoredValues, StoredPositionsBeyondTheBoundAreRefused) {
