@@ -89,12 +89,17 @@ TEST(PathExecutor, RunsALineToItsEndWithinItsLimits) {
     EXPECT_LE(std::abs(r.velocity[k] - r.velocity[k - 1]), 1000 * kDt + 1e-9) << k;
 }
 
+// Queues two lines along X, from 0 to `mid` and on to `end`, the first one blending.
+void push_two_lines(PathExecutor& path, double mid, double end) {
+  ASSERT_TRUE(path.segments().push(line(at(0), at(mid), 0, true)));
+  ASSERT_TRUE(path.segments().push(line(at(mid), at(end))));
+}
+
 TEST(PathExecutor, CrossesATangentJunctionAtSpeed) {
   const auto config = test::small_mill();
   auto path = make(config);
   AxisPose pose{};
-  ASSERT_TRUE(path->segments().push(line(at(0), at(20), 0, true)));
-  ASSERT_TRUE(path->segments().push(line(at(20), at(40))));
+  ASSERT_NO_FATAL_FAILURE(push_two_lines(*path, 20, 40));
   const PathRun r = run(*path, pose);
   EXPECT_DOUBLE_EQ(pose[0], 40.0);
   EXPECT_EQ(path->segments_done(), 2u);
@@ -168,8 +173,7 @@ TEST(PathExecutor, AbortStopsUnderControlAndDropsTheQueue) {
   const auto config = test::small_mill();
   auto path = make(config);
   AxisPose pose{};
-  ASSERT_TRUE(path->segments().push(line(at(0), at(50), 0, true)));
-  ASSERT_TRUE(path->segments().push(line(at(50), at(100))));
+  ASSERT_NO_FATAL_FAILURE(push_two_lines(*path, 50, 100));
   for (int k = 0; k < 150; ++k)
     path->advance(kDt, pose, false);
   path->abort();

@@ -1,6 +1,7 @@
 // The servo loop in virtual time: estop, pause/resume, abort, faults, homing, dwell.
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,18 @@ using motion::Command;
 using motion::MachineState;
 using motion::MotionState;
 using motion::Move;
+
+// Queues feed moves at 100 mm/s through each (X, Y) in turn, at Z 0.
+void feed_through(VirtualMachine& m, std::initializer_list<std::pair<double, double>> points) {
+  for (const auto& [x, y] : points)
+    m.queue(line_to(Move::Kind::feed, x, y, 0, 100));
+}
+
+// Queues a feed move at 100 mm/s to (X, Y) at Z 0 and runs `periods` periods of it.
+void feed_for(VirtualMachine& m, double x, double y, int periods) {
+  m.queue(line_to(Move::Kind::feed, x, y, 0, 100));
+  m.cycles(periods);
+}
 
 TEST(ServoLoop, StartsInEstopAndOnNeedsReset) {
   VirtualMachine m(small_mill());
@@ -29,8 +42,7 @@ TEST(ServoLoop, StartsInEstopAndOnNeedsReset) {
 TEST(ServoLoop, EstopStopsWithinOnePeriodAndFlushes) {
   VirtualMachine m(small_mill());
   m.ready();
-  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
-  m.queue(line_to(Move::Kind::feed, 100, 100, 0, 100));
+  feed_through(m, {{100, 0}, {100, 100}});
   m.cycles(300);
   EXPECT_TRUE(m.drives_enabled());
   m.command(Command::Kind::estop);
@@ -48,8 +60,7 @@ TEST(ServoLoop, EstopStopsWithinOnePeriodAndFlushes) {
 TEST(ServoLoop, PauseHoldsOnThePathAndResumeFinishes) {
   VirtualMachine m(small_mill());
   m.ready();
-  m.queue(line_to(Move::Kind::feed, 100, 50, 0, 100));
-  m.cycles(400);
+  feed_for(m, 100, 50, 400);
   m.command(Command::Kind::pause);
   m.cycles(200);  // 100 mm/s stops in 0.05 s at 2000 mm/s^2 (along the path, less)
   const auto held = m.status();
@@ -91,8 +102,7 @@ TEST(ServoLoop, PauseOnAnArcStaysOnTheCircle) {
 TEST(ServoLoop, AbortStopsUnderControlAndFlushes) {
   VirtualMachine m(small_mill());
   m.ready();
-  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
-  m.queue(line_to(Move::Kind::feed, 0, 0, 0, 100));
+  feed_through(m, {{100, 0}, {0, 0}});
   m.cycles(500);
   m.command(Command::Kind::abort);
   m.run_until_idle(1000);
@@ -149,8 +159,7 @@ TEST(ServoLoop, DriveFaultAndStaleFeedbackLatch) {
 TEST(ServoLoop, LimitSwitchLatches) {
   VirtualMachine m(small_mill());
   m.ready();
-  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
-  m.cycles(100);
+  feed_for(m, 100, 0, 100);
   m.sim().set_limit(0, false, true);
   m.cycles(1);
   const auto s = m.status();
@@ -335,8 +344,7 @@ TEST(ServoLoop, AGantryJointHomedApartFaultsInsteadOfJumping) {
   VirtualMachine m(config);
   m.ready();
   EXPECT_EQ(m.status().joint_commanded[2], 3);
-  m.queue(line_to(Move::Kind::feed, 0, 10, 0, 100));
-  m.cycles(1);
+  feed_for(m, 0, 10, 1);
   EXPECT_EQ(m.status().machine, MachineState::off);
   EXPECT_NE(std::strstr(m.status().fault_reason, "joint 2 stands apart from axis Y"), nullptr)
       << m.status().fault_reason;
@@ -346,8 +354,7 @@ TEST(ServoLoop, AGantryJointHomedApartFaultsInsteadOfJumping) {
 TEST(ServoLoop, MachineOffStopsAtOnceAndDisables) {
   VirtualMachine m(small_mill());
   m.ready();
-  m.queue(line_to(Move::Kind::feed, 100, 0, 0, 100));
-  m.cycles(200);
+  feed_for(m, 100, 0, 200);
   m.command(Command::Kind::off);
   const auto s = m.status();
   EXPECT_EQ(s.machine, MachineState::off);
