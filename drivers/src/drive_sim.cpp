@@ -258,28 +258,23 @@ void DriveSim::set_fault(int slave, bool fault) noexcept {
 }
 
 std::int32_t DriveSim::target(int slave) const noexcept {
-  const Drive* d = drive(slave);
-  return d != nullptr ? d->target.load() : 0;
+  return load(slave, &Drive::target);
 }
 
 std::int32_t DriveSim::actual(int slave) const noexcept {
-  const Drive* d = drive(slave);
-  return d != nullptr ? d->actual.load() : 0;
+  return load(slave, &Drive::actual);
 }
 
 std::uint16_t DriveSim::control(int slave) const noexcept {
-  const Drive* d = drive(slave);
-  return d != nullptr ? d->control.load() : 0;
+  return load(slave, &Drive::control);
 }
 
 std::uint16_t DriveSim::status(int slave) const noexcept {
-  const Drive* d = drive(slave);
-  return d != nullptr ? d->status.load() : 0;
+  return load(slave, &Drive::status);
 }
 
 std::uint64_t DriveSim::target_writes(int slave) const noexcept {
-  const Drive* d = drive(slave);
-  return d != nullptr ? d->target_writes.load() : 0;
+  return load(slave, &Drive::target_writes);
 }
 
 }  // namespace cncd::drivers

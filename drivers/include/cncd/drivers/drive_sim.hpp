@@ -78,6 +78,12 @@ class DriveSim {
   };
   Drive* drive(int slave) noexcept;
   const Drive* drive(int slave) const noexcept;
+  // `field` of the drive at `slave`; 0 when there is none.
+  template <typename T>
+  T load(int slave, const std::atomic<T> Drive::*field) const noexcept {
+    const Drive* d = drive(slave);
+    return d != nullptr ? (d->*field).load() : T{};
+  }
   void serve_tcp();
   void serve_rtu();
   void relay();
