@@ -71,6 +71,15 @@ class ModbusDriverTest : public ::testing::Test {
       servo(1, x, y, enable);
     return done();
   }
+  // Runs both drives at (x, y), then sets drive 11's fault bit; whether the driver reports it
+  // within 2000 periods.
+  bool run_until_drive_11_faults(double x, double y) {
+    start_sim();
+    start_driver();
+    servo(30, x, y, true);
+    sim_->set_fault(11, true);
+    return servo_until([&] { return feedback_[1].fault; }, 2000, x, y, true);
+  }
   bool faulted(int joint) const { return feedback_[joint].fault || feedback_[joint].stale; }
   std::string reason() const {
     char text[drivers::kFaultReasonSize];
@@ -186,11 +195,7 @@ TEST_F(ModbusDriverTest, KilledDriveLatchesAFaultAndWorksAgainOnlyAfterReset) {
 }
 
 TEST_F(ModbusDriverTest, DriveFaultBitLatchesAndIsResetThroughTheControlWord) {
-  start_sim();
-  start_driver();
-  servo(30, 0, 0, true);
-  sim_->set_fault(11, true);
-  EXPECT_TRUE(servo_until([&] { return feedback_[1].fault; }, 2000, 0, 0, true));
+  EXPECT_TRUE(run_until_drive_11_faults(0, 0));
   EXPECT_FALSE(feedback_[0].fault);
   EXPECT_NE(reason().find("slave 11 (joint 1): drive reports a fault"), std::string::npos)
       << reason();
@@ -250,11 +255,7 @@ TEST_F(ModbusDriverTest, SetpointsStoredWithoutPauseReachTheDriveWhole) {
 }
 
 TEST_F(ModbusDriverTest, ALatchedFaultStaysLatchedWhileSetpointsKeepComing) {
-  start_sim();
-  start_driver();
-  servo(30, 0.1, 0.2, true);
-  sim_->set_fault(11, true);
-  ASSERT_TRUE(servo_until([&] { return feedback_[1].fault; }, 2000, 0.1, 0.2, true));
+  ASSERT_TRUE(run_until_drive_11_faults(0.1, 0.2));
   sim_->set_fault(11, false);  // the drive could be reset now, but nobody asked
   BusyServo busy(driver_, 0.1, 0.2);
   const std::uint64_t writes = sim_->target_writes(11);
