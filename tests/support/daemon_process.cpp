@@ -154,8 +154,12 @@ std::string DaemonProcess::start(const std::filesystem::path& dir,
 }
 
 int DaemonProcess::stop() {
+  return end_with(SIGTERM);
+}
+
+int DaemonProcess::end_with(int signal) {
   if (pid_ <= 0) return -1;
-  kill(pid_, SIGTERM);
+  kill(pid_, signal);
   int status = 0;
   waitpid(pid_, &status, 0);
   pid_ = -1;
@@ -167,12 +171,7 @@ void DaemonProcess::signal(int signal) {
 }
 
 int DaemonProcess::kill_hard() {
-  if (pid_ <= 0) return -1;
-  kill(pid_, SIGKILL);
-  int status = 0;
-  waitpid(pid_, &status, 0);
-  pid_ = -1;
-  return decode_status(status);
+  return end_with(SIGKILL);
 }
 
 std::string DaemonProcess::log() const {

@@ -70,6 +70,9 @@ class DaemonProcess {
   std::string log() const;
 
  private:
+  // Sends `signal` and waits; the exit status.
+  int end_with(int signal);
+
   pid_t pid_ = -1;
   bool default_state_dir_ = false;
   std::string socket_;
