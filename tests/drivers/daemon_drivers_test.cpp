@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "client.hpp"
+#include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "test_util.hpp"
 
@@ -246,11 +247,7 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   const json stopped = wait_until([](const json& s) { return s["exec"] == "idle"; });
   EXPECT_NE(stopped["program"]["result"], "done");
   // The daemon is alive and commands nothing further.
-  const double x = stopped["position"]["commanded"]["x"];
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  const json later = result(client.call("status.get"));
-  EXPECT_EQ(later["position"]["commanded"]["x"].get<double>(), x);
-  EXPECT_LT(x, 200.0);
+  expect_stopped_short_of_x200(client, stopped, std::chrono::milliseconds(300));
 
   // The drives come back: after an explicit reset the machine runs again. The port may stay
   // taken for a moment by the daemon's own reconnection attempts (a loopback connection to a
@@ -263,7 +260,7 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   ASSERT_EQ(restarted, "");
   const json refused = client.call("program.run");
   EXPECT_TRUE(refused.contains("error")) << refused.dump();
-  if (later["state"] == "estop") result(client.call("machine.reset"));
+  if (result(client.call("status.get"))["state"] == "estop") result(client.call("machine.reset"));
   // Until the restarted drives answer, turning on trips over their stale or moved feedback;
   // an operator tries again, and so does this test.
   wait_until([&](const json&) {
