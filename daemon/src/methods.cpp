@@ -44,6 +44,15 @@ std::uint32_t joint_mask(const json& params) {
   return mask;
 }
 
+// A method without parameters that hands one command to the task and answers ok.
+void add_command(RpcDispatcher& dispatcher, Task& task, const char* method,
+                 void (Task::*command)()) {
+  dispatcher.add(method, [&task, command](const json&) {
+    (task.*command)();
+    return ok();
+  });
+}
+
 }  // namespace
 
 void register_methods(RpcDispatcher& dispatcher, Task& task, const config::MachineConfig& config,
@@ -96,14 +105,8 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     session.fields.clear();
     return ok();
   });
-  dispatcher.add("machine.estop", [&task](const json&) {
-    task.estop();
-    return ok();
-  });
-  dispatcher.add("machine.reset", [&task](const json&) {
-    task.reset();
-    return ok();
-  });
+  add_command(dispatcher, task, "machine.estop", &Task::estop);
+  add_command(dispatcher, task, "machine.reset", &Task::reset);
   dispatcher.add("machine.on", [&task, &completions](const json&, Session& session) {
     // Answered once the drives have had the time to report a fault; a batch waits for it.
     const auto token = session.in_batch ? 0 : completions.next_token();
@@ -111,10 +114,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     session.defer_token = token;
     return json();
   });
-  dispatcher.add("machine.off", [&task](const json&) {
-    task.machine_off();
-    return ok();
-  });
+  add_command(dispatcher, task, "machine.off", &Task::machine_off);
   const double last_joint = static_cast<double>(config.joints.size()) - 1;
   dispatcher.add("machine.home",
                  [&task](const json& params) {
@@ -142,18 +142,9 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     task.run_program(params.value("from_line", 0));
     return ok();
   });
-  dispatcher.add("program.step", [&task](const json&) {
-    task.step();
-    return ok();
-  });
-  dispatcher.add("program.pause", [&task](const json&) {
-    task.pause();
-    return ok();
-  });
-  dispatcher.add("program.resume", [&task](const json&) {
-    task.resume();
-    return ok();
-  });
+  add_command(dispatcher, task, "program.step", &Task::step);
+  add_command(dispatcher, task, "program.pause", &Task::pause);
+  add_command(dispatcher, task, "program.resume", &Task::resume);
   dispatcher.add("program.abort", [&task, &completions](const json&, Session& session) {
     if (session.in_batch) {
       task.abort();

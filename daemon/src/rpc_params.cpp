@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 namespace cncd::daemon {
 
@@ -34,20 +35,41 @@ bool has_range(ParamType type) {
 }
 
 std::string_view kind(const json& value) {
-  switch (value.type()) {
-    case json::value_t::array:
-      return "an array";
-    case json::value_t::object:
-      return "an object";
-    case json::value_t::string:
-      return "a string";
-    case json::value_t::boolean:
-      return "a boolean";
-    case json::value_t::null:
-      return "null";
-    default:
-      return "a number";
+  static constexpr std::pair<json::value_t, std::string_view> kKinds[] = {
+      {json::value_t::array, "an array"},  {json::value_t::object, "an object"},
+      {json::value_t::string, "a string"}, {json::value_t::boolean, "a boolean"},
+      {json::value_t::null, "null"},
+  };
+  for (const auto& [type, words] : kKinds) {
+    if (value.type() == type) return words;
   }
+  return "a number";
+}
+
+// How the method help and the refusals speak of each parameter type.
+struct TypeWords {
+  ParamType type;
+  std::string_view name;       // "array of strings"
+  std::string_view described;  // "an array of strings", with what it looks like where unclear
+};
+
+constexpr TypeWords kTypeWords[] = {
+    {ParamType::integer, "integer", "an integer"},
+    {ParamType::number, "number", "a number"},
+    {ParamType::string, "string", "a string"},
+    {ParamType::string_list, "array of strings", "an array of strings"},
+    {ParamType::integer_list, "array of integers", "an array of integers"},
+    {ParamType::axis_values, "object of axis values",
+     "an object of axis values such as {\"x\": 1.5}"},
+    {ParamType::coord_system, "string or integer",
+     "a coordinate system, \"G54\" .. \"G59.3\" or 1 .. 9"},
+};
+
+const TypeWords* words_of(ParamType type) {
+  for (const auto& words : kTypeWords) {
+    if (words.type == type) return &words;
+  }
+  return nullptr;
 }
 
 bool in_range(const ParamSpec& param, const json& number) {
@@ -137,50 +159,13 @@ std::string quoted_text(std::string_view text) {
 }
 
 std::string_view type_name(ParamType type) {
-  switch (type) {
-    case ParamType::integer:
-      return "integer";
-    case ParamType::number:
-      return "number";
-    case ParamType::string:
-      return "string";
-    case ParamType::string_list:
-      return "array of strings";
-    case ParamType::integer_list:
-      return "array of integers";
-    case ParamType::axis_values:
-      return "object of axis values";
-    case ParamType::coord_system:
-      return "string or integer";
-  }
-  return "?";
+  const TypeWords* words = words_of(type);
+  return words != nullptr ? words->name : "?";
 }
 
 std::string describe(const ParamSpec& param) {
-  std::string text;
-  switch (param.type) {
-    case ParamType::integer:
-      text = "an integer";
-      break;
-    case ParamType::number:
-      text = "a number";
-      break;
-    case ParamType::string:
-      text = "a string";
-      break;
-    case ParamType::string_list:
-      text = "an array of strings";
-      break;
-    case ParamType::integer_list:
-      text = "an array of integers";
-      break;
-    case ParamType::axis_values:
-      text = "an object of axis values such as {\"x\": 1.5}";
-      break;
-    case ParamType::coord_system:
-      text = "a coordinate system, \"G54\" .. \"G59.3\" or 1 .. 9";
-      break;
-  }
+  const TypeWords* words = words_of(param.type);
+  std::string text = words != nullptr ? std::string(words->described) : std::string();
   if (has_range(param.type)) {
     const bool low = std::isfinite(param.min);
     const bool high = std::isfinite(param.max);
