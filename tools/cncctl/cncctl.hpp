@@ -40,6 +40,9 @@ std::string axes_text(const nlohmann::json& axes);
 double number_arg(const std::string& text, const std::string& what);
 // The status as readable lines.
 void print_status(const nlohmann::json& s);
+// What `method` answers: pretty JSON with --json, else as `print` writes it. Returns kDone.
+int show(daemon::Client& client, const char* method, bool json_output,
+         void (*print)(const nlohmann::json&));
 
 // `watch [--interval MS] [--count N]`
 int watch(daemon::Client& client, const Args& args, bool json_output);

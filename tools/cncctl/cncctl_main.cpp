@@ -177,15 +177,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     if (json_output) std::printf("%s\n", result.dump().c_str());
     return kDone;
   };
-  if (command == "status") {
-    const json s = result_of(client.call("status.get"));
-    if (json_output) {
-      std::printf("%s\n", s.dump(2).c_str());
-    } else {
-      print_status(s);
-    }
-    return kDone;
-  }
+  if (command == "status") return show(client, "status.get", json_output, print_status);
   static const std::vector<std::string> kTakeArgs = {"home", "run",      "mdi",   "open",
                                                      "step", "watch",    "tools", "offsets",
                                                      "jog",  "override", "errors"};

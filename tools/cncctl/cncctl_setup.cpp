@@ -55,15 +55,7 @@ void print_offsets(const json& offsets) {
 }  // namespace
 
 int tools(daemon::Client& client, const Args& args, bool json_output) {
-  if (args.size() == 1) {
-    const json list = result_of(client.call("tool.list"));
-    if (json_output) {
-      std::printf("%s\n", list.dump(2).c_str());
-    } else {
-      print_tools(list);
-    }
-    return kDone;
-  }
+  if (args.size() == 1) return show(client, "tool.list", json_output, print_tools);
   if (args[1] != "set" || args.size() < 3) {
     throw UsageError{"tools takes no arguments, or: tools set T<n> [P..] [X..] [D..] [;comment]"};
   }
@@ -108,15 +100,7 @@ int tools(daemon::Client& client, const Args& args, bool json_output) {
 }
 
 int offsets(daemon::Client& client, const Args& args, bool json_output) {
-  if (args.size() == 1) {
-    const json list = result_of(client.call("offsets.get"));
-    if (json_output) {
-      std::printf("%s\n", list.dump(2).c_str());
-    } else {
-      print_offsets(list);
-    }
-    return kDone;
-  }
+  if (args.size() == 1) return show(client, "offsets.get", json_output, print_offsets);
   if (args[1] != "set" || args.size() < 4) {
     throw UsageError{"offsets takes no arguments, or: offsets set G54..G59.3 [X..] [R..]"};
   }

@@ -20,6 +20,16 @@ json result_of(const json& response) {
   return response.value("result", json());
 }
 
+int show(daemon::Client& client, const char* method, bool json_output, void (*print)(const json&)) {
+  const json answer = result_of(client.call(method));
+  if (json_output) {
+    std::printf("%s\n", answer.dump(2).c_str());
+  } else {
+    print(answer);
+  }
+  return kDone;
+}
+
 std::string axes_text(const json& axes) {
   std::string out;
   char buf[64];
