@@ -11,11 +11,6 @@ using nlohmann::json;
 
 class CncctlTest : public MachineTest {
  protected:
-  CommandResult cncctl(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{CNCCTL_BINARY, "--socket", daemon_.socket()};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run_command(argv);
-  }
   void ready() {
     for (const char* command : {"reset", "on", "home"})
       ASSERT_EQ(cncctl({command}).exit_status, 0) << command;

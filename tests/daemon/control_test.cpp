@@ -41,9 +41,7 @@ TEST_F(MachineTest, PauseStopsAtOnceWhateverIsQueued) {
 
 TEST_F(MachineTest, MachineOffEndsAProgramAndStopsTheMachine) {
   ready_machine();
-  const auto program = dir_.write("long.ngc", "G21 G90 G1 F600 X100\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.run"));
+  start_program("long.ngc", "G21 G90 G1 F600 X100\nM2\n");
   wait_until([](const json& s) { return s["position"]["commanded"]["x"].get<double>() > 0.5; });
   result_of(call("machine.off"));
   json s = status();

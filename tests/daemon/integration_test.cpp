@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "client.hpp"
+#include "client_checks.hpp"
 #include "daemon_process.hpp"
 
 namespace cncd::test {
@@ -146,11 +147,7 @@ TEST_F(DaemonTest, EstopDuringMotionStopsTheProgram) {
   const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
   EXPECT_EQ(s["state"], "estop");
   EXPECT_EQ(s["program"]["result"], "aborted");
-  const double x = s["position"]["commanded"]["x"];
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  const json later = result(client_.call("status.get"));
-  EXPECT_EQ(later["position"]["commanded"]["x"].get<double>(), x);
-  EXPECT_LT(x, 200.0);
+  expect_stopped_short_of_x200(client_, s, std::chrono::milliseconds(100));
 }
 
 TEST_F(DaemonTest, MdiAnswersOnceTheLineHasFinished) {

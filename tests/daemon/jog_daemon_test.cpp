@@ -10,11 +10,6 @@ using nlohmann::json;
 
 class JogTest : public MachineTest {
  protected:
-  CommandResult cncctl(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{CNCCTL_BINARY, "--socket", daemon_.socket()};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run_command(argv);
-  }
   double x() { return status()["position"]["commanded"]["x"].get<double>(); }
 };
 

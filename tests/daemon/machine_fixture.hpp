@@ -38,6 +38,13 @@ inline const std::vector<std::string>& served_methods() {
   return methods;
 }
 
+// cncctl with `args`, talking to the daemon at `socket`.
+inline CommandResult run_cncctl(const std::string& socket, const std::vector<std::string>& args) {
+  std::vector<std::string> argv{CNCCTL_BINARY, "--socket", socket};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return run_command(argv);
+}
+
 class MachineTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -50,6 +57,17 @@ class MachineTest : public ::testing::Test {
     return client_.call(method, params, 30000);
   }
   nlohmann::json status() { return result_of(call("status.get")); }
+  // Writes `text` to `name` in the test's directory, opens it and starts it with `method`
+  // (program.run or program.step).
+  void start_program(const std::string& name, const std::string& text,
+                     const char* method = "program.run") {
+    const auto program = dir_.write(name, text);
+    result_of(call("program.open", {{"path", program.string()}}));
+    result_of(call(method));
+  }
+  CommandResult cncctl(const std::vector<std::string>& args) {
+    return run_cncctl(daemon_.socket(), args);
+  }
 
   // Out of estop, on and homed.
   void ready_machine() {

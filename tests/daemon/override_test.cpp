@@ -96,9 +96,7 @@ TEST_F(MachineTest, HalfFeedOverrideTakesTwiceAsLong) {
 
 TEST_F(MachineTest, ZeroFeedOverrideHoldsMotionUntilRaised) {
   ready_machine();
-  const auto program = dir_.write("hold.ngc", "G21 G90 G1 F600 X20\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.run"));
+  start_program("hold.ngc", "G21 G90 G1 F600 X20\nM2\n");
   wait_until([](const json& st) { return st["position"]["commanded"]["x"].get<double>() > 1.0; });
   result_of(call("override.feed", {{"value", 0}}));
   json s = wait_until([](const json& st) { return st["velocity"].get<double>() == 0.0; });
@@ -120,9 +118,7 @@ TEST_F(MachineTest, ZeroFeedOverrideHoldsMotionUntilRaised) {
 TEST_F(MachineTest, RapidOverrideCapsTraverses) {
   ready_machine();
   result_of(call("override.rapid", {{"value", 0.1}}));
-  const auto program = dir_.write("rapid.ngc", "G21 G90 G0 X30\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.run"));
+  start_program("rapid.ngc", "G21 G90 G0 X30\nM2\n");
   // Sim mill X: 200 mm/s at most; at 10 % no faster than 20 mm/s.
   double fastest = 0;
   const json s = wait_until([&fastest](const json& st) {

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "daemon_process.hpp"
 #include "server.hpp"
 
 namespace cncd::daemon {
@@ -18,20 +19,22 @@ namespace fs = std::filesystem;
 
 class PersistTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("cncd-persist-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string read(const fs::path& p) {
     std::ifstream in(p);
     std::stringstream s;
     s << in.rdbuf();
     return s.str();
   }
-  fs::path dir_;
+  // Why a position file holding `content` is refused (for three joints).
+  std::string corrupt_file_error(const std::string& content) {
+    const auto file = dir_ / "position.txt";
+    std::ofstream(file) << content;
+    std::string error;
+    EXPECT_FALSE(read_position_file(file, std::vector<JointRange>(3), error).has_value());
+    return error;
+  }
+  test::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 TEST_F(PersistTest, ReplacesTheFileAndLeavesNoTemporary) {
@@ -75,18 +78,12 @@ TEST_F(PersistTest, MissingPositionFileIsNotAnError) {
 }
 
 TEST_F(PersistTest, CorruptPositionFileNamesFileAndLine) {
-  const auto file = dir_ / "position.txt";
-  std::ofstream(file) << "1.0\nbanana\n3.0\n";
-  std::string error;
-  EXPECT_FALSE(read_position_file(file, std::vector<JointRange>(3), error).has_value());
+  const std::string error = corrupt_file_error("1.0\nbanana\n3.0\n");
   EXPECT_NE(error.find("position.txt:2"), std::string::npos) << error;
 }
 
 TEST_F(PersistTest, EmptyOrShortPositionFileIsCorrupt) {
-  const auto file = dir_ / "position.txt";
-  std::ofstream(file) << "";
-  std::string error;
-  EXPECT_FALSE(read_position_file(file, std::vector<JointRange>(3), error).has_value());
+  const std::string error = corrupt_file_error("");
   EXPECT_NE(error.find("0 positions"), std::string::npos) << error;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -61,23 +62,17 @@ std::vector<json> wrong_values(ParamType type) {
 }
 
 std::string type_phrase(ParamType type) {
-  switch (type) {
-    case ParamType::integer:
-      return "an integer";
-    case ParamType::number:
-      return "a number";
-    case ParamType::string:
-      return "a string";
-    case ParamType::string_list:
-      return "an array of strings";
-    case ParamType::integer_list:
-      return "an array of integers";
-    case ParamType::axis_values:
-      return "an object of axis values";
-    case ParamType::coord_system:
-      return "a coordinate system";
-  }
-  return "?";
+  static const std::map<ParamType, std::string> kPhrases = {
+      {ParamType::integer, "an integer"},
+      {ParamType::number, "a number"},
+      {ParamType::string, "a string"},
+      {ParamType::string_list, "an array of strings"},
+      {ParamType::integer_list, "an array of integers"},
+      {ParamType::axis_values, "an object of axis values"},
+      {ParamType::coord_system, "a coordinate system"},
+  };
+  const auto it = kPhrases.find(type);
+  return it != kPhrases.end() ? it->second : "?";
 }
 
 class RpcParamsTest : public MachineTest {

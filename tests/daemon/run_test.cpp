@@ -60,9 +60,7 @@ TEST_F(MachineTest, RunFromALineAfterTheProgramEndFails) {
 
 TEST_F(MachineTest, StepRunsOneLineAtATimeAndResumeRunsOn) {
   ready_machine();
-  const auto program = dir_.write("steps.ngc", "G21 G90 G0 X1\nG0 X2\nG0 X3\nG0 X4\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.step"));
+  start_program("steps.ngc", "G21 G90 G0 X1\nG0 X2\nG0 X3\nG0 X4\nM2\n", "program.step");
   json s = wait_until([](const json& st) { return st["exec"] == "paused"; });
   EXPECT_EQ(s["position"]["commanded"]["x"], 1.0);
   EXPECT_EQ(s["program"]["stepping"], true);
@@ -84,9 +82,7 @@ TEST_F(MachineTest, StepRunsOneLineAtATimeAndResumeRunsOn) {
 
 TEST_F(MachineTest, StepWhileAStepRunsIsRefused) {
   ready_machine();
-  const auto program = dir_.write("long.ngc", "G21 G90 G1 F600 X50\nG0 X0\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.step"));
+  start_program("long.ngc", "G21 G90 G1 F600 X50\nG0 X0\nM2\n", "program.step");
   EXPECT_EQ(error_code(call("program.step")), 1004);
   result_of(call("program.abort"));
   EXPECT_EQ(status()["program"]["result"], "aborted");
@@ -107,9 +103,7 @@ TEST_F(MachineTest, AFanucStyleProgramNumberLineIsIgnoredAsLinuxCncDoes) {
 
 TEST_F(MachineTest, M60PausesLikeM0AndResumeRunsOn) {
   ready_machine();
-  const auto program = dir_.write("m60.ngc", "G21 G90\nG0 X5\nM60\nG0 X9\nM2\n");
-  result_of(call("program.open", {{"path", program.string()}}));
-  result_of(call("program.run"));
+  start_program("m60.ngc", "G21 G90\nG0 X5\nM60\nG0 X9\nM2\n");
   auto s = wait_until([](const json& st) { return st["exec"] == "paused"; });
   EXPECT_EQ(s["position"]["commanded"]["x"], 5.0);
   result_of(call("program.resume"));

@@ -109,6 +109,11 @@ class SaveFailureTest : public ::testing::Test {
   daemon::Client client_;
 };
 
+// The answer to a request whose change could not be saved: error 1007.
+void expect_not_saved(const json& answer) {
+  EXPECT_EQ(error_code(answer), 1007) << answer.dump();
+}
+
 TEST_F(SaveFailureTest, OffsetsSetOnAFullDiskAnswers1007AndKeepsTheOldOrigin) {
   const json before = origin("G55");
   fill_disk();
@@ -128,8 +133,7 @@ TEST_F(SaveFailureTest, OffsetsSetOnAReadOnlyDiskAnswers1007AndKeepsTheOldOrigin
   make_read_only();
   // The active system: the work position would move with it.
   const json status_before = result_of(call("status.get"));
-  const json r = call("offsets.set", {{"system", "G54"}, {"origin", {{"x", -7}, {"z", 2}}}});
-  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  expect_not_saved(call("offsets.set", {{"system", "G54"}, {"origin", {{"x", -7}, {"z", 2}}}}));
   EXPECT_EQ(origin("G54"), before);
   const json status_after = result_of(call("status.get"));
   EXPECT_EQ(status_after["work_position"], status_before["work_position"]);
@@ -140,8 +144,7 @@ TEST_F(SaveFailureTest, OffsetsSetOnAReadOnlyDiskAnswers1007AndKeepsTheOldOrigin
 TEST_F(SaveFailureTest, ToolSetOnAFullDiskAnswers1007AndKeepsTheOldEntry) {
   const json before = result_of(call("tool.list"))["tools"];
   fill_disk();
-  const json r = call("tool.set", {{"number", 2}, {"offset", {{"z", 42}}}});
-  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  expect_not_saved(call("tool.set", {{"number", 2}, {"offset", {{"z", 42}}}}));
   EXPECT_EQ(result_of(call("tool.list"))["tools"], before);
   EXPECT_EQ(strays(), std::vector<std::string>{});
 }
@@ -165,8 +168,7 @@ TEST_F(SaveFailureTest, MdiThatChangesOffsetsOrToolsOnAFullDiskFailsAndIsUndone)
     EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 1.0 - g54["x"].get<double>(),
                 1e-9);
   }
-  const json r = call("mdi.execute", {{"line", "G10 L1 P2 Z55"}});
-  EXPECT_EQ(error_code(r), 1007) << r.dump();
+  expect_not_saved(call("mdi.execute", {{"line", "G10 L1 P2 Z55"}}));
   EXPECT_EQ(result_of(call("tool.list"))["tools"], tools);
   EXPECT_EQ(strays(), std::vector<std::string>{});
 }

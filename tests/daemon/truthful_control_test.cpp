@@ -59,9 +59,7 @@ class ControlTruthTest : public ::testing::Test {
   }
   json status() { return result_of(call("status.get")); }
   CommandResult cncctl(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{CNCCTL_BINARY, "--socket", daemon_.socket()};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run_command(argv);
+    return run_cncctl(daemon_.socket(), args);
   }
 
   TempDir dir_;
