@@ -129,14 +129,7 @@ void Task::run_program(int from_line, bool step) {
                                                   std::to_string(program_lines_) +
                                                   ", the program's length");
   }
-  const auto status = motion_.status();
-  if (status.machine != motion::MachineState::on)
-    throw TaskError(TaskErrorKind::wrong_state, "machine is not on");
-  if (status.motion != motion::MotionState::idle)
-    throw TaskError(TaskErrorKind::busy, "the machine is moving");
-  if (!config_.no_force_homing && !all_homed(status)) {
-    throw TaskError(TaskErrorKind::not_homed, "all joints must be homed before running a program");
-  }
+  const auto status = ready_status("running a program");
   // Checked again: a directory on the way may have been replaced by a symlink leading out.
   const ProgramFile file = find_program(program_path_, config_.program_dirs);
   if (!file.error.empty()) throw TaskError(TaskErrorKind::program, file.error);
@@ -169,17 +162,23 @@ void Task::run_program(int from_line, bool step) {
   }
 }
 
-void Task::mdi(const std::string& line, std::uint64_t token) {
-  if (exec_ != ExecState::idle)
-    throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
-  const auto status = motion_.status();
+motion::Status Task::ready_status(const char* before) const {
+  auto status = motion_.status();
   if (status.machine != motion::MachineState::on)
     throw TaskError(TaskErrorKind::wrong_state, "machine is not on");
   if (status.motion != motion::MotionState::idle)
     throw TaskError(TaskErrorKind::busy, "the machine is moving");
   if (!config_.no_force_homing && !all_homed(status)) {
-    throw TaskError(TaskErrorKind::not_homed, "all joints must be homed before MDI");
+    throw TaskError(TaskErrorKind::not_homed,
+                    std::string("all joints must be homed before ") + before);
   }
+  return status;
+}
+
+void Task::mdi(const std::string& line, std::uint64_t token) {
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
+  const auto status = ready_status("MDI");
   if (line.find('\n') != std::string::npos || line.size() > 4096) {
     throw TaskError(TaskErrorKind::bad_value,
                     "\"line\" must be one block of at most 4096 characters");

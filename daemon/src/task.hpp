@@ -153,6 +153,9 @@ class Task {
   // Answers the pending open, if any, with a cancelled error and `why`.
   void cancel_open(const std::string& why);
   bool all_homed(const motion::Status& status) const;
+  // The servo status when the machine may run a program or MDI block: on, at rest and homed
+  // (unless NO_FORCE_HOMING); throws TaskError naming what is missing `before` that.
+  motion::Status ready_status(const char* before) const;
   // Run from line: called after each block while lines before skip_to_line_ are read. Drops
   // their motion (modal state, offsets and tool stay as they left them) and, at the first
   // block of the wanted line, puts a traverse from where the machine stands to where that
