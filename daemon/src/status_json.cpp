@@ -9,35 +9,14 @@ using nlohmann::json;
 namespace {
 
 const char* motion_state_name(motion::MotionState state) {
-  switch (state) {
-    case motion::MotionState::idle:
-      return "idle";
-    case motion::MotionState::moving:
-      return "moving";
-    case motion::MotionState::pausing:
-      return "pausing";
-    case motion::MotionState::paused:
-      return "paused";
-    case motion::MotionState::stopping:
-      return "stopping";
-    case motion::MotionState::homing:
-      return "homing";
-    case motion::MotionState::jogging:
-      return "jogging";
-  }
-  return "idle";
+  static constexpr const char* kNames[] = {"idle",     "moving", "pausing", "paused",
+                                           "stopping", "homing", "jogging"};
+  return enum_name(state, kNames);
 }
 
 const char* mode_name(Mode mode) {
-  switch (mode) {
-    case Mode::mdi:
-      return "mdi";
-    case Mode::automatic:
-      return "auto";
-    case Mode::manual:
-      return "manual";
-  }
-  return "manual";
+  static constexpr const char* kNames[] = {"manual", "auto", "mdi"};
+  return enum_name(mode, kNames);
 }
 
 const char* units_name(const config::MachineConfig& config) {

@@ -55,27 +55,13 @@ std::vector<std::string> active_m_codes(const interp::InterpState& st) {
 }  // namespace
 
 const char* machine_state_name(motion::MachineState state) {
-  switch (state) {
-    case motion::MachineState::estop:
-      return "estop";
-    case motion::MachineState::off:
-      return "off";
-    case motion::MachineState::on:
-      return "on";
-  }
-  return "estop";
+  static constexpr const char* kNames[] = {"estop", "off", "on"};
+  return enum_name(state, kNames);
 }
 
 const char* exec_state_name(ExecState state) {
-  switch (state) {
-    case ExecState::idle:
-      return "idle";
-    case ExecState::running:
-      return "running";
-    case ExecState::paused:
-      return "paused";
-  }
-  return "idle";
+  static constexpr const char* kNames[] = {"idle", "running", "paused"};
+  return enum_name(state, kNames);
 }
 
 std::string coord_system_name(int system) {
