@@ -19,12 +19,7 @@ namespace fs = std::filesystem;
 
 class PersistTest : public ::testing::Test {
  protected:
-  std::string read(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
+  std::string read(const fs::path& p) { return test::slurp(p); }
   // Why a position file holding `content` is refused (for three joints).
   std::string corrupt_file_error(const std::string& content) {
     const auto file = dir_ / "position.txt";
