@@ -74,15 +74,6 @@ bool FeedbackChecks::check(const JointFeedbacks& feedback, std::uint64_t cycle,
   return true;
 }
 
-bool FeedbackChecks::check(const JointFeedbacks& feedback, std::uint64_t cycle,
-                           std::uint32_t limits_ignored, Fault& fault) const noexcept {
-  RtEvent event;
-  const bool ok = check(feedback, cycle, limits_ignored, event);
-  fault.joint = event.joint;
-  if (!ok) format_event(event, fault.text, sizeof fault.text);
-  return ok;
-}
-
 drivers::JointCommand FeedbackChecks::answered_command(std::size_t k, std::uint64_t cycle,
                                                        std::uint64_t now) const noexcept {
   if (cycle != 0 && cycle < now) {

@@ -40,11 +40,6 @@ void Homing::fail(int j, const char* what) noexcept {
   fault_.words = what;
 }
 
-const char* Homing::error() const noexcept {
-  format_event(fault_, error_, sizeof error_);
-  return error_;
-}
-
 bool Homing::check_config(int j) noexcept {
   const auto& joint = config_.joints[static_cast<std::size_t>(j)];
   if (!(joint.max_velocity > 0) || !(joint.max_acceleration > 0)) {

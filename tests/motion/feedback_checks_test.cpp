@@ -36,15 +36,24 @@ Feedbacks at(double position) {
   return fb;
 }
 
+// The first joint that failed and why, in words.
+struct Fault {
+  int joint = -1;
+  char text[kEventTextSize] = {};
+};
+
 struct Checked {
   bool ok;
-  FeedbackChecks::Fault fault;
+  Fault fault;
 };
 
 Checked check(const FeedbackChecks& checks, const Feedbacks& fb, std::uint64_t cycle,
               std::uint32_t limits_ignored = 0) {
   Checked c{};
-  c.ok = checks.check(fb, cycle, limits_ignored, c.fault);
+  RtEvent event;
+  c.ok = checks.check(fb, cycle, limits_ignored, event);
+  c.fault.joint = event.joint;
+  if (!c.ok) format_event(event, c.fault.text, sizeof c.fault.text);
   return c;
 }
 
@@ -166,9 +175,9 @@ TEST(FeedbackChecks, DriveFaultCarriesTheDriversOwnWords) {
   record(checks, 1, 0);
   Feedbacks fb = at(0);
   fb[1].stale = true;
-  FeedbackChecks::Fault fault;
-  EXPECT_FALSE(checks.check(fb, 2, 0, fault));
-  EXPECT_STREQ(fault.text, "joint 1: feedback is stale: bus silent for 40 ms");
+  const Checked c = check(checks, fb, 2);
+  EXPECT_FALSE(c.ok);
+  EXPECT_STREQ(c.fault.text, "joint 1: feedback is stale: bus silent for 40 ms");
 }
 
 }  // namespace

@@ -50,7 +50,7 @@ TEST(HomingUnit, ImmediateHomingRenamesThePositionAndMovesToHome) {
   JointIo io;
   io.motor_offset[0] = 0;
   io.command[0] = io.feedback[0] = 12.5;
-  ASSERT_TRUE(homing.start(1u << 0, io)) << homing.error();
+  ASSERT_TRUE(homing.start(1u << 0, io)) << format_event(homing.fault());
   EXPECT_TRUE(homing.active());
   // Renamed at once: the motor (12.5) is now joint position 3.
   EXPECT_DOUBLE_EQ(io.command[0], 3.0);
@@ -74,7 +74,7 @@ TEST(HomingUnit, LatchesTheSwitchEdgeAsHomeOffset) {
   JointIo io;
   Drive drive;
   drive.switch_at[1] = 30;
-  ASSERT_TRUE(homing.start(1u << 1, io)) << homing.error();
+  ASSERT_TRUE(homing.start(1u << 1, io)) << format_event(homing.fault());
   EXPECT_EQ(run(homing, io, drive), Homing::Result::finished);
   EXPECT_TRUE(io.homed[1]);
   EXPECT_DOUBLE_EQ(io.command[1], 0.0);
@@ -87,7 +87,7 @@ TEST(HomingUnit, SwitchSearchWithoutASwitchIsRefused) {
   Homing homing(config, kDt, 0);  // no driver reports a home switch
   JointIo io;
   EXPECT_FALSE(homing.start(1u << 0, io));
-  EXPECT_STRNE(homing.error(), "");
+  EXPECT_NE(format_event(homing.fault()), "");
   EXPECT_FALSE(homing.active());
 }
 

@@ -22,11 +22,6 @@ class FeedbackChecks {
  public:
   using JointDrivers = std::array<drivers::Driver*, kJoints>;
   using JointFeedbacks = std::array<drivers::JointFeedback, kJoints>;
-  // The first joint that failed and why, in words.
-  struct Fault {
-    int joint = -1;
-    char text[kEventTextSize] = {};
-  };
 
   // Non-RT. `joint_driver`: each joint's driver, asked for its own words about a fault (nullptr:
   // none); `history_depth`: the servo cycles of commands kept for late feedback.
@@ -43,9 +38,6 @@ class FeedbackChecks {
   // not count.
   CNCD_RT bool check(const JointFeedbacks& feedback, std::uint64_t cycle,
                      std::uint32_t limits_ignored, RtEvent& fault) const noexcept;
-  // Not RT: the same, with the fault in words.
-  bool check(const JointFeedbacks& feedback, std::uint64_t cycle, std::uint32_t limits_ignored,
-             Fault& fault) const noexcept;
   // RT: joint `k`'s command of `cycle` (motor coordinates) as feedback read in servo cycle
   // `now` names it: 0 or a cycle not written yet is the latest one written, one that fell out
   // of the history its oldest.

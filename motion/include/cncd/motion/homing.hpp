@@ -55,8 +55,6 @@ class Homing {
   CNCD_RT bool ignores_limits(int j) const noexcept;
   // Why start() refused or update() failed.
   CNCD_RT const RtEvent& fault() const noexcept { return fault_; }
-  // Not RT: fault() in words, valid until the next call.
-  const char* error() const noexcept;
 
  private:
   enum class Phase : std::uint8_t {
@@ -110,7 +108,6 @@ class Homing {
   bool active_ = false;
   bool aborting_ = false;
   RtEvent fault_;
-  mutable char error_[kEventTextSize] = {};
 };
 
 }  // namespace cncd::motion
