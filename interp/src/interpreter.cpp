@@ -94,6 +94,9 @@ bool finite(const CanonOp& op) {
                         [](const SetSpindleSpeed& c) { return std::isfinite(c.rpm); },
                         [](const SetSpindleMode& c) { return std::isfinite(c.css_max_rpm); },
                         [](const OrientSpindle& c) { return std::isfinite(c.angle_deg); },
+                        [](const SetOutputValue& c) { return std::isfinite(c.value); },
+                        [](const WaitInput& c) { return std::isfinite(c.timeout_s); },
+                        [](const UserMCode& c) { return std::isfinite(c.p) && std::isfinite(c.q); },
                         [](const SetToolTableEntry& c) {
                           return finite(c.offset) && std::isfinite(c.front_angle) &&
                                  std::isfinite(c.back_angle);

@@ -211,6 +211,29 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
             out += ')';
           },
           [&](const SetToolTableEntry& c) { append_tool_table_entry(out, c); },
+          [&](const SetOutputBit& c) {
+            out += c.on ? "SET_" : "CLEAR_";
+            out += c.motion ? "MOTION_OUTPUT_BIT(" : "AUX_OUTPUT_BIT(";
+            out += std::to_string(c.index);
+            out += ')';
+          },
+          [&](const SetOutputValue& c) {
+            out += c.motion ? "SET_MOTION_OUTPUT_VALUE(" : "SET_AUX_OUTPUT_VALUE(";
+            out += std::to_string(c.index);
+            out += ',';
+            out += std::to_string(c.value);
+            out += ')';
+          },
+          [&](const WaitInput& c) {
+            out += "WAIT(";
+            append_args(out, c.index, c.digital ? 1 : 0, c.mode, c.timeout_s);
+            out += ')';
+          },
+          [&](const UserMCode& c) {
+            out += "USER_M_CODE(";
+            append_args(out, c.code, c.p, c.q);
+            out += ')';
+          },
       },
       op);
 }

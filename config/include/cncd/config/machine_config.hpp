@@ -82,6 +82,104 @@ struct JointConfig {
   SourceRef source;            // the [JOINT_n] header
 };
 
+// Digital and analog signals a program can reach: M62-M65 / M66 digital, M66-M68 analog.
+inline constexpr int kMaxDigitalIo = 32;
+inline constexpr int kMaxAnalogIo = 16;
+
+// A signal named in an INI key by its address (docs/drivers.md, "Signal addresses"):
+//   gpio:LINE                    a line of [GPIO] CHIP, by offset or name; "gpio:!LINE" is
+//                                active low
+//   modbus:BUS:SLAVE:coil:N      a coil of slave SLAVE on the [MODBUS_BUS] bus
+//   modbus:BUS:SLAVE:hr:N        a holding register
+//   modbus:BUS:SLAVE:di:N        a discrete input
+//   modbus:BUS:SLAVE:ir:N        an input register
+//   sim:NAME                     a simulated signal (tests and demos set and read it)
+struct SignalAddress {
+  enum class Kind : std::uint8_t { none, gpio, modbus, sim };
+  enum class Table : std::uint8_t { coil, holding, discrete, input };
+  Kind kind = Kind::none;
+  std::string line;         // gpio: offset or name of the line
+  bool active_low = false;  // gpio: written with a '!' before the line
+  int bus = 0;              // modbus: n of [MODBUS_n]
+  int slave = 0;            // modbus: slave id
+  Table table = Table::coil;
+  int address = 0;   // modbus: coil or register number (0-based, the protocol's address)
+  std::string name;  // sim: the signal's name
+  std::string text;  // the address as written, for messages
+  SourceRef source;  // the key that named it
+  bool given() const { return kind != Kind::none; }
+};
+
+enum class SpindleDriver { none, sim, gpio, modbus };
+
+// [SPINDLE_0]. A machine with no such section has an ideal spindle: it is at any commanded
+// speed at once and drives nothing (LinuxCNC's spindle with nothing wired to it).
+struct SpindleConfig {
+  bool present = false;  // the section is in the file
+  // DRIVER = none: the machine has no spindle (a program that starts one is refused).
+  SpindleDriver driver = SpindleDriver::sim;
+  // LinuxCNC 2.9 keys, rpm. The reverse ones are positive numbers, as LinuxCNC writes them;
+  // MAX_REVERSE_VELOCITY defaults to MAX_FORWARD_VELOCITY, MIN_REVERSE_VELOCITY to
+  // MIN_FORWARD_VELOCITY.
+  double max_forward_velocity = 1e99;
+  double min_forward_velocity = 0;
+  double max_reverse_velocity = 1e99;
+  double min_reverse_velocity = 0;
+  double increment = 100;            // rpm, the step of a user interface's faster/slower
+  double acceleration = 0;           // rpm/s the sim and PWM spindles ramp at; 0 = at once
+  double at_speed_tolerance = 0.05;  // fraction of the commanded speed
+  double at_speed_timeout_s = 10;    // past it without reaching speed, the program stops
+  bool stop_on_pause = false;        // STOP_ON_PAUSE: a pause stops the spindle, resume restarts it
+  // gpio
+  SignalAddress enable;
+  SignalAddress direction;  // high for reverse (M4)
+  SignalAddress pwm;
+  double pwm_frequency = 1000;  // Hz
+  double pwm_min_duty = 0;      // fraction; duty = min + (1 - min) * rpm / max_forward_velocity
+  SignalAddress encoder_a;
+  SignalAddress encoder_b;
+  SignalAddress encoder_index;
+  int encoder_ppr = 0;  // pulses per revolution (quadrature: 4 counts each), 0 = no encoder
+  // modbus: a VFD on [MODBUS_n], generic register profile (every register a key)
+  int modbus = -1;  // n of [MODBUS_n]
+  int slave = 1;
+  double speed_scale = 1;         // register value = rpm x SPEED_SCALE
+  int command_register = 0;       // holding: COMMAND_STOP / _FORWARD / _REVERSE
+  int speed_register = 1;         // holding: commanded speed
+  int actual_speed_register = 0;  // input: actual speed
+  int status_register = 1;        // input: status bits
+  int command_stop = 0;
+  int command_forward = 1;
+  int command_reverse = 2;
+  int running_bit = 0;  // of the status register; -1 = none
+  int at_speed_bit = 1;
+  int fault_bit = 2;
+  SourceRef source;  // the [SPINDLE_0] header
+};
+
+// What M6 does besides waiting for the operator ([EMCIO]).
+struct ToolChangeConfig {
+  bool has_position = false;                    // TOOL_CHANGE_POSITION given
+  std::array<double, kMaxAxes> position{};      // machine coordinates, indexed by axis_index()
+  std::array<bool, kMaxAxes> position_given{};  // the axes TOOL_CHANGE_POSITION names
+  bool quill_up = false;                        // TOOL_CHANGE_QUILL_UP: Z to machine zero first
+  bool with_spindle_on = false;  // TOOL_CHANGE_WITH_SPINDLE_ON: the spindle keeps turning
+};
+
+// Coolant and the program's digital and analog signals ([CNCD] keys).
+struct IoConfig {
+  SignalAddress flood;                                       // FLOOD_OUTPUT, M8
+  SignalAddress mist;                                        // MIST_OUTPUT, M7
+  std::array<SignalAddress, kMaxDigitalIo> digital_outputs;  // DIGITAL_OUTPUT_n
+  std::array<SignalAddress, kMaxAnalogIo> analog_outputs;    // ANALOG_OUTPUT_n
+  std::array<SignalAddress, kMaxDigitalIo> digital_inputs;   // DIGITAL_INPUT_n
+  std::array<SignalAddress, kMaxAnalogIo> analog_inputs;     // ANALOG_INPUT_n
+  // User M codes M100-M199: executables looked for in these directories ([RS274NGC]
+  // USER_M_PATH, else [DISPLAY] PROGRAM_PREFIX), run for at most user_m_timeout_s.
+  std::vector<std::filesystem::path> user_m_path;
+  double user_m_timeout_s = 60;
+};
+
 struct CncdConfig {
   std::string socket_path = "/run/cncd/cncd.sock";
   std::string read_group;          // empty: only root and the control group may connect
@@ -148,6 +246,9 @@ struct MachineConfig {
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
+  SpindleConfig spindle;  // [SPINDLE_0]
+  ToolChangeConfig tool_change;
+  IoConfig io;
   // Every key of the file with its source, for lookups of keys this struct does not type
   // and to list unused keys. Null when built by hand.
   std::shared_ptr<const IniFile> ini;

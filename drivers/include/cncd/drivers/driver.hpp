@@ -4,6 +4,7 @@
 // write()/read() once per servo period (RT) -> disable() -> destructor (non-RT).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -54,6 +55,46 @@ struct MachineInputs {
   bool probe = false;
 };
 
+inline constexpr int kMaxDigitalIo = config::kMaxDigitalIo;
+inline constexpr int kMaxAnalogIo = config::kMaxAnalogIo;
+
+// The spindle as the servo thread commands it each period.
+struct SpindleCommand {
+  bool enable = false;   // turning
+  bool reverse = false;  // M4
+  double rpm = 0;        // >= 0: the speed to turn at (override applied, within the limits)
+};
+
+// The machine's outputs as the servo thread commands them each period. A driver writes the
+// signals the config gives it (config::SignalAddress) and leaves the others alone.
+struct IoCommand {
+  SpindleCommand spindle;
+  bool flood = false;
+  bool mist = false;
+  std::uint32_t digital = 0;                  // bit n: DIGITAL_OUTPUT_n
+  std::array<double, kMaxAnalogIo> analog{};  // ANALOG_OUTPUT_n
+};
+
+// The spindle as its driver reports it.
+struct SpindleFeedback {
+  bool present = false;       // filled in by the spindle's driver
+  double rpm = 0;             // actual speed, >= 0 (measured, simulated or after the ramp)
+  bool has_at_speed = false;  // the drive reports at-speed itself (a VFD's status bit)
+  bool at_speed = false;
+  bool fault = false;         // the drive reports a fault (fault_reason() says which)
+  bool stale = false;         // no fresh answer from the drive within its deadline
+  bool has_position = false;  // an encoder: revolutions counts the spindle's position
+  double revolutions = 0;
+};
+
+// The machine's inputs as the drivers report them each period; a driver fills in the signals
+// the config gives it and leaves the others alone.
+struct IoFeedback {
+  SpindleFeedback spindle;
+  std::uint32_t digital = 0;                  // bit n: DIGITAL_INPUT_n
+  std::array<double, kMaxAnalogIo> analog{};  // ANALOG_INPUT_n
+};
+
 enum Capability : std::uint32_t {
   kCapPositionFeedback = 1u << 0,  // feedback comes from the drive, not an echo
   kCapHomeSwitch = 1u << 1,
@@ -80,6 +121,12 @@ class Driver {
   CNCD_RT virtual void read(JointFeedback* feedback, int count) noexcept = 0;
   // RT, servo thread: machine-wide inputs; drivers without inputs leave them alone.
   CNCD_RT virtual void read_inputs(MachineInputs& /*inputs*/) noexcept {}
+  // RT, servo thread: hand over this period's spindle and output commands. A driver acts on
+  // the signals the config names with its kind (and the spindle when [SPINDLE_0] DRIVER
+  // names it) and ignores the rest; it never blocks (I/O threads take the values).
+  CNCD_RT virtual void write_io(const IoCommand& /*command*/) noexcept {}
+  // RT, servo thread: fill in the spindle feedback and the inputs this driver owns.
+  CNCD_RT virtual void read_io(IoFeedback& /*feedback*/) noexcept {}
   // RT-safe, any thread: copies into `out` (NUL-terminated) why the driver last reported a
   // fault, naming the drive, register or line; returns false (and an empty text) when it has
   // nothing to say. The text stays until the fault is reset.
@@ -104,9 +151,13 @@ struct DriverInstance {
   std::vector<int> joints;
 };
 
-// Non-RT. The machine's drivers: one instance per DRIVER name among the config's joints,
-// configured for its joints. Returns them, or nothing and sets `error` ("driver 'modbus': ...")
-// when one cannot be made or configured.
+// Non-RT. The machine's drivers: one instance per DRIVER name among the config's joints, the
+// spindle's DRIVER and the kinds of the signal addresses, configured for its joints (none for
+// a driver that only drives the spindle or signals). Returns them, or nothing and sets `error`
+// ("driver 'modbus': ...") when one cannot be made or configured.
 std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, std::string& error);
+
+// The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside.
+std::vector<const char*> io_driver_names(const config::MachineConfig& config);
 
 }  // namespace cncd::drivers

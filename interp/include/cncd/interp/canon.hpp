@@ -135,6 +135,36 @@ struct OrientSpindle {
   double angle_deg = 0;
   int mode = 0;  // LinuxCNC's orientation mode
 };
+// M62/M63 (motion = true: with the start of the next move) and M64/M65 (at once, once the
+// moves before have finished): DIGITAL_OUTPUT_index on or off.
+struct SetOutputBit {
+  int index = 0;
+  bool on = false;
+  bool motion = false;
+};
+// M67 (motion = true) and M68: ANALOG_OUTPUT_index set to value.
+struct SetOutputValue {
+  int index = 0;
+  double value = 0;
+  bool motion = false;
+};
+// M66: wait for DIGITAL_INPUT_index (digital) or ANALOG_INPUT_index. mode: 0 no wait (read
+// now), 1 rising edge, 2 falling edge, 3 high, 4 low (digital); 1 above, 2 below ... as
+// LinuxCNC (analog: 0 only). timeout_s as Q. The result goes to #5399 once the machine has
+// waited (Interpreter::set_input_result()).
+struct WaitInput {
+  int index = 0;
+  bool digital = true;
+  int mode = 0;
+  double timeout_s = 0;
+};
+// M100-M199: the executable found for it, run with P and Q as its two arguments.
+struct UserMCode {
+  int code = 0;
+  double p = 0;
+  double q = 0;
+  std::string executable;  // absolute path
+};
 struct SetToolTableEntry {
   int pocket = 0;
   int tool = 0;
@@ -145,16 +175,15 @@ struct SetToolTableEntry {
 };
 
 // The moves and the dwell come first.
-using CanonOp =
-    std::variant<StraightTraverse, StraightFeed, ArcFeed, Dwell, SetFeedRate, SetFeedMode,
-                 SetFeedReference, SelectPlane, UseLengthUnits, SetG5xOffset, SetG92Offset,
-                 SetXyRotation, UseToolLengthOffset, SetMotionControlMode, SetNaivecamTolerance,
-                 StartSpindleClockwise, StartSpindleCounterclockwise, StopSpindleTurning,
-                 SetSpindleSpeed, SetSpindleMode, MistOn, MistOff, FloodOn, FloodOff, SelectTool,
-                 ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
-                 SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage,
-                 ProgramStop, OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish,
-                 StartChange, OrientSpindle, SetToolTableEntry>;
+using CanonOp = std::variant<
+    StraightTraverse, StraightFeed, ArcFeed, Dwell, SetFeedRate, SetFeedMode, SetFeedReference,
+    SelectPlane, UseLengthUnits, SetG5xOffset, SetG92Offset, SetXyRotation, UseToolLengthOffset,
+    SetMotionControlMode, SetNaivecamTolerance, StartSpindleClockwise, StartSpindleCounterclockwise,
+    StopSpindleTurning, SetSpindleSpeed, SetSpindleMode, MistOn, MistOff, FloodOn, FloodOff,
+    SelectTool, ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
+    SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage, ProgramStop,
+    OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish, StartChange, OrientSpindle,
+    SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode>;
 
 struct CanonCommand {
   std::int32_t line = 0;  // 1-based source line number in its file
