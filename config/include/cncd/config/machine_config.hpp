@@ -146,8 +146,12 @@ struct SpindleConfig {
   double speed_scale = 1;         // register value = rpm x SPEED_SCALE
   int command_register = 0;       // holding: COMMAND_STOP / _FORWARD / _REVERSE
   int speed_register = 1;         // holding: commanded speed
-  int actual_speed_register = 0;  // input: actual speed
-  int status_register = 1;        // input: status bits
+  int actual_speed_register = 0;  // actual speed, in actual_speed_table (-1 = none)
+  int status_register = 1;        // status bits, in status_table (-1 = none)
+  // Where the drive keeps its read-only registers: input registers (function 4) or holding
+  // registers (function 3), ACTUAL_SPEED_TABLE / STATUS_TABLE = ir | hr.
+  SignalAddress::Table actual_speed_table = SignalAddress::Table::input;
+  SignalAddress::Table status_table = SignalAddress::Table::input;
   int command_stop = 0;
   int command_forward = 1;
   int command_reverse = 2;
