@@ -80,6 +80,7 @@ const std::vector<MethodSpec>& method_table() {
        Access::control,
        {override_ratio("spindle override ratio, 1.0 = 100 %")}},
       {"tool.list", Access::read, {}},
+      {"tool.change_done", Access::control, {}},
       {"tool.set",
        Access::control,
        {bounded("number", integer, 1, kMaxTool, "tool number", true),

@@ -57,6 +57,41 @@ json optional_number(const std::optional<double>& value) {
   return value ? json(*value) : json(nullptr);
 }
 
+json spindle_object(const SpindleReport& sp) {
+  json out{{"direction", sp.direction},
+           {"speed", sp.speed},
+           {"programmed_speed", sp.programmed_speed},
+           {"override", sp.override_ratio},
+           {"override_enabled", sp.override_enabled},
+           {"enabled", sp.enabled},
+           {"commanded_rpm", sp.commanded_rpm},
+           {"actual_rpm", sp.actual_rpm},
+           {"at_speed", sp.at_speed}};
+  if (sp.position) out["position"] = *sp.position;
+  return out;
+}
+
+json bits_array(std::uint32_t bits) {
+  json out = json::array();
+  for (int i = 0; i < 32; ++i)
+    out.push_back(((bits >> i) & 1u) != 0);
+  return out;
+}
+
+json io_object(const IoReport& io) {
+  return json{{"douts", bits_array(io.douts)},
+              {"aouts", io.aouts},
+              {"dins", bits_array(io.dins)},
+              {"ains", io.ains}};
+}
+
+json wait_object(const WaitReport& w) {
+  if (w.kind.empty()) return nullptr;
+  json out{{"kind", w.kind}, {"message", w.message}, {"since", w.since_s}};
+  if (w.kind == "tool_change") out["tool"] = w.tool;
+  return out;
+}
+
 json program_object(const ProgramReport& p) {
   return {{"path", p.path},
           {"opening", p.opening},
@@ -121,12 +156,10 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
         {"rapid", s.rapid_override},
         {"spindle", s.spindle.override_ratio}}},
       {"program", program_object(s.program)},
-      {"spindle",
-       {{"direction", s.spindle.direction},
-        {"speed", s.spindle.speed},
-        {"programmed_speed", s.spindle.programmed_speed},
-        {"override", s.spindle.override_ratio}}},
+      {"spindle", spindle_object(s.spindle)},
       {"coolant", {{"mist", s.mist}, {"flood", s.flood}}},
+      {"io", io_object(s.io)},
+      {"wait", wait_object(s.wait)},
       {"tool",
        {{"number", s.tool.number},
         {"prepared", s.tool.prepared},

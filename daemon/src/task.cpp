@@ -51,12 +51,18 @@ Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& a
           pipeline::machine_units(config),
           [&events](int line, const std::string& text) {
             events.add("info", "message", "line " + std::to_string(line) + ": " + text);
-          })),
+          },
+          &config)),
       interp_(std::make_unique<interp::Interpreter>(pipeline::interpreter_options(config))),
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
-      opener_(config) {}
+      opener_(config) {
+  feeder_->on_warning([this](int line, const std::string& text) {
+    const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
+    events_.add("warning", "program", where + ":" + std::to_string(line) + ": " + text);
+  });
+}
 
 Task::~Task() {
   shutdown();
@@ -195,7 +201,8 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   interp::Pose position{};
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
   interp_->set_machine_position(position);
-  feeder_->start_program();
+  feeder_->start_program(&status.commanded);
+  path_errors_base_ = status.path_errors;
   interp_done_ = false;
   moves_enqueued_ = 0;
   moves_done_base_ = status.moves_done;
@@ -230,6 +237,8 @@ void Task::abort(std::uint64_t token) {
 }
 
 void Task::finish_program(const std::string& ended, const std::string& why) {
+  user_m_.stop();
+  user_m_hold_ = 0;
   // Offsets and tool data set by the program or MDI (G10, G92 ...) survive a crash or power
   // loss; those that cannot be saved are not kept, and the run says so.
   std::string result = ended;
@@ -344,6 +353,15 @@ void Task::poll() {
     finish_program("error", status.fault_reason);
     return;
   }
+  if (status.path_errors != path_errors_base_) {
+    // The servo thread stopped the path (a spindle that did not reach its speed in time).
+    motion_.abort();
+    finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
+                                std::to_string(status.line) + ": " +
+                                motion::format_event(status.path_error));
+    return;
+  }
+  if (!poll_holds(status)) return;
   // Run from line: the remaining time counts from when the traverse to the line has ended.
   if (skip_moved_ && !approach_done_s_ && status.moves_done > moves_done_base_)
     approach_done_s_ = moving_s();

@@ -24,6 +24,7 @@
 #include "program_open.hpp"
 #include "task_outcome.hpp"
 #include "task_report.hpp"
+#include "user_m.hpp"
 
 namespace cncd::daemon {
 
@@ -85,6 +86,9 @@ class Task {
   void set_feed_override(double ratio);
   void set_rapid_override(double ratio);
   void set_spindle_override(double ratio);
+  // The operator has put in the tool a running program's M6 waits for: the program goes on.
+  // Throws TaskError (wrong_state) when no tool change is waited for.
+  void tool_change_done();
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 
@@ -126,6 +130,11 @@ class Task {
   // Servo periods run since the servo thread had run `cycles`, in seconds.
   double servo_seconds_since(std::uint64_t cycles) const;
   void drain_servo_events();
+  // The holds the path waits in (task_io.cpp): a tool change waits for tool_change_done(), a
+  // user M code runs and its end releases the path. Returns false when the run has ended.
+  bool poll_holds(const motion::Status& status);
+  // What the path waits for, in words (task_io.cpp).
+  WaitReport wait_report(const motion::Status& status) const;
   // Answers the machine.on requests waiting for the drives (task_machine.cpp).
   void confirm_machine_on(const motion::Status& status);
   std::chrono::steady_clock::duration on_check_time() const;
@@ -186,8 +195,11 @@ class Task {
   bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
   motion::AxisPose skip_end_{};
   double spindle_override_ = 1.0;
-  bool stepping_ = false;  // program.step: one line, then pause
-  int step_budget_ = 0;    // lines the interpreter may still read in this step
+  std::uint64_t path_errors_base_ = 0;  // motion's path error count when the run started
+  UserMProcess user_m_;                 // the user M code running, if any
+  std::uint32_t user_m_hold_ = 0;       // the hold it answers
+  bool stepping_ = false;               // program.step: one line, then pause
+  int step_budget_ = 0;                 // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
   // The run on the servo clock: servo periods since program.run (rt.cycles) x the period. Falls

@@ -59,9 +59,31 @@ struct ProgramReport {
 
 struct SpindleReport {
   int direction = 0;  // 1 cw, -1 ccw, 0 stopped
-  double speed = 0;   // rpm, with the override
+  double speed = 0;   // rpm, with the override (commanded_rpm, or what it would be when stopped)
   double programmed_speed = 0;
   double override_ratio = 1.0;
+  bool override_enabled = true;
+  bool enabled = false;
+  double commanded_rpm = 0;  // what the drive is told: 0 when stopped, within the limits
+  double actual_rpm = 0;
+  bool at_speed = true;
+  std::optional<double> position;  // revolutions, with an encoder (or the sim spindle)
+};
+
+// The machine's outputs and inputs.
+struct IoReport {
+  std::uint32_t douts = 0;
+  std::vector<double> aouts;
+  std::uint32_t dins = 0;
+  std::vector<double> ains;
+};
+
+// What a running program waits for ("" kind: nothing).
+struct WaitReport {
+  std::string kind;  // "tool_change" | "spindle_at_speed" | "input" | "user_m" | ""
+  int tool = 0;      // tool_change
+  std::string message;
+  double since_s = 0;  // how long it has waited
 };
 
 struct ToolReport {
@@ -100,6 +122,8 @@ struct TaskStatus {
   SpindleReport spindle;
   bool mist = false;
   bool flood = false;
+  IoReport io;
+  WaitReport wait;
   ToolReport tool;
   ActiveOffsets offsets;
   std::vector<std::string> gcodes;  // active, in modal-group order: "G1", "G17" ...

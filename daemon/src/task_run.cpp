@@ -13,7 +13,8 @@ bool Task::skip_before_start(bool program_ended) {
       return false;
     }
     for (const auto& move : feeder_->pending) {
-      if (move.kind == motion::Move::Kind::dwell) continue;
+      if (move.kind == motion::Move::Kind::dwell || move.kind == motion::Move::Kind::action)
+        continue;
       skip_end_ = move.end;
       skip_moved_ = true;
     }
@@ -28,6 +29,8 @@ bool Task::skip_before_start(bool program_ended) {
     approach.line = interp_->current_line();
     feeder_->pending.push_front(approach);
   }
+  // The spindle and coolant as the skipped lines left them, before the machine moves there.
+  feeder_->restore_io_state();
   skip_to_line_ = 0;
   return true;
 }

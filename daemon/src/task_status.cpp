@@ -194,12 +194,24 @@ TaskStatus Task::status() const {
   program.result = last_result_;
   program.error = last_error_;
 
-  out.spindle.direction = feeder_->spindle_direction;
-  out.spindle.speed = feeder_->spindle_speed * spindle_override_;
-  out.spindle.programmed_speed = feeder_->spindle_speed;
-  out.spindle.override_ratio = spindle_override_;
-  out.mist = feeder_->mist;
-  out.flood = feeder_->flood;
+  const motion::SpindleStatus& sp = s.spindle;
+  out.spindle.direction = sp.direction;
+  out.spindle.programmed_speed = sp.programmed_rpm;
+  out.spindle.override_ratio = sp.override_ratio;
+  out.spindle.override_enabled = sp.override_enabled;
+  out.spindle.speed = sp.programmed_rpm * (sp.override_enabled ? sp.override_ratio : 1.0);
+  out.spindle.enabled = sp.enabled;
+  out.spindle.commanded_rpm = sp.commanded_rpm;
+  out.spindle.actual_rpm = sp.actual_rpm;
+  out.spindle.at_speed = sp.at_speed;
+  if (sp.has_position) out.spindle.position = sp.revolutions;
+  out.mist = s.io.mist;
+  out.flood = s.io.flood;
+  out.io.douts = s.io.douts;
+  out.io.aouts.assign(s.io.aouts.begin(), s.io.aouts.end());
+  out.io.dins = s.io.dins;
+  out.io.ains.assign(s.io.ains.begin(), s.io.ains.end());
+  out.wait = wait_report(s);
 
   const interp::InterpState st = interp_->state();
   out.work_commanded = work_pose(s.commanded, st);

@@ -40,6 +40,7 @@ void Planner::reset(const AxisPose& start) {
   merge_.reset();
   held_.reset();
   output_.clear();
+  pending_sync_ = {};
 }
 
 bool Planner::push(const Move& move, bool check_limits, std::string& error) {
@@ -64,9 +65,9 @@ bool Planner::push(const Move& move, bool check_limits, std::string& error) {
 }
 
 bool Planner::mergeable(const Move& move, const Segment& seg) const {
-  return move.kind == Move::Kind::feed && move.path_mode == Move::PathMode::blend &&
-         move.merge_tolerance > 0 && seg.kind == Segment::Kind::line && seg.length > 0 &&
-         euclidean(seg);
+  return move.kind == Move::Kind::feed && !move.sync.any() &&
+         move.path_mode == Move::PathMode::blend && move.merge_tolerance > 0 &&
+         seg.kind == Segment::Kind::line && seg.length > 0 && euclidean(seg);
 }
 
 bool Planner::extends_merge(const Move& move, const Segment& seg) const {
@@ -117,7 +118,12 @@ void Planner::release_merge() {
 }
 
 void Planner::take(Segment seg, const Move& move) {
+  // Outputs of a move with nothing to move are set as the next segment starts.
+  add_sync(seg.sync, pending_sync_);
+  pending_sync_ = {};
   if (seg.kind != Segment::Kind::dwell && seg.length == 0) {
+    pending_sync_ = seg.sync;
+    seg.sync = {};
     // Nothing to move: the move is done with the one before it, which keeps its junction.
     if (held_) {
       held_->segment.moves += seg.moves;
@@ -141,10 +147,37 @@ void Planner::take(Segment seg, const Move& move) {
 
 void Planner::flush() {
   release_merge();
-  if (!held_) return;
-  held_->segment.continuous = false;
-  output_.push_back(held_->segment);
-  held_.reset();
+  if (held_) {
+    held_->segment.continuous = false;
+    output_.push_back(held_->segment);
+    held_.reset();
+  }
+  if (pending_sync_.any()) {
+    // Outputs of a last move that went nowhere: set where the path rests.
+    Segment rest;
+    rest.kind = Segment::Kind::dwell;
+    rest.start = rest.end = end_;
+    rest.sync = pending_sync_;
+    rest.moves = 0;
+    pending_sync_ = {};
+    output_.push_back(rest);
+  }
+}
+
+void Planner::add_sync(SyncOutputs& into, const SyncOutputs& earlier) {
+  if (!earlier.any()) return;
+  // The later settings win over the earlier ones of the same outputs.
+  const std::uint32_t set = earlier.set & ~into.clear;
+  const std::uint32_t clear = earlier.clear & ~into.set;
+  into.set |= set;
+  into.clear |= clear;
+  for (int i = 0; i < kMaxAnalogIo; ++i) {
+    const std::uint32_t bit = 1u << i;
+    if ((earlier.analog_mask & bit) && !(into.analog_mask & bit)) {
+      into.analog[static_cast<std::size_t>(i)] = earlier.analog[static_cast<std::size_t>(i)];
+      into.analog_mask |= bit;
+    }
+  }
 }
 
 void Planner::join(Segment& next, const Move& move) {
@@ -222,6 +255,9 @@ void Planner::join(Segment& next, const Move& move) {
   blend.line = next.line;
   blend.moves = 0;
   blend.continuous = true;
+  // The blend starts the next move: its outputs go with it.
+  blend.sync = next.sync;
+  next.sync = {};
   if (prev.feed > 0 && next.feed > 0) {
     blend.feed = std::min(prev.feed, next.feed);
   } else {
@@ -238,6 +274,7 @@ void Planner::join(Segment& next, const Move& move) {
     output_.push_back(prev);
   } else {
     blend.moves += prev.moves;  // the blend took all that was left of it
+    add_sync(blend.sync, prev.sync);
   }
   output_.push_back(blend);
 }

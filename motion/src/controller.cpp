@@ -337,6 +337,18 @@ void MotionController::set_rapid_override(double ratio) {
   command.velocity = ratio;
   impl_->send(command);
 }
+void MotionController::set_spindle_override(double ratio) {
+  Command command;
+  command.kind = Command::Kind::spindle_override;
+  command.velocity = ratio;
+  impl_->send(command);
+}
+void MotionController::release_hold(std::uint32_t hold_id) {
+  Command command;
+  command.kind = Command::Kind::release;
+  command.id = hold_id;
+  impl_->send(command);
+}
 
 namespace {
 // Why a jog cannot start now (checked before the servo thread sees it), or "".

@@ -188,6 +188,10 @@ void PathExecutor::fill_window() noexcept {
   }
 }
 
+void PathExecutor::activate(const Segment& segment) noexcept {
+  if (gate_ != nullptr && segment.sync.any()) gate_->started(segment.sync);
+}
+
 void PathExecutor::finish_front() noexcept {
   const Segment& done = window_at(head_seq_);
   ++segments_done_;
@@ -231,6 +235,8 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
       moved = true;
       path_s_ = 0;
       dwell_elapsed_s_ = 0;
+      action_started_ = false;
+      activate(window_at(head_seq_));
     }
     const Segment& active = window_at(head_seq_);
     line_ = active.line;
@@ -241,6 +247,10 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
       } else if (pause_requested_) {
         done = false;
         dt = 0;
+      } else if (active.action.kind != IoAction::Kind::none) {
+        done = gate_ == nullptr || gate_->run(active.action, !action_started_);
+        action_started_ = true;
+        if (!done) dt = 0;
       } else {
         const double left = active.dwell_s - dwell_elapsed_s_;
         done = left <= dt + 1e-12;

@@ -266,6 +266,7 @@ void PathExecutor::scurve_step(double& dt, AxisPose& pose) noexcept {
     }
     has_active_ = true;
     if (!starts_here(next, pose)) return;
+    activate(next);
   }
   path_s_ = s;
   if (has_active_) pose = window_at(head_seq_).point_at(path_s_);

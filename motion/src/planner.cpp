@@ -189,7 +189,8 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   }
   // Beyond kMaxCoordinate the path arithmetic itself overflows (a length of infinity makes
   // every point NaN): refused homed or not, with the soft limits when they apply.
-  if (move.kind != Move::Kind::dwell) {
+  const bool rests = move.kind == Move::Kind::dwell || move.kind == Move::Kind::action;
+  if (!rests) {
     for (int i = 0; i < kAxes; ++i) {
       const auto& axis = config_.axes[static_cast<std::size_t>(i)];
       if (!axis.present || std::fabs(move.end[i]) <= kMaxCoordinate) continue;
@@ -224,14 +225,16 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   }
   Segment seg;
   seg.start = start;
-  seg.end = move.kind == Move::Kind::dwell ? start : move.end;
+  seg.end = rests ? start : move.end;
   seg.line = move.line;
+  seg.sync = move.sync;
   for (int i = 0; i < kAxes; ++i) {
     if (!config_.axes[static_cast<std::size_t>(i)].present) seg.end[i] = start[i];
   }
-  if (move.kind == Move::Kind::dwell) {
+  if (rests) {
     seg.kind = Segment::Kind::dwell;
-    seg.dwell_s = std::max(0.0, move.dwell_s);
+    seg.dwell_s = move.kind == Move::Kind::dwell ? std::max(0.0, move.dwell_s) : 0.0;
+    if (move.kind == Move::Kind::action) seg.action = move.action;
     return seg;
   }
   if (move.kind != Move::Kind::traverse && !(move.feed > 0)) {

@@ -88,6 +88,19 @@ int format(const RtEvent& e, char* out, std::size_t size) {
                            e.joint, axis_letter(e.axis));
     case Code::off_path:
       return std::snprintf(out, size, "a queued move does not start where the machine stands");
+    case Code::spindle_not_at_speed:
+      return std::snprintf(out, size,
+                           "spindle 0 did not reach %.0f rpm within %.3g s ([SPINDLE_0] "
+                           "AT_SPEED_TIMEOUT): it turns at %.0f rpm",
+                           clamped(e.limit), static_cast<double>(e.oldest_ago) / 1000.0,
+                           clamped(e.error));
+    case Code::spindle_fault:
+      return std::snprintf(out, size, "spindle 0: drive fault%s%s", e.text[0] ? ": " : "", e.text);
+    case Code::spindle_stale:
+      return std::snprintf(out, size, "spindle 0: no answer from the drive%s%s",
+                           e.text[0] ? ": " : "", e.text);
+    case Code::no_spindle:
+      return std::snprintf(out, size, "the machine has no spindle ([SPINDLE_0] DRIVER = none)");
   }
   return std::snprintf(out, size, "servo event %d", static_cast<int>(e.code));
 }

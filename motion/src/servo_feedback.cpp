@@ -9,11 +9,15 @@ namespace cncd::motion {
 
 void ServoLoop::read_drivers() noexcept {
   drivers::MachineInputs inputs;
+  drivers::IoFeedback io;
   for (auto& binding : drivers_) {
     drivers::JointFeedback block[kJoints];
     const int n = static_cast<int>(binding.joints.size());
     binding.driver->read(block, n);
     binding.driver->read_inputs(inputs);
+    const bool had_spindle = io.spindle.present;
+    binding.driver->read_io(io);
+    if (!had_spindle && io.spindle.present) spindle_driver_ = binding.driver;
     for (int k = 0; k < n; ++k)
       feedback_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])] = block[k];
   }
@@ -22,6 +26,8 @@ void ServoLoop::read_drivers() noexcept {
     joints_.feedback[k] = feedback_[k].position - joints_.motor_offset[k];
     joints_.home_switch[k] = feedback_[k].home_switch;
   }
+  io_.set_cycle(cycle_);
+  io_.feedback(io);
   if (inputs.estop && status_.machine != MachineState::estop) {
     stop_now(MachineState::estop);
     latch_fault(RtEvent::Code::estop_input);
@@ -40,6 +46,14 @@ void ServoLoop::check_joints() noexcept {
   RtEvent fault;
   if (checks_.check(feedback_, cycle_, limits_ignored, fault)) return;
   status_.joint_fault[static_cast<std::size_t>(fault.joint)] = true;
+  latch_fault(fault);
+}
+
+void ServoLoop::check_spindle() noexcept {
+  if (status_.machine != MachineState::on || !drives_enabled_) return;
+  RtEvent fault;
+  if (!io_.drive_problem(fault)) return;
+  if (spindle_driver_ != nullptr) spindle_driver_->fault_reason(fault.text, sizeof fault.text);
   latch_fault(fault);
 }
 
@@ -79,6 +93,7 @@ void ServoLoop::write_drivers() noexcept {
       block[k] =
           commands_out_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])];
     binding.driver->write(block, n);
+    binding.driver->write_io(io_.command());
   }
 }
 

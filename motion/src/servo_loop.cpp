@@ -41,11 +41,13 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       drivers_(std::move(drivers)),
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
       joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
+      io_(config, period_s_),
       path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config),
       checks_(config, joint_count_, joint_drivers(drivers_),
               history_depth(drivers_, config.servo_period_ns)) {
+  path_.set_gate(&io_);
   joint_axis_.fill(-1);
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
@@ -141,6 +143,8 @@ void ServoLoop::stop_now(MachineState next) noexcept {
     if (config_.joints[static_cast<std::size_t>(j)].volatile_home)
       joints_.homed[static_cast<std::size_t>(j)] = false;
   }
+  io_.stop_all();
+  resume_pending_ = false;
   status_.machine = next;
   status_.motion = MotionState::idle;
   status_.velocity = 0;
@@ -180,12 +184,24 @@ void ServoLoop::apply(const Command& command) noexcept {
       path_.abort();
       homing_.abort();
       jog_.stop_all();
+      // The spindle, coolant and outputs stop at once, not when the path has come to rest.
+      io_.stop_all();
+      resume_pending_ = false;
       break;
     case Command::Kind::pause:
       path_.pause();
+      resume_pending_ = false;
       break;
     case Command::Kind::resume:
-      path_.resume();
+      // A spindle stopped by the pause turns again first; the path waits for it.
+      io_.resume_requested();
+      resume_pending_ = true;
+      break;
+    case Command::Kind::spindle_override:
+      io_.set_override(command.velocity);
+      break;
+    case Command::Kind::release:
+      io_.release(command.id);
       break;
     case Command::Kind::feed_override:
       // The controller clamps; a NaN would stall every later move.
@@ -278,6 +294,26 @@ void ServoLoop::advance_path() noexcept {
   }
 }
 
+void ServoLoop::advance_io() noexcept {
+  if (resume_pending_ && io_.resume_ready()) {
+    resume_pending_ = false;
+    path_.resume();
+  }
+  if (status_.motion == MotionState::paused && !resume_pending_) io_.path_paused();
+  RtEvent error;
+  if (io_.take_error(error)) {
+    // The program stops there; the machine stays on.
+    path_.flush();
+    io_.stop_all();
+    resume_pending_ = false;
+    error.level = EventLevel::warning;
+    status_.path_error = error;
+    ++status_.path_errors;
+    status_.motion = MotionState::idle;
+    post(error);
+  }
+}
+
 void ServoLoop::sync_axes_from_joints() noexcept {
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {
@@ -311,6 +347,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
   while (commands_.pop(command))
     apply(command);
   check_joints();
+  check_spindle();
 
   if (status_.machine == MachineState::on) {
     if (homing_.active()) {
@@ -319,6 +356,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
       advance_jog();
     } else {
       advance_path();
+      advance_io();
     }
   } else {
     // Drives off: the command follows the machine wherever it is pushed.

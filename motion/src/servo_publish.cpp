@@ -14,6 +14,11 @@ void ServoLoop::publish() noexcept {
   status_.segments_done = path_.segments_done();
   status_.moves_done = path_.moves_done();
   status_.homed = joints_.homed;
+  status_.spindle = io_.spindle();
+  status_.io = io_.io();
+  status_.wait = io_.wait();
+  status_.input_result = io_.input_result();
+  status_.input_waits = io_.input_waits();
   std::array<bool, kAxes> seen{};
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);

@@ -1,14 +1,80 @@
 #include "cncd/pipeline/feeder.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <variant>
 
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
-void ProgramFeeder::start_program() {
+void ProgramFeeder::start_program(const motion::AxisPose* at) {
   pending.clear();
   stop_seen = false;
+  input_wait_seen = false;
+  holds.clear();
+  sync_ = {};
+  need_at_speed_ = false;
+  end_known_ = at != nullptr;
+  if (at != nullptr) end_ = *at;
+}
+
+motion::IoAction ProgramFeeder::spindle_action() const {
+  motion::IoAction a;
+  a.kind = motion::IoAction::Kind::spindle;
+  a.direction = static_cast<std::int8_t>(spindle_direction);
+  a.rpm = spindle_speed;
+  return a;
+}
+
+void ProgramFeeder::check_speed(int line) {
+  if (machine_ == nullptr || !on_warning_ || spindle_direction == 0 || spindle_speed <= 0) return;
+  const config::SpindleConfig& sp = machine_->spindle;
+  if (!sp.present || sp.driver == config::SpindleDriver::none) return;
+  const bool reverse = spindle_direction < 0;
+  const double lo = reverse ? sp.min_reverse_velocity : sp.min_forward_velocity;
+  const double hi = reverse ? sp.max_reverse_velocity : sp.max_forward_velocity;
+  if ((spindle_speed >= lo && spindle_speed <= hi) || spindle_speed == warned_rpm_) return;
+  warned_rpm_ = spindle_speed;
+  const bool above = spindle_speed > hi;
+  const std::string key =
+      std::string(above ? "MAX_" : "MIN_") + (reverse ? "REVERSE" : "FORWARD") + "_VELOCITY";
+  char text[200];
+  std::snprintf(text, sizeof text, "S%g is %s [SPINDLE_0] %s %g: the spindle turns at %g rpm",
+                spindle_speed, above ? "above" : "below", key.c_str(), above ? hi : lo,
+                above ? hi : lo);
+  on_warning_(line, text);
+}
+
+void ProgramFeeder::add_action(const motion::IoAction& action, int line) {
+  motion::Move move;
+  move.kind = motion::Move::Kind::action;
+  move.action = action;
+  move.line = line;
+  move.path_mode = path_mode_;
+  pending.push_back(move);
+}
+
+void ProgramFeeder::restore_io_state() {
+  std::deque<motion::Move> front;
+  const auto push = [&](const motion::IoAction& a) {
+    motion::Move move;
+    move.kind = motion::Move::Kind::action;
+    move.action = a;
+    front.push_back(move);
+  };
+  push(spindle_action());
+  motion::IoAction coolant;
+  coolant.kind = motion::IoAction::Kind::coolant;
+  coolant.flood = flood;
+  coolant.mist = mist;
+  push(coolant);
+  if (spindle_direction != 0) {
+    motion::IoAction at_speed;
+    at_speed.kind = motion::IoAction::Kind::wait_at_speed;
+    push(at_speed);
+  }
+  need_at_speed_ = false;
+  pending.insert(pending.begin(), front.begin(), front.end());
 }
 
 void ProgramFeeder::emit(const interp::CanonCommand& command) {
@@ -16,21 +82,69 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   const in::CanonCommand m = tracker_.to_machine(command);
   motion::Move move;
   move.line = m.line;
-  // Spindle, coolant and tool events queue no move; they mark a stop point.
+  using Action = motion::IoAction;
+  // Spindle, coolant and output events are actions the servo thread does where the path
+  // rests; a feed move after the spindle starts or changes speed waits until it is at speed.
   auto spindle = [&](int direction) {
-    add_stop_point();
     spindle_direction = direction;
+    check_speed(m.line);
+    add_action(spindle_action(), m.line);
+    need_at_speed_ = direction != 0;
     return false;
   };
   auto coolant = [&](bool& flag, bool on) {
-    add_stop_point();
     flag = on;
+    Action a;
+    a.kind = Action::Kind::coolant;
+    a.flood = flood;
+    a.mist = mist;
+    add_action(a, m.line);
     return false;
   };
+  auto hold = [&](HoldInfo info) {
+    Action a;
+    a.kind = Action::Kind::hold;
+    a.hold = info.kind;
+    a.hold_id = next_hold_id_++;
+    info.line = m.line;
+    holds[a.hold_id] = std::move(info);
+    add_action(a, m.line);
+  };
   auto tool_change = [&](int number) {
-    add_stop_point();
     tool = number;
+    const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
+    if (change != nullptr && change->has_position) {
+      // LinuxCNC's TOOL_CHANGE_POSITION: one traverse there, machine coordinates; the axes it
+      // does not name stay where they are.
+      motion::Move there;
+      there.kind = motion::Move::Kind::traverse;
+      there.line = m.line;
+      there.path_mode = motion::Move::PathMode::exact_stop;
+      there.end = end_;
+      for (int i = 0; i < motion::kAxes; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        if (change->position_given[k]) there.end[k] = change->position[k];
+      }
+      pending.push_back(there);
+      end_ = there.end;
+    }
+    HoldInfo info;
+    info.kind = Action::Hold::tool_change;
+    info.tool = number;
+    hold(std::move(info));
     return false;
+  };
+  auto moving = [&](motion::Move& next) {
+    if (next.kind != motion::Move::Kind::traverse && need_at_speed_) {
+      Action a;
+      a.kind = Action::Kind::wait_at_speed;
+      add_action(a, m.line);
+      need_at_speed_ = false;
+    }
+    next.sync = sync_;
+    sync_ = {};
+    end_ = next.end;
+    end_known_ = true;
   };
   auto stop = [&] {
     stop_seen = true;
@@ -41,12 +155,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           [&](const in::StraightTraverse& c) {
             move.kind = motion::Move::Kind::traverse;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
+            moving(move);
             return true;
           },
           [&](const in::StraightFeed& c) {
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
             move.feed = tracker_.feed_per_minute() / 60.0;
+            moving(move);
             return true;
           },
           [&](const in::ArcFeed& c) {
@@ -58,6 +174,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             move.center_first = c.first_axis;
             move.center_second = c.second_axis;
             move.turns = c.rotation;
+            moving(move);
             return true;
           },
           [&](const in::Dwell& c) {
@@ -85,8 +202,65 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           [&](const in::StartSpindleCounterclockwise&) { return spindle(-1); },
           [&](const in::StopSpindleTurning&) { return spindle(0); },
           [&](const in::SetSpindleSpeed& c) {
-            add_stop_point();
             spindle_speed = c.rpm;
+            check_speed(m.line);
+            add_action(spindle_action(), m.line);
+            need_at_speed_ = spindle_direction != 0;
+            return false;
+          },
+          [&](const in::SetSpindleOverrideEnable& c) {
+            Action a;
+            a.kind = Action::Kind::spindle_override_enable;
+            a.on = c.on;
+            add_action(a, m.line);
+            return false;
+          },
+          [&](const in::SetOutputBit& c) {
+            const std::uint32_t bit =
+                c.index >= 0 && c.index < motion::kMaxDigitalIo ? 1u << c.index : 0u;
+            if (c.motion) {
+              sync_.set = c.on ? sync_.set | bit : sync_.set & ~bit;
+              sync_.clear = c.on ? sync_.clear & ~bit : sync_.clear | bit;
+            } else {
+              Action a;
+              a.kind = Action::Kind::digital_output;
+              a.index = static_cast<std::int16_t>(c.index);
+              a.on = c.on;
+              add_action(a, m.line);
+            }
+            return false;
+          },
+          [&](const in::SetOutputValue& c) {
+            if (c.motion) {
+              if (c.index >= 0 && c.index < motion::kMaxAnalogIo) {
+                sync_.analog[static_cast<std::size_t>(c.index)] = c.value;
+                sync_.analog_mask |= 1u << c.index;
+              }
+            } else {
+              Action a;
+              a.kind = Action::Kind::analog_output;
+              a.index = static_cast<std::int16_t>(c.index);
+              a.value = c.value;
+              add_action(a, m.line);
+            }
+            return false;
+          },
+          [&](const in::WaitInput& c) {
+            Action a;
+            a.kind = Action::Kind::wait_input;
+            a.index = static_cast<std::int16_t>(c.index);
+            a.digital = c.digital;
+            a.mode = static_cast<std::int8_t>(c.mode);
+            a.timeout_s = c.timeout_s;
+            add_action(a, m.line);
+            input_wait_seen = true;
+            return false;
+          },
+          [&](const in::UserMCode& c) {
+            HoldInfo info;
+            info.kind = Action::Hold::user_m;
+            info.user = c;
+            hold(std::move(info));
             return false;
           },
           [&](const in::MistOn&) { return coolant(mist, true); },
@@ -94,7 +268,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           [&](const in::FloodOn&) { return coolant(flood, true); },
           [&](const in::FloodOff&) { return coolant(flood, false); },
           [&](const in::ChangeTool& c) { return tool_change(c.tool); },
-          [&](const in::ChangeToolNumber& c) { return tool_change(c.tool); },
+          [&](const in::ChangeToolNumber& c) {
+            tool = c.tool;  // M61: the tool is already in the spindle
+            return false;
+          },
           [&](const in::Message& c) {
             if (on_message_) on_message_(m.line, c.text);
             return false;

@@ -39,7 +39,7 @@ class Simulation final : MoveTarget {
         options_(options),
         result_(result),
         interp_(options.interp),
-        feeder_(machine_units(machine)),
+        feeder_(machine_units(machine), {}, &machine),
         planner_(machine) {}
 
   void run() {
@@ -48,7 +48,7 @@ class Simulation final : MoveTarget {
       return;
     }
     if (!start_machine()) return;
-    feeder_.start_program();
+    feeder_.start_program(&previous_);
     std::uint64_t& cycle = cycle_;
     for (;;) {
       if (!feed()) return;
@@ -164,7 +164,13 @@ class Simulation final : MoveTarget {
   // MoveTarget: the next move goes to the planner once its output is in the servo loop's ring.
   bool ready() override { return pump(); }
 
-  Push push(const motion::Move& move) override {
+  Push push(const motion::Move& programmed) override {
+    // No operator changes tools and no input changes here: holds and input waits take no time.
+    motion::Move move = programmed;
+    using Action = motion::IoAction::Kind;
+    if (move.kind == motion::Move::Kind::action &&
+        (move.action.kind == Action::hold || move.action.kind == Action::wait_input))
+      move.action.kind = Action::none;
     bound(move);
     std::string error;
     const double cpu_start = thread_cpu_s();

@@ -53,9 +53,17 @@ class CheckSink final : public interp::CanonSink {
         file_(std::move(file)),
         machine_(options.machine ? *options.machine : every_axis(options.interp.machine_units)),
         planner_(machine_),
-        feeder_(options.interp.machine_units) {}
+        feeder_(options.interp.machine_units, {}, &machine_) {}
 
-  void start_at(const Pose& machine) { position_ = machine; }
+  // What stops the program besides the interpreter: a spindle the machine lacks.
+  std::optional<interp::InterpError> refusal;
+
+  void start_at(const Pose& machine) {
+    position_ = machine;
+    motion::AxisPose at{};
+    std::copy(machine.begin(), machine.end(), at.begin());
+    feeder_.start_program(&at);
+  }
 
   void emit(const CanonCommand& command) override {
     if (options_.trace) options_.trace->emit(command);
@@ -82,6 +90,15 @@ class CheckSink final : public interp::CanonSink {
           arc(move);
           break;
         case motion::Move::Kind::dwell:
+          break;
+        case motion::Move::Kind::action:
+          if (move.action.kind == motion::IoAction::Kind::spindle && move.action.direction != 0 &&
+              machine_.spindle.driver == config::SpindleDriver::none && !refusal) {
+            refusal = interp::InterpError{
+                file_, move.line, 0,
+                std::string(move.action.direction > 0 ? "M3" : "M4") +
+                    " starts a spindle the machine does not have ([SPINDLE_0] DRIVER = none)"};
+          }
           break;
       }
     }
@@ -277,6 +294,10 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
       break;
     }
     ++report.blocks;
+    if (sink.refusal) {
+      report.error = sink.refusal;
+      break;
+    }
     if (step == interp::Interpreter::Step::end) break;
   }
   return report;

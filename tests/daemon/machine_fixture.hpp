@@ -34,7 +34,7 @@ inline const std::vector<std::string>& served_methods() {
       "jog.start",     "jog.stop",         "jog.increment",      "program.open",  "program.run",
       "program.step",  "program.pause",    "program.resume",     "program.abort", "mdi.execute",
       "override.feed", "override.rapid",   "override.spindle",   "tool.list",     "tool.set",
-      "offsets.get",   "offsets.set"};
+      "offsets.get",   "offsets.set",      "tool.change_done"};
   return methods;
 }
 

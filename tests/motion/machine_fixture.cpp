@@ -47,15 +47,16 @@ void RecordingDriver::write(const drivers::JointCommand* commands, int count) no
 }
 
 VirtualMachine::VirtualMachine(const config::MachineConfig& config, std::uint32_t capabilities,
-                               drivers::Driver* drive)
+                               drivers::Driver* drive, drivers::Driver* io_driver)
     : config_(config), sim_(std::make_unique<drivers::SimDriver>()), planner_(config_) {
   std::vector<int> joints;
   for (std::size_t j = 0; j < config_.joints.size(); ++j)
     joints.push_back(static_cast<int>(j));
   EXPECT_EQ(sim_->configure(config_, joints), "");
   recorder_ = std::make_unique<RecordingDriver>(drive != nullptr ? *drive : *sim_, capabilities);
-  loop_ = std::make_unique<motion::ServoLoop>(
-      config_, std::vector<motion::DriverBinding>{{recorder_.get(), joints}});
+  std::vector<motion::DriverBinding> bindings{{recorder_.get(), joints}};
+  if (io_driver != nullptr) bindings.push_back({io_driver, {}});
+  loop_ = std::make_unique<motion::ServoLoop>(config_, std::move(bindings));
 }
 
 double VirtualMachine::motor_position(int j) const {
@@ -65,6 +66,11 @@ double VirtualMachine::motor_position(int j) const {
 
 void VirtualMachine::command(motion::Command::Kind kind, std::uint32_t mask) {
   ASSERT_TRUE(loop_->commands().push(motion::Command{kind, mask}));
+  loop_->cycle(0);
+}
+
+void VirtualMachine::send(const motion::Command& command) {
+  ASSERT_TRUE(loop_->commands().push(command));
   loop_->cycle(0);
 }
 

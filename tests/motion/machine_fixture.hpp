@@ -46,6 +46,13 @@ class RecordingDriver final : public FakeDriver {
     inner_.read(feedback, count);
   }
   void read_inputs(drivers::MachineInputs& inputs) noexcept override { inner_.read_inputs(inputs); }
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    io_written_.push_back(command);  // test code: allocation is fine here
+    inner_.write_io(command);
+  }
+  void read_io(drivers::IoFeedback& feedback) noexcept override { inner_.read_io(feedback); }
+  // Every period's output commands.
+  const std::vector<drivers::IoCommand>& io_written() const { return io_written_; }
   bool fault_reason(char* out, std::size_t size) const noexcept override {
     return inner_.fault_reason(out, size);
   }
@@ -55,11 +62,15 @@ class RecordingDriver final : public FakeDriver {
   const std::vector<motion::JointArray>& written() const { return written_; }
   // Whether the last write enabled the drives.
   bool enabled() const { return enabled_; }
-  void clear() { written_.clear(); }
+  void clear() {
+    written_.clear();
+    io_written_.clear();
+  }
 
  private:
   drivers::Driver& inner_;
   std::vector<motion::JointArray> written_;
+  std::vector<drivers::IoCommand> io_written_;
   bool enabled_ = false;
 };
 
@@ -68,11 +79,12 @@ class VirtualMachine {
   // `capabilities`: what the loop is told the driver can do (the sim's by default). `drive`:
   // the driver behind the recording one, already configured and outliving the machine (the
   // simulated driver by default).
+  // `io_driver`: a driver of no joints for the spindle and signals, outliving the machine.
   explicit VirtualMachine(const config::MachineConfig& config,
                           std::uint32_t capabilities = drivers::kCapHomeSwitch |
                                                        drivers::kCapLimitSwitches |
                                                        drivers::kCapEstopInput,
-                          drivers::Driver* drive = nullptr);
+                          drivers::Driver* drive = nullptr, drivers::Driver* io_driver = nullptr);
   // Machine on and homed.
   void ready();
   // Plans and queues through the look-ahead planner (which may hold the move back until the
@@ -85,10 +97,14 @@ class VirtualMachine {
   int run_until_idle(int max_cycles = 2'000'000);
   void cycles(int n);
   void command(motion::Command::Kind kind, std::uint32_t mask = 0);
+  // Any command, then one period.
+  void send(const motion::Command& command);
   motion::Status status() const { return loop_->status(); }
   const std::vector<motion::AxisPose>& trajectory() const { return trajectory_; }
   // Every recorded period's motor commands (motor coordinates).
   const std::vector<motion::JointArray>& motor_trajectory() const { return recorder_->written(); }
+  // Every recorded period's output commands, as the joint driver was handed them.
+  const std::vector<drivers::IoCommand>& io_trajectory() const { return recorder_->io_written(); }
   void clear_trajectory() {
     trajectory_.clear();
     recorder_->clear();

@@ -34,10 +34,10 @@ int decode_status(int status) {
 }
 
 pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& out,
-            const std::filesystem::path& err) {
+            const std::filesystem::path& err, int stdin_fd = -1) {
   const pid_t pid = fork();
   if (pid != 0) return pid;
-  const int in_fd = open("/dev/null", O_RDONLY);
+  const int in_fd = stdin_fd >= 0 ? stdin_fd : open("/dev/null", O_RDONLY);
   const int out_fd = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   const int err_fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (in_fd < 0 || out_fd < 0 || err_fd < 0) _exit(127);
@@ -117,6 +117,42 @@ CommandResult run_command(const std::vector<std::string>& argv) {
   int status = 0;
   waitpid(pid, &status, 0);
   return {decode_status(status), slurp(dir.path() / "out"), slurp(dir.path() / "err")};
+}
+
+BackgroundCommand::BackgroundCommand(const std::vector<std::string>& argv) {
+  int fds[2];
+  if (pipe(fds) != 0) return;
+  pid_ = spawn(argv, dir_.path() / "out", dir_.path() / "err", fds[0]);
+  close(fds[0]);
+  stdin_fd_ = fds[1];
+}
+
+BackgroundCommand::~BackgroundCommand() {
+  if (stdin_fd_ >= 0) close(stdin_fd_);
+  if (pid_ > 0) {
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+}
+
+bool BackgroundCommand::write_stdin(const std::string& text) {
+  return stdin_fd_ >= 0 &&
+         write(stdin_fd_, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+}
+
+std::string BackgroundCommand::err_so_far() const {
+  return slurp(dir_.path() / "err");
+}
+
+CommandResult BackgroundCommand::wait() {
+  if (stdin_fd_ >= 0) {
+    close(stdin_fd_);
+    stdin_fd_ = -1;
+  }
+  int status = 0;
+  if (pid_ > 0) waitpid(pid_, &status, 0);
+  pid_ = -1;
+  return {decode_status(status), slurp(dir_.path() / "out"), slurp(dir_.path() / "err")};
 }
 
 DaemonProcess::~DaemonProcess() {

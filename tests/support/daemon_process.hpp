@@ -47,6 +47,25 @@ struct CommandResult {
 // Runs argv to completion (stdin from /dev/null), capturing stdout and stderr.
 CommandResult run_command(const std::vector<std::string>& argv);
 
+// A command left running, its standard input a pipe the test writes to.
+class BackgroundCommand {
+ public:
+  explicit BackgroundCommand(const std::vector<std::string>& argv);
+  ~BackgroundCommand();
+  BackgroundCommand(const BackgroundCommand&) = delete;
+  BackgroundCommand& operator=(const BackgroundCommand&) = delete;
+  bool write_stdin(const std::string& text);
+  // What it has written to stderr so far.
+  std::string err_so_far() const;
+  // Closes its standard input and waits for it to end.
+  CommandResult wait();
+
+ private:
+  TempDir dir_;
+  pid_t pid_ = -1;
+  int stdin_fd_ = -1;
+};
+
 class DaemonProcess {
  public:
   DaemonProcess() = default;

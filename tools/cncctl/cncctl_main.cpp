@@ -1,10 +1,12 @@
 // cncctl: command-line client for cncd's control socket. Exit status: see cncctl.hpp.
+#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <string>
@@ -37,6 +39,7 @@ void usage(std::FILE* out) {
       "  open FILE           open FILE for run or step\n"
       "  step [FILE]         run one more line of the open program (or of FILE) and wait\n"
       "  pause | resume      feed hold and continue\n"
+      "  tool-done           the tool a program's M6 waits for is in: go on\n"
       "  abort               stop the running program; returns once the machine is at rest\n"
       "  mdi LINE            execute one block; returns when it has finished\n"
       "  jog AXIS +/-VELOCITY\n"
@@ -84,11 +87,47 @@ int wait_homed(cncd::daemon::Client& client, const std::vector<int>& joints) {
   return kFailed;
 }
 
+// A tool change the program waits for: prompts once and answers tool.change_done when a line
+// comes on standard input (another terminal may answer it with 'cncctl tool-done' meanwhile).
+class ToolPrompt {
+ public:
+  void update(cncd::daemon::Client& client, const json& wait, bool tty) {
+    const bool waiting = wait.is_object() && wait.value("kind", "") == "tool_change";
+    if (!waiting) {
+      prompted_ = false;
+      return;
+    }
+    if (!prompted_) {
+      prompted_ = true;
+      std::fprintf(stderr, "%s%s\n", tty ? "\r\033[K" : "", wait.value("message", "").c_str());
+    }
+    if (stdin_closed_) return;
+    pollfd fd{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&fd, 1, 0) <= 0) return;
+    char buffer[256];
+    const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+    if (n <= 0) {
+      stdin_closed_ = true;  // no operator here: 'cncctl tool-done' answers
+      return;
+    }
+    if (std::memchr(buffer, '\n', static_cast<std::size_t>(n)) == nullptr) return;
+    // Answered meanwhile from elsewhere: the refusal says so, and is of no matter here.
+    const json reply = client.call("tool.change_done");
+    (void)reply;
+  }
+
+ private:
+  bool prompted_ = false;
+  bool stdin_closed_ = false;
+};
+
 int follow_program(cncd::daemon::Client& client, bool json_output) {
   const bool tty = isatty(STDOUT_FILENO) != 0 && !json_output;
   int last_line = -1;
+  ToolPrompt prompt;
   for (;;) {
     const json s = result_of(client.call("status.get"));
+    prompt.update(client, s.contains("wait") ? s["wait"] : json(), tty);
     const auto& p = s["program"];
     const std::string exec = s.value("exec", "");
     const int line = p.value("line", 0);
@@ -193,6 +232,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "abort") return simple("program.abort");
   if (command == "pause") return simple("program.pause");
   if (command == "resume") return simple("program.resume");
+  if (command == "tool-done") return simple("tool.change_done");
   if (command == "mdi") {
     std::string line;
     for (std::size_t i = 1; i < args.size(); ++i)

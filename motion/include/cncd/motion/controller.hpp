@@ -72,6 +72,12 @@ class MotionController {
   // Status::feed_override and Status::rapid_override show the ratios in force.
   void set_feed_override(double ratio);
   void set_rapid_override(double ratio);
+  // The spindle override (ratio, 1.0 = 100 %) scales the commanded spindle speed at once,
+  // within [SPINDLE_0]'s speed limits, unless the program turned it off (M48/M49, M51).
+  void set_spindle_override(double ratio);
+  // Ends the hold the path waits in (Status::wait, an IoAction::Kind::hold) when its id is
+  // `hold_id`: the tool is changed, the user M code has finished.
+  void release_hold(std::uint32_t hold_id);
 
   // Jogs of one axis (config::axis_index), run by the servo thread within the axis's
   // MAX_VELOCITY (speeds above it are capped) and MAX_ACCELERATION; on a homed axis up to its

@@ -11,6 +11,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/rt.hpp"
+#include "cncd/motion/machine_io.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/spsc_ring.hpp"
 #include "cncd/motion/status.hpp"
@@ -37,6 +38,9 @@ class PathExecutor {
 
   // Producer: the planner (task thread). Consumer: the servo thread.
   SegmentRing& segments() noexcept { return segments_; }
+  // Non-RT, before the first advance(): who does the actions and sets a segment's outputs
+  // (none: actions are done at once, outputs ignored).
+  void set_gate(ActionGate* gate) noexcept { gate_ = gate; }
 
   // One period of `dt` seconds along the path; `pose` (the axes) follows it. When a move
   // would start from rest while `joints_apart` is set, the path faults instead.
@@ -84,7 +88,9 @@ class PathExecutor {
   CNCD_RT void run_pass() noexcept;
   // The overrides or a hold changed: the override-dependent exit speeds are all recomputed.
   CNCD_RT void soft_limits_changed() noexcept;
-  CNCD_RT void finish_front() noexcept;          // the window's first segment is done
+  CNCD_RT void finish_front() noexcept;  // the window's first segment is done
+  // The window's first segment starts: its outputs are set.
+  CNCD_RT void activate(const Segment& segment) noexcept;
   CNCD_RT double window_floor_accel() noexcept;  // the smallest acceleration limit in the window
   // S-curve profiles (path_scurve.cpp): one period of path motion whose acceleration changes
   // by at most jerk_ per second, through as many segments as it covers. Spends all of `dt`.
@@ -154,6 +160,8 @@ class PathExecutor {
   int limit_count_ = 0;
   double cap_soft_ = 0, cap_hard_ = 0;  // the active segment's own speed limits
   double dwell_elapsed_s_ = 0;
+  bool action_started_ = false;  // the active action has been asked once
+  ActionGate* gate_ = nullptr;
   bool pause_requested_ = false;
   bool abort_requested_ = false;
   Fault fault_ = Fault::none;  // of this period's advance()

@@ -126,6 +126,10 @@ class Planner {
   std::optional<Merge> merge_;
   std::optional<Held> held_;
   bool next_reserved_ = false;  // join() reduced the next segment's limits for a kink
+  // Outputs of moves that went nowhere, for the next segment to set (SyncOutputs).
+  SyncOutputs pending_sync_{};
+  // Adds the `earlier` settings of outputs to `into`, whose own settings win.
+  static void add_sync(SyncOutputs& into, const SyncOutputs& earlier);
   std::deque<Segment> output_;
 };
 

@@ -37,6 +37,10 @@ struct RtEvent {
     set_point_not_finite,   // `joint`
     joints_apart,           // `joint` stands apart from its axis `axis`
     off_path,               // a queued move starts away from the machine
+    spindle_not_at_speed,   // `error` rpm actual, `limit` commanded, `oldest_ago` ms waited
+    spindle_fault,          // `text`: the driver's words, if any
+    spindle_stale,          // `text`: the driver's words, if any
+    no_spindle,             // the program starts a spindle the machine does not have
   };
   Code code = Code::none;
   EventLevel level = EventLevel::info;

@@ -50,6 +50,10 @@ struct Segment {
   double in_center_first = 0, in_center_second = 0, in_radius = 0;
   double out_center_first = 0, out_center_second = 0, out_radius = 0;
   std::int32_t line = 0;
+  // A dwell that does this (Move::Kind::action) and is over once it is done.
+  IoAction action;
+  // Outputs set as the segment starts (the first segment of a move, or the blend arc into it).
+  SyncOutputs sync;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
   AxisPose start_direction{};

@@ -14,6 +14,7 @@
 #include "cncd/motion/feedback_checks.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
+#include "cncd/motion/machine_io.hpp"
 #include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/rt_stats.hpp"
@@ -35,14 +36,17 @@ struct Command {
     jog_start,
     jog_increment,
     jog_stop,
-    feed_override,  // velocity = the new ratio
-    rapid_override  // velocity = the new ratio
+    feed_override,     // velocity = the new ratio
+    rapid_override,    // velocity = the new ratio
+    spindle_override,  // velocity = the new ratio
+    release            // id: the hold the task answers (tool change done, user M code ended)
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
-  int axis = 0;         // jogs: axis index
-  double velocity = 0;  // jog_start: units/s, signed; jog_increment: speed
-  double distance = 0;  // jog_increment: units, signed
+  int axis = 0;          // jogs: axis index
+  double velocity = 0;   // jog_start: units/s, signed; jog_increment: speed
+  double distance = 0;   // jog_increment: units, signed
+  std::uint32_t id = 0;  // release
 };
 
 // Something the servo thread tells the non-RT side (which logs it), as that side reads it.
@@ -112,6 +116,9 @@ class ServoLoop {
   // One period of path motion: the executor's progress into the status, its fault latched,
   // the joints moved with their axes.
   CNCD_RT void advance_path() noexcept;
+  // The path's actions and outputs (MachineIo) after the path's period: an error of theirs
+  // stops the path, a pause may stop the spindle, a resume waits for it.
+  CNCD_RT void advance_io() noexcept;
   // The first joint whose command stands apart from its axis's position, or -1.
   CNCD_RT int joint_apart() const noexcept;
   CNCD_RT void advance_homing() noexcept;
@@ -121,6 +128,8 @@ class ServoLoop {
   CNCD_RT void read_drivers() noexcept;
   // Feedback judged by checks_; the first joint that fails latches the fault.
   CNCD_RT void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
+  // A spindle drive that faults or stops answering faults the machine.
+  CNCD_RT void check_spindle() noexcept;
   CNCD_RT void write_drivers() noexcept;
   // RT: a joint whose set-point is not a number keeps its last command and the machine
   // faults (RtEvent::Code::set_point_not_finite): a drive never sees a NaN or an infinity.
@@ -149,6 +158,7 @@ class ServoLoop {
   bool drives_enabled_ = false;  // the last commands sent to the drives enabled them
   AxisPose axis_pose_{};
   JointIo joints_{};
+  MachineIo io_;
   PathExecutor path_;
   Homing homing_;
   Jog jog_;
@@ -161,6 +171,8 @@ class ServoLoop {
   RtHistogram histogram_;
   JointArray start_positions_{};
   bool has_start_positions_ = false;
+  drivers::Driver* spindle_driver_ = nullptr;  // the driver that reports the spindle
+  bool resume_pending_ = false;                // a resume waits for the spindle (STOP_ON_PAUSE)
 };
 
 }  // namespace cncd::motion

@@ -38,6 +38,42 @@ struct JointStatus {
   char driver[12] = {};  // the driver's name ("sim", "gpio", "modbus"), "" when none
 };
 
+// The spindle as the servo thread commands it and its driver reports it.
+struct SpindleStatus {
+  bool present = true;           // the machine has a spindle ([SPINDLE_0] DRIVER is not none)
+  bool enabled = false;          // commanded to turn
+  std::int8_t direction = 0;     // 1 M3, -1 M4, 0 stopped
+  double programmed_rpm = 0;     // S as the program set it
+  double commanded_rpm = 0;      // with the override, within the limits (0 when stopped)
+  double actual_rpm = 0;         // as the driver reports it (the command, with no driver)
+  bool at_speed = false;         // turning at the commanded speed (or stopped, when stopped)
+  double override_ratio = 1.0;   // spindle override
+  bool override_enabled = true;  // M51 P0 / M49 turn it off
+  bool has_position = false;     // revolutions comes from an encoder (or the sim spindle)
+  double revolutions = 0;
+  bool paused_off = false;  // stopped by a pause ([SPINDLE_0] STOP_ON_PAUSE), restarts on resume
+};
+
+// The machine's outputs and inputs.
+struct IoStatus {
+  bool flood = false;
+  bool mist = false;
+  std::uint32_t douts = 0;  // bit n: digital output n
+  std::array<double, kMaxAnalogIo> aouts{};
+  std::uint32_t dins = 0;  // bit n: digital input n
+  std::array<double, kMaxAnalogIo> ains{};
+};
+
+// What the path waits for at an action (IoAction): none while it moves.
+struct WaitStatus {
+  enum class Kind : std::uint8_t { none, spindle_at_speed, input, tool_change, user_m };
+  Kind kind = Kind::none;
+  std::uint32_t hold_id = 0;  // tool_change and user_m: what IoAction::hold_id the task answers
+  std::int16_t index = 0;     // input: its index
+  bool digital = true;        // input: digital or analog
+  std::uint64_t since = 0;    // servo cycle the wait began in
+};
+
 // What the servo thread publishes every period.
 struct ServoStatus {
   std::uint64_t sequence = 0;  // servo cycle count at publication
@@ -60,6 +96,16 @@ struct ServoStatus {
   std::uint64_t segments_done = 0;  // segments completed (or dropped by an abort) since start
   std::uint64_t moves_done = 0;     // programmed moves completed (or dropped) since start
   RtEvent fault;                    // latched fault, code none when none
+  SpindleStatus spindle;
+  IoStatus io;
+  WaitStatus wait;
+  // M66: the last wait's result (#5399) and how many waits have ended since the start.
+  double input_result = 0;
+  std::uint64_t input_waits = 0;
+  // Errors that stopped the path but not the machine (a spindle that did not reach its speed
+  // in time): the last one, and how many there have been since the start.
+  RtEvent path_error;
+  std::uint64_t path_errors = 0;
   RtStats rt;
 };
 

@@ -15,10 +15,54 @@ inline constexpr int kJoints = config::kMaxJoints;
 using AxisPose = std::array<double, kAxes>;
 using JointArray = std::array<double, kJoints>;
 
+inline constexpr int kMaxDigitalIo = config::kMaxDigitalIo;
+inline constexpr int kMaxAnalogIo = config::kMaxAnalogIo;
+
+// What the machine does at a point of the program besides moving (S and M3-M5, M7-M9,
+// M64/M65, M68, M66, M6, user M codes): the servo thread does it when the path has come to
+// rest there, and goes on once it is done (a wait) or at once. Trivially copyable.
+struct IoAction {
+  enum class Kind : std::uint8_t {
+    none,
+    spindle,                  // direction (-1, 0, 1) and rpm as programmed
+    spindle_override_enable,  // on (M48/M49, M51)
+    coolant,                  // flood, mist
+    digital_output,           // index, on (M64/M65)
+    analog_output,            // index, value (M68)
+    wait_at_speed,            // the spindle at the commanded speed (before a feed move)
+    wait_input,               // index, digital, mode, timeout_s (M66)
+    hold,                     // until the task releases hold_id (M6, user M codes)
+  };
+  enum class Hold : std::uint8_t { none, tool_change, user_m };
+  Kind kind = Kind::none;
+  std::int8_t direction = 0;
+  bool on = false;
+  bool flood = false;
+  bool mist = false;
+  bool digital = true;
+  Hold hold = Hold::none;
+  std::int8_t mode = 0;
+  std::int16_t index = 0;
+  std::uint32_t hold_id = 0;
+  double rpm = 0;
+  double value = 0;
+  double timeout_s = 0;
+};
+
+// Outputs set as a move starts (M62/M63, M67), exact to the servo period.
+struct SyncOutputs {
+  std::uint32_t set = 0;    // digital outputs turned on
+  std::uint32_t clear = 0;  // digital outputs turned off
+  std::uint32_t analog_mask = 0;
+  std::array<double, kMaxAnalogIo> analog{};  // the values of analog_mask's outputs
+  bool any() const { return (set | clear | analog_mask) != 0; }
+};
+
 // One programmed move as the task layer hands it to the planner: machine coordinates, machine
 // units. Trivially copyable.
 struct Move {
-  enum class Kind : std::uint8_t { traverse, feed, arc, dwell };
+  // An action is a dwell of no time that does `action` (IoAction) where the path rests.
+  enum class Kind : std::uint8_t { traverse, feed, arc, dwell, action };
   Kind kind = Kind::traverse;
   AxisPose end{};   // end point (traverse, feed, arc)
   double feed = 0;  // units/s along the path (feed, arc); traverse uses the limits
@@ -41,6 +85,8 @@ struct Move {
   // straight line are run as that line; 0 = no merging.
   double merge_tolerance = 0;  // units
   std::int32_t line = 0;       // source line of the program, 0 = none
+  IoAction action;             // Kind::action
+  SyncOutputs sync;            // set as this move starts (traverse, feed, arc)
 };
 
 }  // namespace cncd::motion

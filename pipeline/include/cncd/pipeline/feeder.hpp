@@ -5,10 +5,13 @@
 // One thread at a time.
 #pragma once
 
+#include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <string>
 
+#include "cncd/config/machine_config.hpp"
 #include "cncd/interp/canon.hpp"
 #include "cncd/interp/to_machine.hpp"
 #include "cncd/motion/types.hpp"
@@ -32,16 +35,32 @@ struct Drained {
   int line = 0;                                          // the refused move's line
 };
 
+// What a hold (IoAction::Kind::hold) waits for, by its id: the task shows it and answers it.
+struct HoldInfo {
+  motion::IoAction::Hold kind = motion::IoAction::Hold::none;
+  int line = 0;
+  int tool = 0;            // tool_change: the tool to put in
+  interp::UserMCode user;  // user_m: what to run
+};
+
 class ProgramFeeder final : public interp::CanonSink {
  public:
   // Operator messages (MSG) in the program, with their line; none = dropped.
   using MessageHandler = std::function<void(int line, const std::string& text)>;
 
-  explicit ProgramFeeder(interp::Units machine_units, MessageHandler on_message = {})
-      : tracker_(machine_units), on_message_(std::move(on_message)) {}
+  // `machine` (which must outlive the feeder) gives the tool change position; null: none.
+  explicit ProgramFeeder(interp::Units machine_units, MessageHandler on_message = {},
+                         const config::MachineConfig* machine = nullptr)
+      : tracker_(machine_units), on_message_(std::move(on_message)), machine_(machine) {}
   void emit(const interp::CanonCommand& command) override;
-  // Resets what a new program run must not inherit.
-  void start_program();
+  // Receives warnings about the program (an S the spindle's limits clamp), with their line.
+  void on_warning(MessageHandler handler) { on_warning_ = std::move(handler); }
+  // Resets what a new program run must not inherit; `at` is where the machine stands
+  // (machine coordinates), when known.
+  void start_program(const motion::AxisPose* at = nullptr);
+  // Puts the spindle and coolant as the program has left them in front of the pending moves
+  // (run from line: the lines skipped set them).
+  void restore_io_state();
   // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
   // planner is flushed there.
   static bool stop_point(const motion::Move& move) {
@@ -55,8 +74,13 @@ class ProgramFeeder final : public interp::CanonSink {
 
   std::deque<motion::Move> pending;  // moves the planner had no room for yet
   bool stop_seen = false;            // M0/M1/M60 reached in the stream
-  int spindle_direction = 0;         // 1 cw, -1 ccw, 0 stopped
-  double spindle_speed = 0;          // rpm
+  // M66 reached in the stream: the interpreter must not read on until the machine has waited
+  // and its result is in #5399 (Interpreter::set_input_result()). The caller clears it.
+  bool input_wait_seen = false;
+  // The holds queued, by id; the caller erases those it has answered.
+  std::map<std::uint32_t, HoldInfo> holds;
+  int spindle_direction = 0;  // 1 cw, -1 ccw, 0 stopped
+  double spindle_speed = 0;   // rpm
   bool mist = false;
   bool flood = false;
   int tool = 0;
@@ -68,6 +92,23 @@ class ProgramFeeder final : public interp::CanonSink {
   // program, for the task to flush the planner there: the path comes to rest at that point
   // instead of blending through it.
   void add_stop_point();
+  // Queues an action (a zero dwell that does `action` at rest).
+  void add_action(const motion::IoAction& action, int line);
+  // The spindle as the program sets it now.
+  motion::IoAction spindle_action() const;
+  const config::MachineConfig* machine_ = nullptr;
+  MessageHandler on_warning_;
+  // Warns when the spindle's limits clamp the speed the program sets (once per speed).
+  void check_speed(int line);
+  double warned_rpm_ = -1;
+  // M62/M63/M67 waiting for the next move.
+  motion::SyncOutputs sync_{};
+  // M3/M4 or S changed the spindle: the next feed move waits until it is at speed.
+  bool need_at_speed_ = false;
+  std::uint32_t next_hold_id_ = 1;
+  // Where the last move queued ends (machine coordinates), once known.
+  motion::AxisPose end_{};
+  bool end_known_ = false;
 
   // Path control mode and G64 P tolerance (machine units) as the interpreter last set them
   // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).

@@ -1,0 +1,111 @@
+// The spindle, outputs and holds of a running program: tool changes the operator answers,
+// user M codes run for the path, and what status shows of them.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "task.hpp"
+
+namespace cncd::daemon {
+namespace {
+
+const char* wait_kind_name(motion::WaitStatus::Kind kind) {
+  switch (kind) {
+    case motion::WaitStatus::Kind::none:
+      return "";
+    case motion::WaitStatus::Kind::spindle_at_speed:
+      return "spindle_at_speed";
+    case motion::WaitStatus::Kind::input:
+      return "input";
+    case motion::WaitStatus::Kind::tool_change:
+      return "tool_change";
+    case motion::WaitStatus::Kind::user_m:
+      return "user_m";
+  }
+  return "";
+}
+
+}  // namespace
+
+WaitReport Task::wait_report(const motion::Status& s) const {
+  WaitReport out;
+  if (s.wait.kind == motion::WaitStatus::Kind::none || exec_ == ExecState::idle) return out;
+  out.kind = wait_kind_name(s.wait.kind);
+  out.since_s = s.sequence >= s.wait.since ? servo_seconds_since(s.wait.since) : 0.0;
+  switch (s.wait.kind) {
+    case motion::WaitStatus::Kind::spindle_at_speed:
+      out.message = fmt::format("waiting for the spindle to reach {:.0f} rpm (now {:.0f} rpm)",
+                                s.spindle.commanded_rpm, s.spindle.actual_rpm);
+      break;
+    case motion::WaitStatus::Kind::input:
+      out.message = fmt::format("waiting for {} input {}", s.wait.digital ? "digital" : "analog",
+                                s.wait.index);
+      break;
+    case motion::WaitStatus::Kind::tool_change: {
+      const auto hold = feeder_->holds.find(s.wait.hold_id);
+      out.tool = hold != feeder_->holds.end() ? hold->second.tool : 0;
+      std::string what;
+      if (const auto entry = interp_->tool(out.tool); entry && !entry->comment.empty())
+        what = " (" + entry->comment + ")";
+      out.message = fmt::format("Insert T{}{} and press Enter", out.tool, what);
+      break;
+    }
+    case motion::WaitStatus::Kind::user_m: {
+      const auto hold = feeder_->holds.find(s.wait.hold_id);
+      out.message = hold != feeder_->holds.end()
+                        ? fmt::format("running {}", hold->second.user.executable)
+                        : std::string("running a user M code");
+      break;
+    }
+    case motion::WaitStatus::Kind::none:
+      break;
+  }
+  return out;
+}
+
+void Task::tool_change_done() {
+  const auto s = motion_.status();
+  if (exec_ == ExecState::idle || s.wait.kind != motion::WaitStatus::Kind::tool_change)
+    throw TaskError(TaskErrorKind::wrong_state, "no tool change is waiting");
+  const auto hold = feeder_->holds.find(s.wait.hold_id);
+  events_.add("info", "tool",
+              fmt::format("tool T{} put in", hold != feeder_->holds.end() ? hold->second.tool : 0));
+  motion_.release_hold(s.wait.hold_id);
+  if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
+}
+
+bool Task::poll_holds(const motion::Status& s) {
+  if (user_m_.running() || user_m_hold_ != 0) {
+    const auto result = user_m_.poll();
+    if (!result) return true;
+    const auto hold = feeder_->holds.find(user_m_hold_);
+    const int line = hold != feeder_->holds.end() ? hold->second.line : 0;
+    const std::uint32_t id = user_m_hold_;
+    user_m_hold_ = 0;
+    if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
+    if (!result->empty()) {
+      motion_.abort();
+      finish_program(
+          "error", fmt::format("{}:{}: {} {}", program_path_, line, user_m_.executable(), *result));
+      return false;
+    }
+    motion_.release_hold(id);
+    return true;
+  }
+  if (s.wait.kind != motion::WaitStatus::Kind::user_m) return true;
+  const auto hold = feeder_->holds.find(s.wait.hold_id);
+  if (hold == feeder_->holds.end()) return true;
+  const interp::UserMCode& user = hold->second.user;
+  const std::string problem =
+      user_m_.start(user.executable, user.p, user.q, config_.io.user_m_timeout_s);
+  if (!problem.empty()) {
+    motion_.abort();
+    finish_program("error", fmt::format("{}:{}: {} {}", program_path_, hold->second.line,
+                                        user.executable, problem));
+    return false;
+  }
+  spdlog::info("line {}: running {} {:f} {:f}", hold->second.line, user.executable, user.p, user.q);
+  user_m_hold_ = s.wait.hold_id;
+  return true;
+}
+
+}  // namespace cncd::daemon

@@ -1,0 +1,95 @@
+// The servo loop's unit for everything but the axes: the spindle (direction, commanded speed
+// with its override and limits, at-speed), coolant, the program's digital and analog outputs,
+// and the actions queued with the path (IoAction) that set them or wait (at-speed, an input,
+// a hold the task releases). Every method but the constructor is RT (servo thread); it knows
+// nothing of drivers beyond the command and feedback records it fills and reads.
+#pragma once
+
+#include <cstdint>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/rt.hpp"
+#include "cncd/motion/rt_event.hpp"
+#include "cncd/motion/status.hpp"
+#include "cncd/motion/types.hpp"
+
+namespace cncd::motion {
+
+// What the path executor asks when it reaches an action, and tells when a segment starts.
+class ActionGate {
+ public:
+  virtual ~ActionGate() = default;
+  // RT: does `action` (`first`: the first period it is asked) and says whether it is done;
+  // false keeps the path waiting there, and it is asked again next period.
+  CNCD_RT virtual bool run(const IoAction& action, bool first) noexcept = 0;
+  // RT: a segment with outputs to set starts this period.
+  CNCD_RT virtual void started(const SyncOutputs& sync) noexcept = 0;
+};
+
+class MachineIo final : public ActionGate {
+ public:
+  MachineIo(const config::MachineConfig& config, double period_s);
+
+  CNCD_RT bool run(const IoAction& action, bool first) noexcept override;
+  CNCD_RT void started(const SyncOutputs& sync) noexcept override;
+
+  // The drivers' feedback of this period.
+  CNCD_RT void feedback(const drivers::IoFeedback& in) noexcept;
+  // What the drivers are told this period.
+  CNCD_RT const drivers::IoCommand& command() const noexcept { return out_; }
+  // Everything off at once: the spindle, coolant, outputs (estop, drives off, a fault, abort).
+  CNCD_RT void stop_all() noexcept;
+  // The wait the path is in ends (abort, flush): nothing is waited for any more.
+  CNCD_RT void cancel_wait() noexcept;
+  // The task's answer to a hold (tool change done, a user M code finished).
+  CNCD_RT void release(std::uint32_t hold_id) noexcept;
+  CNCD_RT void set_override(double ratio) noexcept;
+  // Pause and resume with [SPINDLE_0] STOP_ON_PAUSE: the spindle stops once the path rests,
+  // and restarts on resume; resumed() says when the path may go on (the spindle at speed).
+  CNCD_RT void path_paused() noexcept;
+  CNCD_RT void resume_requested() noexcept;
+  CNCD_RT bool resume_ready() noexcept;
+  // An error that stops the path (not the machine): true once, with the event.
+  CNCD_RT bool take_error(RtEvent& out) noexcept;
+  // Spindle drive fault or stale answer this period: the machine faults.
+  CNCD_RT bool drive_problem(RtEvent& out) const noexcept;
+
+  CNCD_RT const SpindleStatus& spindle() const noexcept { return spindle_; }
+  CNCD_RT const IoStatus& io() const noexcept { return io_; }
+  CNCD_RT const WaitStatus& wait() const noexcept { return wait_; }
+  CNCD_RT double input_result() const noexcept { return input_result_; }
+  CNCD_RT std::uint64_t input_waits() const noexcept { return input_waits_; }
+  // Called once a period after feedback(), with the cycle count.
+  CNCD_RT void set_cycle(std::uint64_t cycle) noexcept { cycle_ = cycle; }
+
+ private:
+  // The commanded speed from the programmed one, the override and the limits.
+  CNCD_RT void update_command() noexcept;
+  CNCD_RT bool at_speed() const noexcept;
+  CNCD_RT bool wait_at_speed(bool first) noexcept;
+  CNCD_RT bool wait_input(const IoAction& action, bool first) noexcept;
+  CNCD_RT double input_value(const IoAction& action) const noexcept;
+
+  const config::SpindleConfig& config_;
+  double period_s_;
+  bool ideal_;  // no [SPINDLE_0]: at any speed at once, and drives nothing
+  drivers::IoCommand out_{};
+  drivers::IoFeedback in_{};
+  SpindleStatus spindle_{};
+  IoStatus io_{};
+  WaitStatus wait_{};
+  std::uint64_t cycle_ = 0;
+  std::uint64_t waited_ = 0;  // periods the current wait has been asked
+  bool released_ = false;
+  std::uint32_t released_id_ = 0;
+  bool last_input_ = false;  // M66 edges: the input in the previous period
+  double input_result_ = 0;
+  std::uint64_t input_waits_ = 0;
+  bool has_error_ = false;
+  RtEvent error_{};
+  bool resuming_ = false;  // STOP_ON_PAUSE: restarted, waiting for at-speed before going on
+  std::uint64_t resume_waited_ = 0;
+};
+
+}  // namespace cncd::motion
