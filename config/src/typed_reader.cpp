@@ -179,4 +179,23 @@ std::optional<std::string> TypedReader::choice(std::string_view section, std::st
   return std::nullopt;
 }
 
+SignalAddress TypedReader::signal(std::string_view section, std::string_view key,
+                                  bool bare_is_gpio) {
+  SignalAddress address;
+  const IniEntry* e = entry(section, key);
+  if (e == nullptr) return address;
+  std::string written(trim(strip_trailing_comment(e->value)));
+  if (written.empty()) return address;
+  if (bare_is_gpio && written.find(':') == std::string::npos) {
+    written = (written.starts_with('!') ? "gpio:!" + written.substr(1) : "gpio:" + written);
+  }
+  if (const std::string error = parse_signal_address(written, address); !error.empty()) {
+    problem(section, key, "'" + printable(e->value) + "': " + error);
+    return SignalAddress{};
+  }
+  address.text = std::string(trim(strip_trailing_comment(e->value)));
+  address.source = e->source;
+  return address;
+}
+
 }  // namespace cncd::config

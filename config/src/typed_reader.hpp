@@ -31,6 +31,10 @@ class TypedReader {
   std::vector<std::filesystem::path> path_list(std::string_view section, std::string_view key);
   // The choice as the table spells it (the INI may use any case).
   std::optional<std::string> choice(std::string_view section, std::string_view key);
+  // The signal address the key names (its source set); an absent or empty key gives an
+  // address of kind none. With `bare_is_gpio`, a value without a kind ("17", "!17") is a
+  // gpio line.
+  SignalAddress signal(std::string_view section, std::string_view key, bool bare_is_gpio = false);
 
   // The first entry of the key (every one marked used), nullptr when absent.
   const IniEntry* entry(std::string_view section, std::string_view key);

@@ -16,12 +16,13 @@ enum class KeyType {
   path,       // file name, resolved relative to the INI file's directory
   path_list,  // colon-separated list of paths
   choice,     // one of `choices` (separated by '|'), any case
+  signal,     // a signal address (gpio:LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N, sim:NAME)
 };
 
 struct KeySpec {
   std::string_view
       section;  // "TRAJ"; "JOINT_n" / "AXIS_L" / "MODBUS_n" stand for every joint / axis / bus
-  std::string_view key;
+  std::string_view key;  // a trailing "_n" stands for any number: "DIGITAL_OUTPUT_n"
   KeyType type;
   std::string_view default_value;  // as it would be written in the INI; empty: see help
   double min;                      // inclusive unless min_exclusive (real and integer only)
@@ -34,7 +35,8 @@ struct KeySpec {
 
 std::span<const KeySpec> key_table();
 
-// The spec for a key, with [JOINT_3] matched by "JOINT_n" and [AXIS_Y] by "AXIS_L";
+// The spec for a key, with [JOINT_3] matched by "JOINT_n", [AXIS_Y] by "AXIS_L" and the key
+// DIGITAL_OUTPUT_7 by "DIGITAL_OUTPUT_n" (whatever the number: the loader checks its range);
 // nullptr when cncd does not interpret the key.
 const KeySpec* find_key_spec(std::string_view section, std::string_view key);
 

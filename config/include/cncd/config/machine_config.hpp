@@ -94,6 +94,8 @@ inline constexpr int kMaxAnalogIo = 16;
 //   modbus:BUS:SLAVE:di:N        a discrete input
 //   modbus:BUS:SLAVE:ir:N        an input register
 //   sim:NAME                     a simulated signal (tests and demos set and read it)
+// The kind and the table may be written in any case. BUS is 0..99, SLAVE 0..247, N 0..65535;
+// LINE and NAME have no blanks and no ':'. An empty INI value means "not connected".
 struct SignalAddress {
   enum class Kind : std::uint8_t { none, gpio, modbus, sim };
   enum class Table : std::uint8_t { coil, holding, discrete, input };
@@ -109,6 +111,11 @@ struct SignalAddress {
   SourceRef source;  // the key that named it
   bool given() const { return kind != Kind::none; }
 };
+
+// Parses a signal address (the syntax above) into `out`, keeping `text` as written (trimmed);
+// `source` is left to the caller. Returns "" when it parsed, else what is wrong (then `out` is
+// unchanged). Any thread may call it.
+std::string parse_signal_address(std::string_view text, SignalAddress& out);
 
 enum class SpindleDriver { none, sim, gpio, modbus };
 
