@@ -75,6 +75,12 @@ constexpr KeySpec register_key(std::string_view section, std::string_view key,
   return integer_key(section, key, default_value, 0, 65535, "", help);
 }
 
+// A signal address (docs/drivers.md, "Signal addresses"); empty: not connected.
+constexpr KeySpec signal_key(std::string_view section, std::string_view key,
+                             std::string_view help) {
+  return {section, key, KeyType::signal, "", 0, 0, false, "", "", help};
+}
+
 // A real number that must be above zero: a velocity, an acceleration, a following error.
 constexpr KeySpec positive_key(std::string_view section, std::string_view key,
                                std::string_view default_value, std::string_view unit,
@@ -99,7 +105,17 @@ constexpr std::array kKeys{
              "G-code run when the interpreter starts, e.g. G17 G21 G40 G49 G54 G80 G90 G94"),
     path_list_key("RS274NGC", "SUBROUTINE_PATH",
                   "Colon-separated directories searched for O-word subroutine files"),
+    path_list_key("RS274NGC", "USER_M_PATH",
+                  "Colon-separated directories searched for user M-code programs (M100-M199), "
+                  "relative to this INI's directory, after the first program directory "
+                  "([DISPLAY] PROGRAM_PREFIX)"),
     path_key("EMCIO", "TOOL_TABLE", "", "Tool table file"),
+    text_key("EMCIO", "TOOL_CHANGE_POSITION", "",
+             "Machine position M6 moves to before the tool change: 3 (X Y Z), 6 (X Y Z A B C) "
+             "or 9 (X Y Z A B C U V W) numbers in machine units; empty: change where it stands"),
+    bool_key("EMCIO", "TOOL_CHANGE_QUILL_UP", "0", "M6 first moves Z to machine zero (G53 G0 Z0)"),
+    bool_key("EMCIO", "TOOL_CHANGE_WITH_SPINDLE_ON", "0",
+             "The spindle keeps turning during a tool change (lathes, work in the spindle)"),
     text_key("TRAJ", "COORDINATES", "XYZ",
              "Axis letters of the machine; a repeated letter is a gantry (X Y Y Z or XYYZ)"),
     choice_key("TRAJ", "LINEAR_UNITS", "mm", "mm|metric|inch|in|imperial",
@@ -152,6 +168,86 @@ constexpr std::array kKeys{
                   "INI's directory (~ is $HOME); see [DISPLAY] PROGRAM_PREFIX"),
     choice_key("CNCD", "LOG_LEVEL", "info", "trace|debug|info|warn|warning|error|critical|off",
                "Log verbosity"),
+    signal_key("CNCD", "FLOOD_OUTPUT", "Digital output turned on by M8 (flood coolant)"),
+    signal_key("CNCD", "MIST_OUTPUT", "Digital output turned on by M7 (mist coolant)"),
+    signal_key("CNCD", "DIGITAL_OUTPUT_n",
+               "Digital output n (0-31) that M62-M65 set and clear: gpio, coil or sim"),
+    signal_key("CNCD", "ANALOG_OUTPUT_n",
+               "Analog output n (0-15) that M67/M68 write: holding register or sim"),
+    signal_key("CNCD", "DIGITAL_INPUT_n",
+               "Digital input n (0-31) that M66 P waits for or reads: gpio, di, coil or sim"),
+    signal_key("CNCD", "ANALOG_INPUT_n",
+               "Analog input n (0-15) that M66 E reads: input or holding register, or sim"),
+    positive_key("CNCD", "USER_M_TIMEOUT", "60", "s",
+                 "A user M code (M100-M199) still running after this long is stopped and the "
+                 "program with it"),
+
+    choice_key("SPINDLE_0", "DRIVER", "sim", "none|sim|gpio|modbus",
+               "What turns the spindle: none (the machine has none), sim (simulated), gpio "
+               "(enable, direction and PWM lines), modbus (a VFD)"),
+    real_key("SPINDLE_0", "MAX_FORWARD_VELOCITY", "", 0, kInf, "rpm",
+             "Fastest forward speed; faster commands are lowered to it; unset: no limit"),
+    real_key("SPINDLE_0", "MIN_FORWARD_VELOCITY", "0", 0, kInf, "rpm",
+             "Slowest forward speed; slower commands (but 0) are raised to it"),
+    real_key("SPINDLE_0", "MAX_REVERSE_VELOCITY", "", -kInf, kInf, "rpm",
+             "Fastest reverse speed, a magnitude (-500 reads as 500, as in LinuxCNC); 0 = never "
+             "in reverse; unset: MAX_FORWARD_VELOCITY"),
+    real_key("SPINDLE_0", "MIN_REVERSE_VELOCITY", "", -kInf, kInf, "rpm",
+             "Slowest reverse speed, a magnitude; unset: MIN_FORWARD_VELOCITY"),
+    positive_key("SPINDLE_0", "INCREMENT", "100", "rpm",
+                 "Step of the faster/slower commands of a user interface"),
+    real_key("SPINDLE_0", "ACCELERATION", "0", 0, kInf, "rpm/s",
+             "How fast the sim and PWM spindles change speed; 0 = at once"),
+    real_key("SPINDLE_0", "AT_SPEED_TOLERANCE", "0.05", 0, 1, "ratio",
+             "The spindle is at speed within this fraction of the commanded speed"),
+    positive_key("SPINDLE_0", "AT_SPEED_TIMEOUT", "10", "s",
+                 "A spindle not at speed this long after a command stops the program"),
+    bool_key("SPINDLE_0", "STOP_ON_PAUSE", "0",
+             "A pause stops the spindle; resume starts it again and waits until it is at speed"),
+    signal_key("SPINDLE_0", "ENABLE",
+               "gpio: digital output on while the spindle turns; a bare line (17, !17, GPIO17) "
+               "is a gpio line"),
+    signal_key("SPINDLE_0", "DIRECTION", "gpio: digital output on for reverse (M4)"),
+    signal_key("SPINDLE_0", "PWM",
+               "gpio: output the base thread pulses with a duty cycle for the speed"),
+    real_key("SPINDLE_0", "PWM_FREQUENCY", "1000", 0.001, 1e6, "Hz",
+             "gpio: PWM frequency; a period spans whole base periods"),
+    real_key("SPINDLE_0", "PWM_MIN_DUTY", "0", 0, 1, "ratio",
+             "gpio: duty cycle at 0 rpm; duty = PWM_MIN_DUTY + (1 - PWM_MIN_DUTY) x speed / "
+             "MAX_FORWARD_VELOCITY"),
+    signal_key("SPINDLE_0", "ENCODER_A", "gpio: encoder channel A input (with ENCODER_B)"),
+    signal_key("SPINDLE_0", "ENCODER_B", "gpio: encoder channel B input (with ENCODER_A)"),
+    signal_key("SPINDLE_0", "ENCODER_INDEX", "gpio: encoder index input, once a revolution"),
+    integer_key("SPINDLE_0", "ENCODER_PPR", "0", 0, 1'000'000, "pulses/rev",
+                "gpio: encoder pulses a revolution on each channel (4 counts each); 0 = none"),
+    integer_key("SPINDLE_0", "MODBUS", "", 0, 99, "",
+                "modbus: number n of the [MODBUS_n] bus the VFD is on"),
+    integer_key("SPINDLE_0", "SLAVE", "1", 1, 247, "", "modbus: unit identifier of the VFD"),
+    positive_key("SPINDLE_0", "SPEED_SCALE", "1", "",
+                 "modbus: speed register value per rpm (register = rpm x SPEED_SCALE)"),
+    register_key("SPINDLE_0", "COMMAND_REGISTER", "0",
+                 "modbus: holding register of the run command (COMMAND_STOP/FORWARD/REVERSE)"),
+    register_key("SPINDLE_0", "SPEED_REGISTER", "1",
+                 "modbus: holding register of the commanded speed"),
+    integer_key("SPINDLE_0", "ACTUAL_SPEED_REGISTER", "0", -1, 65535, "",
+                "modbus: register of the actual speed, in ACTUAL_SPEED_TABLE; -1 = none"),
+    integer_key("SPINDLE_0", "STATUS_REGISTER", "1", -1, 65535, "",
+                "modbus: register of the status bits, in STATUS_TABLE; -1 = none"),
+    choice_key("SPINDLE_0", "ACTUAL_SPEED_TABLE", "ir", "ir|hr",
+               "modbus: the actual speed is an input (ir) or holding (hr) register"),
+    choice_key("SPINDLE_0", "STATUS_TABLE", "ir", "ir|hr",
+               "modbus: the status is an input (ir) or holding (hr) register"),
+    register_key("SPINDLE_0", "COMMAND_STOP", "0", "modbus: command register value to stop"),
+    register_key("SPINDLE_0", "COMMAND_FORWARD", "1",
+                 "modbus: command register value to run forward"),
+    register_key("SPINDLE_0", "COMMAND_REVERSE", "2",
+                 "modbus: command register value to run in reverse"),
+    integer_key("SPINDLE_0", "RUNNING_BIT", "0", -1, 15, "",
+                "modbus: status bit set while the motor turns; -1 = none"),
+    integer_key("SPINDLE_0", "AT_SPEED_BIT", "1", -1, 15, "",
+                "modbus: status bit set at the commanded speed; -1 = none"),
+    integer_key("SPINDLE_0", "FAULT_BIT", "2", -1, 15, "",
+                "modbus: status bit set when the VFD has tripped; -1 = none"),
 
     position_key("AXIS_L", "MIN_LIMIT", "-1e99",
                  "Lowest position programs and jogs may reach (soft limit)"),
@@ -296,6 +392,14 @@ bool matches_section(std::string_view pattern, std::string_view section) {
   return pattern == section;
 }
 
+// "DIGITAL_OUTPUT_n" matches DIGITAL_OUTPUT_ and digits.
+bool matches_key(std::string_view pattern, std::string_view key) {
+  if (!pattern.ends_with("_n")) return pattern == key;
+  const std::string_view prefix = pattern.substr(0, pattern.size() - 1);
+  return key.size() > prefix.size() && key.starts_with(prefix) &&
+         key.find_first_not_of("0123456789", prefix.size()) == std::string_view::npos;
+}
+
 }  // namespace
 
 std::span<const KeySpec> key_table() {
@@ -304,7 +408,7 @@ std::span<const KeySpec> key_table() {
 
 const KeySpec* find_key_spec(std::string_view section, std::string_view key) {
   for (const auto& spec : kKeys) {
-    if (spec.key == key && matches_section(spec.section, section)) return &spec;
+    if (matches_key(spec.key, key) && matches_section(spec.section, section)) return &spec;
   }
   return nullptr;
 }

@@ -35,6 +35,108 @@ void line(std::string& out, const std::string& text) {
   out += text + "\n";
 }
 
+const char* driver_name(SpindleDriver driver) {
+  switch (driver) {
+    case SpindleDriver::none:
+      return "none";
+    case SpindleDriver::gpio:
+      return "gpio";
+    case SpindleDriver::modbus:
+      return "modbus";
+    case SpindleDriver::sim:
+      break;
+  }
+  return "sim";
+}
+
+// "  NAME = address as written" for a signal that is given.
+void signal_line(std::string& out, const std::string& name, const SignalAddress& a) {
+  if (a.given()) line(out, "  " + name + " = " + a.text);
+}
+
+const char* table_name(SignalAddress::Table table) {
+  return table == SignalAddress::Table::holding ? "holding" : "input";
+}
+
+void describe_spindle(std::string& out, const SpindleConfig& s) {
+  line(out, "Spindle:      driver " + std::string(driver_name(s.driver)) +
+                (s.present ? "" : " (no [SPINDLE_0]: ideal, at speed at once)"));
+  if (s.driver == SpindleDriver::none) return;
+  line(out, "  forward " + num(s.min_forward_velocity) + " .. " + num(s.max_forward_velocity) +
+                " rpm, reverse " +
+                (s.max_reverse_velocity == 0 ? std::string("never")
+                                             : num(s.min_reverse_velocity) + " .. " +
+                                                   num(s.max_reverse_velocity) + " rpm"));
+  line(out, "  acceleration " +
+                (s.acceleration > 0 ? num(s.acceleration) + " rpm/s" : std::string("instant")) +
+                ", at speed within " + num(s.at_speed_tolerance * 100) + " % in " +
+                num(s.at_speed_timeout_s) + " s" + (s.stop_on_pause ? ", stops on pause" : ""));
+  if (s.driver == SpindleDriver::gpio) {
+    signal_line(out, "enable", s.enable);
+    signal_line(out, "direction", s.direction);
+    if (s.pwm.given()) {
+      line(out, "  pwm = " + s.pwm.text + " at " + num(s.pwm_frequency) + " Hz, min duty " +
+                    num(s.pwm_min_duty * 100) + " %");
+    }
+    signal_line(out, "encoder A", s.encoder_a);
+    signal_line(out, "encoder B", s.encoder_b);
+    signal_line(out, "encoder index", s.encoder_index);
+    if (s.encoder_ppr > 0) line(out, "  encoder " + std::to_string(s.encoder_ppr) + " PPR");
+  }
+  if (s.driver == SpindleDriver::modbus) {
+    line(out, "  MODBUS_" + std::to_string(s.modbus) + " slave " + std::to_string(s.slave) +
+                  ", command hr " + std::to_string(s.command_register) + " (stop " +
+                  std::to_string(s.command_stop) + ", forward " +
+                  std::to_string(s.command_forward) + ", reverse " +
+                  std::to_string(s.command_reverse) + "), speed hr " +
+                  std::to_string(s.speed_register) + " x " + num(s.speed_scale));
+    line(out, "  actual speed " +
+                  (s.actual_speed_register < 0
+                       ? std::string("none")
+                       : std::string(table_name(s.actual_speed_table)) + " register " +
+                             std::to_string(s.actual_speed_register)) +
+                  ", status " +
+                  (s.status_register < 0 ? std::string("none")
+                                         : std::string(table_name(s.status_table)) + " register " +
+                                               std::to_string(s.status_register) +
+                                               " (running bit " + std::to_string(s.running_bit) +
+                                               ", at speed bit " + std::to_string(s.at_speed_bit) +
+                                               ", fault bit " + std::to_string(s.fault_bit) + ")"));
+  }
+}
+
+void describe_tool_change(std::string& out, const ToolChangeConfig& t) {
+  std::string text;
+  if (t.quill_up) text += "Z to machine zero, ";
+  if (t.has_position) {
+    text += "move to";
+    for (std::size_t i = 0; i < t.position.size(); ++i) {
+      if (t.position_given[i]) text += std::string(" ") + kAxisLetters[i] + num(t.position[i]);
+    }
+    text += ", ";
+  }
+  if (text.empty()) text = "where the machine stands, ";
+  text += t.with_spindle_on ? "spindle keeps turning" : "spindle stopped";
+  line(out, "Tool change:  " + text);
+}
+
+void describe_io(std::string& out, const IoConfig& io) {
+  line(out, "I/O:");
+  signal_line(out, "flood (M8)", io.flood);
+  signal_line(out, "mist (M7)", io.mist);
+  const auto numbered = [&](const char* name, const auto& signals) {
+    for (std::size_t n = 0; n < signals.size(); ++n)
+      signal_line(out, name + std::to_string(n), signals[n]);
+  };
+  numbered("digital output ", io.digital_outputs);
+  numbered("analog output ", io.analog_outputs);
+  numbered("digital input ", io.digital_inputs);
+  numbered("analog input ", io.analog_inputs);
+  for (const auto& dir : io.user_m_path)
+    line(out, "  user M codes in " + dir.string());
+  line(out, "  user M codes stopped after " + num(io.user_m_timeout_s) + " s");
+}
+
 }  // namespace
 
 std::string describe(const MachineConfig& c) {
@@ -124,6 +226,9 @@ std::string describe(const MachineConfig& c) {
                   (j.scale != 0 ? ", scale " + num(j.scale) : ""));
     line(out, "     " + home);
   }
+  describe_spindle(out, c.spindle);
+  describe_tool_change(out, c.tool_change);
+  describe_io(out, c.io);
   line(out, "cncd:");
   line(out, "  socket " + c.cncd.socket_path + ", read group " + or_none(c.cncd.read_group) +
                 ", control group " + or_none(c.cncd.control_group));

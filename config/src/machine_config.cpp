@@ -58,9 +58,12 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
   load_general(reader, config);
   load_program_dirs(reader, config, options);
   load_state_files(reader, config, options);
+  load_spindle(reader, config);
+  load_io(reader, config);
   if (check_sections(reader)) {
     load_motion(reader, config);
     validate(reader, config);
+    validate_io(reader, config);
   }
   check_keys(reader);
   config.ini = std::move(ini);

@@ -7,8 +7,8 @@
 namespace cncd::config {
 namespace {
 
-constexpr std::string_view kTypedSections[] = {"EMC",  "EMCMOT", "TASK",    "RS274NGC", "EMCIO",
-                                               "TRAJ", "KINS",   "DISPLAY", "CNCD"};
+constexpr std::string_view kTypedSections[] = {
+    "EMC", "EMCMOT", "TASK", "RS274NGC", "EMCIO", "TRAJ", "KINS", "DISPLAY", "CNCD", "SPINDLE_0"};
 
 std::string at_line(const SourceRef& ref) {
   return ref.file + ":" + std::to_string(ref.line);
