@@ -125,9 +125,10 @@ struct SpindleConfig {
   bool present = false;  // the section is in the file
   // DRIVER = none: the machine has no spindle (a program that starts one is refused).
   SpindleDriver driver = SpindleDriver::sim;
-  // LinuxCNC 2.9 keys, rpm. The reverse ones are positive numbers, as LinuxCNC writes them;
-  // MAX_REVERSE_VELOCITY defaults to MAX_FORWARD_VELOCITY, MIN_REVERSE_VELOCITY to
-  // MIN_FORWARD_VELOCITY.
+  // LinuxCNC 2.9 keys, rpm. The reverse ones are positive numbers, as LinuxCNC writes them
+  // (a negative one is read as its magnitude, as LinuxCNC does); MAX_REVERSE_VELOCITY
+  // defaults to MAX_FORWARD_VELOCITY, MIN_REVERSE_VELOCITY to MIN_FORWARD_VELOCITY (to 0 when
+  // MAX_REVERSE_VELOCITY = 0 forbids reverse).
   double max_forward_velocity = 1e99;
   double min_forward_velocity = 0;
   double max_reverse_velocity = 1e99;
@@ -185,8 +186,9 @@ struct IoConfig {
   std::array<SignalAddress, kMaxAnalogIo> analog_outputs;    // ANALOG_OUTPUT_n
   std::array<SignalAddress, kMaxDigitalIo> digital_inputs;   // DIGITAL_INPUT_n
   std::array<SignalAddress, kMaxAnalogIo> analog_inputs;     // ANALOG_INPUT_n
-  // User M codes M100-M199: executables looked for in these directories ([RS274NGC]
-  // USER_M_PATH, else [DISPLAY] PROGRAM_PREFIX), run for at most user_m_timeout_s.
+  // User M codes M100-M199: executables looked for in these directories, in order: the first
+  // program directory ([DISPLAY] PROGRAM_PREFIX, which LinuxCNC searches first), then
+  // [RS274NGC] USER_M_PATH; absolute. Run for at most user_m_timeout_s.
   std::vector<std::filesystem::path> user_m_path;
   double user_m_timeout_s = 60;
 };
