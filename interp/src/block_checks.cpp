@@ -79,13 +79,13 @@ void Interpreter::Impl::check_block() const {
     }
   }
   check_word_users(active_motion);
-  if (b.has('e')) fail("E word with no G70, G76, M66, M67 or M68 to use it", b.col('e'));
   if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
   if (b.has('s') && b.get('s') < 0) fail("Negative spindle speed used", b.col('s'));
   if (b.has('t') && b.get('t') < 0) fail("Negative t word used", b.col('t'));
 }
 
-// Words that no code on the line (or the modal motion) uses are errors in LinuxCNC.
+// Words that no code on the line (or the modal motion) uses are errors in LinuxCNC, checked in
+// its order: D E H I J K L P Q R.
 void Interpreter::Impl::check_word_users(int motion) const {
   const Block& b = block_;
   const int non_modal = b.g_code(GGroup::non_modal);
@@ -93,31 +93,35 @@ void Interpreter::Impl::check_word_users(int motion) const {
   const bool arc = motion == 20 || motion == 30;
   const bool cycle = motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
   const int overrides = b.m_code(MGroup::overrides);
+  const int io = b.m_code(MGroup::io);  // M62-M68
+  const bool user_m = b.m_code(MGroup::user) >= 0;
   auto require = [&](char letter, bool used, const char* message) {
     if (b.has(letter) && !used) fail(message, b.col(letter));
   };
+  require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+  require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
+  require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
   require('i', arc || g10 || motion == 870,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
   require('j', arc || g10 || motion == 870,
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
   require('k', arc || motion == 870, "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
-  require('r', arc || cycle || g10, "R word with no g code that uses it");
+  require('l', g10 || cycle || io == 66,
+          "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
+          "NURBS code");
   const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
                       motion == 820 || motion == 860 || motion == 880 || motion == 890 ||
-                      motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53);
+                      motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53) ||
+                      (io >= 62 && io <= 66) || user_m;
   require('p', p_user,
           "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
           "M63 M64 M65 M66 M98 or user M code to use it");
   const bool q_user = g10 || b.g_code(GGroup::path_control) == 640 || motion == 730 ||
-                      motion == 830 || b.m_code(MGroup::tool_change) == 61;
+                      motion == 830 || b.m_code(MGroup::tool_change) == 61 || io >= 66 || user_m;
   require('q', q_user,
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
-  require('l', g10 || cycle,
-          "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
-          "NURBS code");
-  require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
-  require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
+  require('r', arc || cycle || g10, "R word with no g code that uses it");
 }
 
 }  // namespace cncd::interp

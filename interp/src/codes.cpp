@@ -79,7 +79,8 @@ CodeInfo g_code_info(int code) {
 }
 
 CodeInfo m_code_info(int code) {
-  // M codes first .. last, their group and whether they are supported.
+  // M codes first .. last, their group and whether they are supported. M70-M73 share the
+  // spindle group with M3-M5 and M19, as in LinuxCNC.
   struct Codes {
     int first;
     int last;
@@ -92,7 +93,7 @@ CodeInfo m_code_info(int code) {
       {19, 19, MGroup::spindle, false},    {6, 6, MGroup::tool_change, true},
       {61, 61, MGroup::tool_change, true}, {7, 9, MGroup::coolant, true},
       {48, 53, MGroup::overrides, true},   {62, 68, MGroup::io, false},
-      {70, 73, MGroup::io, false},         {100, 199, MGroup::user, false},
+      {70, 73, MGroup::spindle, false},    {100, 199, MGroup::user, false},
   };
   for (const Codes& codes : kCodes) {
     if (code >= codes.first && code <= codes.last) {

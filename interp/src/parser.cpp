@@ -132,8 +132,6 @@ void BlockParser::read_word(Block& block) {
       block.line_number = read_real_value();
       return;
     }
-    case 'e':
-      fail("Unknown word starting with e", col);
     default:
       break;
   }
@@ -178,8 +176,10 @@ void BlockParser::read_g(Block& block, int col) {
 
 void BlockParser::read_m(Block& block, int col) {
   const int number = read_integer_value();
+  if (number < 0) fail("Negative m code used", col);
+  if (number > 199) fail("M-code greater than 199: M" + std::to_string(number), col);
   const CodeInfo info = m_code_info(number);
-  if (info.group < 0) fail("Unknown m code used", col);
+  if (info.group < 0) fail("Unknown m code used: M" + std::to_string(number), col);
   const auto group = static_cast<std::size_t>(info.group);
   if (block.m[group] != -1) fail("Two m codes used from same modal group", col);
   if (++block.m_count > 4) fail("Too many m codes on line", col);
