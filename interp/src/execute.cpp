@@ -1,6 +1,7 @@
-// One block in LinuxCNC's order of execution: comment, feed mode, feed, speed, tool, spindle,
-// coolant, overrides, dwell, plane, units, cutter compensation, tool length, coordinate system,
-// path control, distance modes, retract mode, non-modal codes, motion, stop.
+// One block in LinuxCNC's order of execution: comment, feed mode, feed, speed, tool, I/O
+// (M62-M68), tool change, spindle, coolant, overrides, user M code, dwell, plane, units, cutter
+// compensation, tool length, coordinate system, path control, distance modes, retract mode,
+// non-modal codes, motion, stop.
 #include <cctype>
 #include <cstdio>
 
@@ -28,6 +29,7 @@ void Interpreter::Impl::execute_block() {
   do_feed_mode();
   do_tool_and_spindle();
   do_coolant_and_overrides();
+  do_user_m_code();
   do_dwell();
   do_modes();
   do_non_modal();
@@ -148,6 +150,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
     tool_prepped_ = tool;
     emit(SelectTool{tool});
   }
+  do_io();  // LinuxCNC's M codes start with group 5, before the tool change
   const int change = block_.m_code(MGroup::tool_change);
   if (change == 6) {
     const int tool = tool_prepped_ < 0 ? tool_in_spindle_ : tool_prepped_;

@@ -143,6 +143,10 @@ struct Interpreter::Impl {
   void do_feed_mode();
   void do_tool_and_spindle();
   void do_coolant_and_overrides();
+  // io.cpp
+  void do_io();
+  void read_input_result();
+  void do_user_m_code();
   void do_dwell();
   void do_modes();
   void do_non_modal();
@@ -255,6 +259,8 @@ struct Interpreter::Impl {
   std::unordered_map<std::string, SubInfo> subs_;
   std::int64_t line_offset_ = 0;  // offset of the line being executed
   int line_before_ = 0;           // line number before it
+  bool input_pending_ = false;    // an M66 ran: #5399 gets its answer before the next line
+  bool input_digital_ = true;     // the M66 was for a digital input
   double last_value_ = 0;         // #<_value>
   bool value_returned_ = false;   // #<_value_returned>
   std::string o_scan_name_;       // scratch for skipping lines

@@ -67,6 +67,7 @@ void Interpreter::Impl::reset_modal_state() {
   ended_ = false;
   loops_without_motion_ = 0;
   seen_percent_ = false;
+  input_pending_ = false;
 }
 
 namespace {
@@ -173,6 +174,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     }
     resend_g5x_ = false;
     resend_g92_ = false;
+    read_input_result();
     LineSource& source = sources_.back();
     line_offset_ = source.tell();
     line_before_ = source.line_number();
@@ -327,6 +329,11 @@ const std::optional<InterpError>& Interpreter::load_error() const {
 
 const std::vector<std::string>& Interpreter::load_warnings() const {
   return impl_->load_warnings_;
+}
+
+void Interpreter::set_input_result(double value) {
+  impl_->input_pending_ = false;
+  impl_->parameters_.set(5399, std::isfinite(value) ? value : -1.0);
 }
 
 int Interpreter::current_line() const {

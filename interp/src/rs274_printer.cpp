@@ -224,11 +224,8 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
             out += std::to_string(c.value);
             out += ')';
           },
-          [&](const WaitInput& c) {
-            out += "WAIT(";
-            append_args(out, c.index, c.digital ? 1 : 0, c.mode, c.timeout_s);
-            out += ')';
-          },
+          // rs274's WAIT prints nothing (only the machine's canon acts on it): no line.
+          [&](const WaitInput&) {},
           [&](const UserMCode& c) {
             out += "USER_M_CODE(";
             append_args(out, c.code, c.p, c.q);
@@ -249,6 +246,7 @@ std::string format_rs274(const CanonCommand& command, int axes) {
 void Rs274Printer::emit(const CanonCommand& command) {
   buffer_.clear();
   append_rs274(buffer_, command.op, axes_);
+  if (buffer_.empty()) return;  // a command rs274 does not print
   buffer_ += '\n';
   out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
 }

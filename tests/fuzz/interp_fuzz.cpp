@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 
 #include "cncd/interp/interpreter.hpp"
@@ -29,15 +30,25 @@ class MachineSink final : public CanonSink {
                                 [](const ArcFeed& c) { return c.first_end; },
                                 [](const Comment& c) { return static_cast<double>(c.text.size()); },
                                 [](const Message& c) { return static_cast<double>(c.text.size()); },
+                                [](const SetOutputValue& c) { return c.value; },
+                                [](const UserMCode& c) { return c.p + c.q; },
+                                [this](const WaitInput& c) {
+                                  waited_ = true;
+                                  return c.timeout_s;
+                                },
                                 [](const auto&) { return 0.0; },
                             },
                             out.op);
   }
   double checksum() const { return checksum_; }
+  // An M66 ran: the machine's answer goes back before the next step, as the daemon's task
+  // does it.
+  bool take_wait() { return std::exchange(waited_, false); }
 
  private:
   MachineTracker tracker_;
   double checksum_ = 0;
+  bool waited_ = false;
 };
 
 void run(Interpreter& interp, MachineSink& sink) {
@@ -47,6 +58,7 @@ void run(Interpreter& interp, MachineSink& sink) {
       if (step == Interpreter::Step::error && !interp.error()) __builtin_trap();
       return;
     }
+    if (sink.take_wait()) interp.set_input_result(blocks % 3 == 0 ? -1.0 : blocks % 2);
   }
 }
 

@@ -135,6 +135,11 @@ struct OrientSpindle {
   double angle_deg = 0;
   int mode = 0;  // LinuxCNC's orientation mode
 };
+// The program I/O indexes cncd has (config::kMaxDigitalIo, config::kMaxAnalogIo): M62-M66 P
+// 0..31, M66-M68 E 0..15. Another index is an error at its line.
+inline constexpr int kDigitalIoCount = 32;
+inline constexpr int kAnalogIoCount = 16;
+
 // M62/M63 (motion = true: with the start of the next move) and M64/M65 (at once, once the
 // moves before have finished): DIGITAL_OUTPUT_index on or off.
 struct SetOutputBit {
@@ -148,21 +153,23 @@ struct SetOutputValue {
   double value = 0;
   bool motion = false;
 };
-// M66: wait for DIGITAL_INPUT_index (digital) or ANALOG_INPUT_index. mode: 0 no wait (read
-// now), 1 rising edge, 2 falling edge, 3 high, 4 low (digital); 1 above, 2 below ... as
-// LinuxCNC (analog: 0 only). timeout_s as Q. The result goes to #5399 once the machine has
-// waited (Interpreter::set_input_result()).
+// M66: wait for DIGITAL_INPUT_index (digital) or ANALOG_INPUT_index. mode (L): 0 no wait (read
+// now), 1 rising edge, 2 falling edge, 3 high, 4 low; an analog input is read at once (mode
+// 0, timeout 0), as in LinuxCNC. timeout_s: Q when above 0, else 0. The machine's answer goes
+// to #5399 (Interpreter::set_input_result()) before the interpreter reads on: a reader stops
+// after this command until the machine has waited. LinuxCNC's rs274 prints nothing for it.
 struct WaitInput {
   int index = 0;
   bool digital = true;
   int mode = 0;
   double timeout_s = 0;
 };
-// M100-M199: the executable found for it, run with P and Q as its two arguments.
+// M100-M199: the executable found for it (InterpOptions::user_m_path), run with P and Q as its
+// two arguments; an absent P or Q is -1, as LinuxCNC passes it.
 struct UserMCode {
   int code = 0;
-  double p = 0;
-  double q = 0;
+  double p = -1;
+  double q = -1;
   std::string executable;  // absolute path
 };
 struct SetToolTableEntry {

@@ -34,6 +34,10 @@ struct InterpOptions {
   // reads tables as inches). Unset = machine_units.
   std::optional<Units> tool_table_units;
   std::vector<std::filesystem::path> subroutine_path;
+  // Directories searched in order for the user M codes M100-M199: an executable regular file
+  // named exactly M100 .. M199 (LinuxCNC's [DISPLAY] PROGRAM_PREFIX, then [RS274NGC]
+  // USER_M_PATH). A user M code found nowhere is an error ("Unknown m code used: M101").
+  std::vector<std::filesystem::path> user_m_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'
   // O-word loop iterations in a row without a move or dwell before the program is rejected as
@@ -100,6 +104,14 @@ class Interpreter {
   // A parameter file or tool table that does not exist yet: the defaults (an empty table) are
   // used, as LinuxCNC does; one line per file, naming it.
   const std::vector<std::string>& load_warnings() const;
+  // The answer to the last M66 (WaitInput): the input's value (digital 0 or 1, analog its
+  // value) or -1 when the wait timed out. #5399 takes it. The caller (the daemon's task) stops
+  // calling step() after a WaitInput until the machine has waited, then calls this before the
+  // next step(). Without it, #5399 reads as LinuxCNC's standalone interpreter gives it: for a
+  // digital input 1 if #5399 was not 0 and 0 if it was, for an analog input unchanged. A
+  // value that is not finite is taken as -1.
+  void set_input_result(double value);
+
   // Line number of the block last executed.
   int current_line() const;
 

@@ -11,7 +11,10 @@
 namespace cncd::interp {
 
 // One command as rs274 prints it, e.g. "STRAIGHT_FEED(1.0000, 2.0000, 0.0000, 0.0000, 0.0000,
-// 0.0000)". `axes` = 6 prints X Y Z A B C (rs274 without an INI file), 9 adds U V W.
+// 0.0000)". `axes` = 6 prints X Y Z A B C (rs274 without an INI file), 9 adds U V W. Empty for
+// a command rs274 does not print (WaitInput: its WAIT is silent); the printer leaves out its
+// line. UserMCode, which rs274 never gets to (it knows no user M codes), prints as
+// USER_M_CODE(code, p, q).
 std::string format_rs274(const CanonCommand& command, int axes = 6);
 
 class Rs274Printer final : public CanonSink {
