@@ -2,6 +2,10 @@
 
 namespace cncd::pipeline {
 
+// The interpreter checks program I/O indexes against the signals the machine can have.
+static_assert(interp::kDigitalIoCount == config::kMaxDigitalIo);
+static_assert(interp::kAnalogIoCount == config::kMaxAnalogIo);
+
 interp::Units machine_units(const config::MachineConfig& config) {
   return config.linear_units == config::LinearUnits::inch ? interp::Units::inches
                                                           : interp::Units::mm;
@@ -13,6 +17,9 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   options.parameter_file = config.parameter_file;
   options.tool_table = config.tool_table;
   options.subroutine_path = config.subroutine_path;
+  // As LinuxCNC's task looks for M100-M199: the first program directory, then [RS274NGC]
+  // USER_M_PATH (the config lists them in that order).
+  options.user_m_path = config.io.user_m_path;
   options.startup_code = config.startup_code;
   return options;
 }

@@ -135,6 +135,28 @@ TEST_F(CncdCheckTest, MissingProgramBadUsageAndInterpreterErrors) {
   EXPECT_NE(r.err.find("Dwell time p word missing with g82"), std::string::npos) << r.err;
 }
 
+// A user M code needs its executable in [RS274NGC] USER_M_PATH (or the program directory); one
+// found nowhere stops the check at its line, as it would stop program.open and the run.
+TEST_F(CncdCheckTest, UserMCodesAreLookedUpInUserMPath) {
+  std::string text = read_all(ini_);
+  const auto at = text.find("[RS274NGC]\n");
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + 11, "USER_M_PATH = um\n");
+  const auto ini = dir_.write("user_m.ini", text);
+  std::filesystem::create_directories(dir_.path() / "um");
+  const auto m101 = dir_.write("um/M101", "#!/bin/sh\nexit 0\n");
+  std::filesystem::permissions(m101, std::filesystem::perms::owner_all);
+  auto r = check("G0 X1\nM101 P2 Q3\nM2\n", {"--ini", ini.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  r = check("G0 X1\nM101 P2\nM62 P1 M102\nM2\n", {"--ini", ini.string()});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("prog.ngc:3:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Unknown m code used: M102"), std::string::npos) << r.err;
+  r = check("G0 X1\nM101\nM2\n", {"--ini", ini_.string()});  // no USER_M_PATH
+  EXPECT_NE(r.err.find("prog.ngc:2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Unknown m code used: M101"), std::string::npos) << r.err;
+}
+
 TEST_F(CncdCheckTest, AProgramThatNeverEndsIsStoppedWithAClearMessage) {
   const auto r = check("o1 while [1]\nG0 X1\nG0 X2\no1 endwhile\nM2\n", {"--max-seconds", "0.2"});
   EXPECT_EQ(r.exit_status, 1);
