@@ -1,7 +1,9 @@
 #include "cncd/drivers/sim_driver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "cncd/drivers/fault_reason.hpp"
 
@@ -26,6 +28,40 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
     const int direction = joint.home_search_vel > 0 ? 1 : joint.home_search_vel < 0 ? -1 : 0;
     set_home_switch(static_cast<int>(i), joint.home_offset, direction);
   }
+  // Every sim address gets a slot; an output and an input of the same name share it.
+  std::vector<std::string> names;
+  const auto slot = [&](const config::SignalAddress& a) -> int {
+    if (a.kind != config::SignalAddress::Kind::sim) return -1;
+    const auto at = std::find(names.begin(), names.end(), a.name);
+    if (at != names.end()) return static_cast<int>(at - names.begin());
+    names.push_back(a.name);
+    return static_cast<int>(names.size()) - 1;
+  };
+  const config::IoConfig& io = machine.io;
+  flood_ = slot(io.flood);
+  mist_ = slot(io.mist);
+  for (std::size_t n = 0; n < digital_out_.size(); ++n)
+    digital_out_[n] = slot(io.digital_outputs[n]);
+  for (std::size_t n = 0; n < analog_out_.size(); ++n)
+    analog_out_[n] = slot(io.analog_outputs[n]);
+  for (std::size_t n = 0; n < digital_in_.size(); ++n)
+    digital_in_[n] = slot(io.digital_inputs[n]);
+  for (std::size_t n = 0; n < analog_in_.size(); ++n)
+    analog_in_[n] = slot(io.analog_inputs[n]);
+  signal_count_ = names.size();
+  signals_ = std::make_unique<Signal[]>(std::max<std::size_t>(1, signal_count_));
+  for (std::size_t k = 0; k < signal_count_; ++k)
+    signals_[k].name = names[k];
+
+  const config::SpindleConfig& spindle = machine.spindle;
+  spindle_ = spindle.present && spindle.driver == config::SpindleDriver::sim;
+  if (spindle_ && spindle.acceleration < 0) {
+    return "[SPINDLE_0] ACCELERATION must not be negative (0 = at once)";
+  }
+  spindle_acceleration_ = spindle.acceleration;
+  spindle_command_ = SpindleCommand{};
+  spindle_rpm_ = 0;
+  spindle_revolutions_ = 0;
   return "";
 }
 
@@ -60,6 +96,89 @@ void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
   if (estop_.load(std::memory_order_relaxed)) inputs.estop = true;
 }
 
+void SimDriver::store(int index, double value) noexcept {
+  if (index >= 0)
+    signals_[static_cast<std::size_t>(index)].value.store(value, std::memory_order_relaxed);
+}
+
+double SimDriver::load(int index) const noexcept {
+  return index >= 0
+             ? signals_[static_cast<std::size_t>(index)].value.load(std::memory_order_relaxed)
+             : 0.0;
+}
+
+void SimDriver::write_io(const IoCommand& command) noexcept {
+  spindle_command_ = command.spindle;
+  store(flood_, command.flood ? 1 : 0);
+  store(mist_, command.mist ? 1 : 0);
+  for (std::size_t n = 0; n < digital_out_.size(); ++n)
+    store(digital_out_[n], (command.digital >> n) & 1u ? 1 : 0);
+  for (std::size_t n = 0; n < analog_out_.size(); ++n)
+    store(analog_out_[n], command.analog[n]);
+}
+
+void SimDriver::simulate_spindle(IoFeedback& feedback) noexcept {
+  SpindleFeedback& fb = feedback.spindle;
+  fb.present = true;
+  fb.fault = spindle_fault_.load(std::memory_order_relaxed);
+  fb.stale = spindle_stale_.load(std::memory_order_relaxed);
+  fb.has_at_speed = false;
+  fb.at_speed = false;
+  // The stand-in for an encoder: revolutions count the simulated position, signed.
+  fb.has_position = true;
+  if (!fb.stale) {
+    const SpindleCommand& c = spindle_command_;
+    const double target = !c.enable ? 0.0 : c.reverse ? -std::abs(c.rpm) : std::abs(c.rpm);
+    // Signed speed, so a change of direction ramps through zero.
+    const double step = spindle_acceleration_ * period_s_;
+    const double before = spindle_rpm_;
+    if (spindle_acceleration_ <= 0 || std::abs(target - spindle_rpm_) <= step) {
+      spindle_rpm_ = target;
+    } else {
+      spindle_rpm_ += target > spindle_rpm_ ? step : -step;
+    }
+    spindle_revolutions_ += (before + spindle_rpm_) * 0.5 / 60.0 * period_s_;
+  }
+  fb.rpm = std::abs(spindle_rpm_);
+  fb.revolutions = spindle_revolutions_;
+}
+
+void SimDriver::read_io(IoFeedback& feedback) noexcept {
+  if (spindle_) simulate_spindle(feedback);
+  for (std::size_t n = 0; n < digital_in_.size(); ++n) {
+    if (digital_in_[n] < 0) continue;
+    const std::uint32_t bit = 1u << n;
+    feedback.digital = load(digital_in_[n]) != 0 ? feedback.digital | bit : feedback.digital & ~bit;
+  }
+  for (std::size_t n = 0; n < analog_in_.size(); ++n) {
+    if (analog_in_[n] >= 0) feedback.analog[n] = load(analog_in_[n]);
+  }
+}
+
+SimDriver::Signal* SimDriver::find(std::string_view name) const {
+  for (std::size_t k = 0; k < signal_count_; ++k) {
+    if (signals_[k].name == name) return &signals_[k];
+  }
+  return nullptr;
+}
+
+std::optional<double> SimDriver::signal_value(std::string_view name) const {
+  const Signal* s = find(name);
+  if (s == nullptr) return std::nullopt;
+  return s->value.load();
+}
+
+bool SimDriver::signal_on(std::string_view name) const {
+  return signal_value(name).value_or(0) != 0;
+}
+
+bool SimDriver::set_signal(std::string_view name, double value) {
+  Signal* s = find(name);
+  if (s == nullptr) return false;
+  s->value.store(value);
+  return true;
+}
+
 bool SimDriver::fault_reason(char* out, std::size_t size) const noexcept {
   if (size == 0) return false;
   out[0] = '\0';
@@ -72,6 +191,10 @@ bool SimDriver::fault_reason(char* out, std::size_t size) const noexcept {
     text[n++] = static_cast<char>('0' + i % 10);
     text[n] = '\0';
     copy_text(out, size, text);
+    return true;
+  }
+  if (spindle_ && spindle_fault_.load(std::memory_order_relaxed)) {
+    copy_text(out, size, "fault injected on the simulated spindle ([SPINDLE_0] DRIVER = sim)");
     return true;
   }
   return false;

@@ -1,11 +1,16 @@
 // The simulated driver: feedback follows the command, optionally through a first-order lag,
 // with home switches simulated at set positions and faults, stale feedback, limit switches
-// and the estop input injectable from any thread (tests, demos).
+// and the estop input injectable from any thread (tests, demos). With [SPINDLE_0] DRIVER = sim
+// it also simulates the spindle, and it owns every `sim:NAME` signal address.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
 
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/rt.hpp"
@@ -27,7 +32,11 @@ class SimDriver final : public Driver {
   // RT.
   CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
   CNCD_RT void read_inputs(MachineInputs& inputs) noexcept override;
-  // RT-safe, any thread: names the first joint with an injected fault.
+  // RT: the simulated spindle takes the command; sim outputs take their values.
+  CNCD_RT void write_io(const IoCommand& command) noexcept override;
+  // RT: the simulated spindle moves one servo period on; sim inputs give their values.
+  CNCD_RT void read_io(IoFeedback& feedback) noexcept override;
+  // RT-safe, any thread: names the first joint with an injected fault, else the spindle.
   CNCD_RT bool fault_reason(char* out, std::size_t size) const noexcept override;
   std::uint32_t capabilities() const noexcept override {
     return kCapHomeSwitch | kCapLimitSwitches | kCapEstopInput;
@@ -48,7 +57,32 @@ class SimDriver final : public Driver {
   // (direction < 0); direction 0 removes the switch.
   void set_home_switch(int index, double position, int direction) noexcept;
 
+  // The simulated spindle (any thread). A fault or stale feedback shows in SpindleFeedback
+  // until it is injected off again.
+  void set_spindle_fault(bool fault) noexcept { spindle_fault_.store(fault); }
+  void set_spindle_stale(bool stale) noexcept { spindle_stale_.store(stale); }
+
+  // Signals named `sim:NAME` in the config (any thread, not RT: they look the name up).
+  // An output and an input given the same NAME are one signal, wired back to back.
+  // The value of a signal (an output as last written, 0/1 for digital ones), or nothing when
+  // no address names it.
+  std::optional<double> signal_value(std::string_view name) const;
+  // Whether a signal is on (value not 0); false when no address names it.
+  bool signal_on(std::string_view name) const;
+  // Sets a signal the next read_io() reports (a bool gives 0 or 1); false when no address
+  // names it. Setting an output is allowed too, and lasts until the servo writes it again.
+  bool set_signal(std::string_view name, double value);
+
  private:
+  struct Signal {
+    std::string name;
+    std::atomic<double> value{0};
+  };
+  Signal* find(std::string_view name) const;
+  CNCD_RT void store(int index, double value) noexcept;
+  CNCD_RT double load(int index) const noexcept;
+  CNCD_RT void simulate_spindle(IoFeedback& feedback) noexcept;
+
   struct HomeSwitch {
     std::atomic<double> position{0};
     std::atomic<int> direction{0};
@@ -63,6 +97,31 @@ class SimDriver final : public Driver {
   std::array<std::atomic<bool>, kMaxJoints> min_limit_{};
   std::array<std::atomic<bool>, kMaxJoints> max_limit_{};
   std::array<HomeSwitch, kMaxJoints> home_switch_{};
+
+  // Signals: names resolved to indexes at configure(), so the servo thread only indexes.
+  std::unique_ptr<Signal[]> signals_;
+  std::size_t signal_count_ = 0;
+  int flood_ = -1;
+  int mist_ = -1;
+  template <std::size_t N>
+  static constexpr std::array<int, N> none() {
+    std::array<int, N> out{};
+    out.fill(-1);
+    return out;
+  }
+  std::array<int, kMaxDigitalIo> digital_out_ = none<kMaxDigitalIo>();
+  std::array<int, kMaxAnalogIo> analog_out_ = none<kMaxAnalogIo>();
+  std::array<int, kMaxDigitalIo> digital_in_ = none<kMaxDigitalIo>();
+  std::array<int, kMaxAnalogIo> analog_in_ = none<kMaxAnalogIo>();
+
+  // The simulated spindle; state below is the servo thread's.
+  bool spindle_ = false;
+  double spindle_acceleration_ = 0;  // rpm/s, 0 = at once
+  std::atomic<bool> spindle_fault_{false};
+  std::atomic<bool> spindle_stale_{false};
+  SpindleCommand spindle_command_{};
+  double spindle_rpm_ = 0;  // signed: negative turns in reverse
+  double spindle_revolutions_ = 0;
   // Servo thread only.
   std::array<double, kMaxJoints> commanded_{};
   std::array<double, kMaxJoints> position_{};
