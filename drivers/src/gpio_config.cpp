@@ -1,12 +1,129 @@
-// GpioDriver::configure: lines, step timing and inputs from [GPIO] and [JOINT_n] (non-RT).
+// GpioDriver::configure: lines, step timing and inputs from [GPIO] and [JOINT_n], signals
+// and the spindle from their addresses (non-RT).
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "cncd/drivers/gpio_driver.hpp"
 #include "ini_lookup.hpp"
+#include "pwm_encoder.hpp"
 #include "stepgen.hpp"
 
 namespace cncd::drivers {
+namespace {
+
+// "FILE:LINE: ADDRESS: " for a problem with a signal address.
+std::string where(const config::SignalAddress& a) {
+  std::string out;
+  if (!a.source.file.empty()) out = a.source.file + ":" + std::to_string(a.source.line) + ": ";
+  return out + (a.text.empty() ? "gpio:" + a.line : a.text) + ": ";
+}
+
+bool is_gpio(const config::SignalAddress& a) {
+  return a.kind == config::SignalAddress::Kind::gpio;
+}
+
+}  // namespace
+
+std::string GpioDriver::configure_io(const config::MachineConfig& machine,
+                                     std::vector<GpioOutput>& outputs,
+                                     std::vector<int>& input_lines,
+                                     std::vector<std::pair<bool, int>>& input_specs,
+                                     std::set<int>& used) {
+  std::string problem;
+  encoder_a_ = encoder_b_ = encoder_index_ = -1;
+  pwmgen_.reset();
+  encoder_.reset();
+  const auto claim = [&](const config::SignalAddress& a) -> int {
+    std::string why;
+    const int offset = backend_->find_line(a.line, why);
+    if (offset < 0) {
+      if (problem.empty()) problem = where(a) + why;
+      return -1;
+    }
+    if (!used.insert(offset).second) {
+      if (problem.empty())
+        problem = where(a) + "line " + a.line + " is already used by another signal";
+      return -1;
+    }
+    return offset;
+  };
+  const auto output = [&](const config::SignalAddress& a, const std::string& name) {
+    OutputLine out;
+    if (!is_gpio(a)) return out;
+    if (const int offset = claim(a); offset >= 0) {
+      out.output = static_cast<int>(outputs.size());
+      out.active_low = a.active_low;
+      outputs.push_back(GpioOutput{offset, name});
+    }
+    return out;
+  };
+  // Raw input levels (the encoder) and debounced ones (digital inputs) both come from here.
+  const auto input = [&](const config::SignalAddress& a) -> int {
+    if (!is_gpio(a)) return -1;
+    const int offset = claim(a);
+    if (offset < 0) return -1;
+    input_lines.push_back(offset);
+    input_specs.emplace_back(a.active_low, offset);
+    return static_cast<int>(input_lines.size()) - 1;
+  };
+  const config::IoConfig& io = machine.io;
+  flood_ = output(io.flood, "flood");
+  mist_ = output(io.mist, "mist");
+  for (std::size_t n = 0; n < digital_out_.size(); ++n)
+    digital_out_[n] = output(io.digital_outputs[n], "dout" + std::to_string(n));
+  for (std::size_t n = 0; n < digital_in_.size(); ++n)
+    digital_in_[n] = input(io.digital_inputs[n]);
+  for (const auto* analog : {&io.analog_outputs, &io.analog_inputs}) {
+    for (const auto& a : *analog) {
+      if (is_gpio(a) && problem.empty()) {
+        problem = where(a) + "a GPIO line carries no analog value (use modbus:BUS:SLAVE:hr:N)";
+      }
+    }
+  }
+
+  const config::SpindleConfig& sp = machine.spindle;
+  spindle_ = sp.present && sp.driver == config::SpindleDriver::gpio;
+  if (!spindle_) return problem;
+  const std::string section = "[SPINDLE_0] ";
+  spindle_enable_ = output(sp.enable, "spindle_enable");
+  spindle_dir_ = output(sp.direction, "spindle_dir");
+  spindle_pwm_ = output(sp.pwm, "spindle_pwm");
+  spindle_max_rpm_ = sp.max_forward_velocity;
+  pwm_min_duty_ = sp.pwm_min_duty;
+  spindle_acceleration_ = sp.acceleration;
+  if (sp.acceleration < 0 && problem.empty()) {
+    problem = section + "ACCELERATION must not be negative (0 = at once)";
+  }
+  if (sp.pwm.given()) {
+    const double base_rate = 1e9 / static_cast<double>(base_period_ns_);
+    if (!(sp.max_forward_velocity > 0 && sp.max_forward_velocity < 1e9) && problem.empty()) {
+      problem = section + "PWM needs MAX_FORWARD_VELOCITY, the speed at full duty";
+    }
+    if (!(sp.pwm_min_duty >= 0 && sp.pwm_min_duty < 1) && problem.empty()) {
+      problem = section + "PWM_MIN_DUTY must be at least 0 and below 1";
+    }
+    if (!(sp.pwm_frequency > 0 && sp.pwm_frequency * 2 <= base_rate) && problem.empty()) {
+      problem = section + "PWM_FREQUENCY must be positive and at most half the base rate (" +
+                std::to_string(static_cast<long>(base_rate / 2)) + " Hz at BASE_PERIOD " +
+                std::to_string(base_period_ns_) + ")";
+    }
+    pwmgen_ = std::make_unique<Pwmgen>();
+    pwmgen_->setup(base_rate / sp.pwm_frequency);
+  }
+  if (sp.encoder_a.given() || sp.encoder_b.given() || sp.encoder_ppr > 0) {
+    if ((!is_gpio(sp.encoder_a) || !is_gpio(sp.encoder_b) || sp.encoder_ppr <= 0) &&
+        problem.empty()) {
+      problem = section + "an encoder needs ENCODER_A and ENCODER_B on gpio lines and ENCODER_PPR";
+    }
+    encoder_a_ = input(sp.encoder_a);
+    encoder_b_ = input(sp.encoder_b);
+    encoder_index_ = input(sp.encoder_index);
+    encoder_ = std::make_unique<QuadratureDecoder>();
+    encoder_->setup(4 * std::max(1, sp.encoder_ppr));
+  }
+  return problem;
+}
 
 std::string GpioDriver::configure(const config::MachineConfig& machine,
                                   const std::vector<int>& joints) {
@@ -111,6 +228,10 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
   probe_input_ = add_input("GPIO", "PROBE_LINE", "PROBE_ACTIVE_LOW");
   if (estop_input_ >= 0) capabilities_ |= kCapEstopInput;
   if (!ini.error().empty()) return ini.error();
+  if (auto problem = configure_io(machine, outputs, input_lines, input_specs, used);
+      !problem.empty()) {
+    return problem;
+  }
 
   input_count_ = input_lines.size();
   inputs_ = std::make_unique<Input[]>(std::max<std::size_t>(1, input_count_));

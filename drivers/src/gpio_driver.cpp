@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pwm_encoder.hpp"
 #include "stepgen.hpp"
 
 #include "monotonic_clock.hpp"
@@ -22,7 +23,9 @@ constexpr std::int64_t kStaleServoPeriods = 20;
 
 }  // namespace
 
-GpioDriver::GpioDriver() = default;
+GpioDriver::GpioDriver() {
+  digital_in_.fill(-1);
+}
 
 GpioDriver::~GpioDriver() {
   disable();
@@ -68,6 +71,88 @@ void GpioDriver::read(JointFeedback* feedback, int count) noexcept {
     fb.fault = false;
     fb.stale = stale;
   }
+}
+
+void GpioDriver::write_io(const IoCommand& command) noexcept {
+  IoBlock block;
+  block.spindle_enable = command.spindle.enable;
+  block.spindle_reverse = command.spindle.reverse;
+  block.spindle_rpm = command.spindle.rpm;
+  block.flood = command.flood;
+  block.mist = command.mist;
+  block.digital = command.digital;
+  io_mailbox_.store(block);
+}
+
+void GpioDriver::read_io(IoFeedback& feedback) noexcept {
+  for (std::size_t n = 0; n < digital_in_.size(); ++n) {
+    if (digital_in_[n] < 0) continue;
+    const std::uint32_t bit = 1u << n;
+    feedback.digital = input(digital_in_[n]) ? feedback.digital | bit : feedback.digital & ~bit;
+  }
+  if (!spindle_) return;
+  // While the base thread is publishing, the previous period's values do.
+  spindle_state_.try_load(spindle_feedback_);
+  SpindleFeedback& fb = feedback.spindle;
+  fb.present = true;
+  fb.rpm = spindle_feedback_.rpm;
+  fb.has_at_speed = false;
+  fb.at_speed = false;
+  fb.fault = false;
+  fb.stale = running_.load(std::memory_order_relaxed) &&
+             monotonic_ns() - last_period_ns_.load(std::memory_order_relaxed) >
+                 kStaleServoPeriods * std::max(servo_period_ns_, base_period_ns_);
+  fb.has_position = encoder_ != nullptr;
+  fb.revolutions = encoder_ ? spindle_feedback_.revolutions : 0;
+}
+
+void GpioDriver::set_output(const OutputLine& line, bool on) noexcept {
+  if (line.output >= 0) {
+    output_levels_[static_cast<std::size_t>(line.output)] = on != line.active_low ? 1 : 0;
+  }
+}
+
+void GpioDriver::run_io(double dt, std::int64_t time_ns) noexcept {
+  IoBlock latest;
+  if (io_mailbox_.version() != io_version_ && io_mailbox_.try_load(latest)) {
+    io_ = latest;
+    io_version_ = io_mailbox_.version();
+  }
+  set_output(flood_, io_.flood);
+  set_output(mist_, io_.mist);
+  for (std::size_t n = 0; n < digital_out_.size(); ++n)
+    set_output(digital_out_[n], ((io_.digital >> n) & 1u) != 0);
+  if (!spindle_) return;
+  const double rpm = std::abs(io_.spindle_rpm);
+  const double target = !io_.spindle_enable ? 0.0 : io_.spindle_reverse ? -rpm : rpm;
+  // Signed, so that a change of direction ramps through zero.
+  const double step = spindle_acceleration_ * dt;
+  if (spindle_acceleration_ <= 0 || std::abs(target - ramp_rpm_) <= step) {
+    ramp_rpm_ = target;
+  } else {
+    ramp_rpm_ += target > ramp_rpm_ ? step : -step;
+  }
+  set_output(spindle_enable_, io_.spindle_enable);
+  set_output(spindle_dir_, ramp_rpm_ < 0 || (ramp_rpm_ == 0 && target < 0));
+  if (pwmgen_) {
+    const double duty =
+        io_.spindle_enable
+            ? pwm_min_duty_ + (1 - pwm_min_duty_) * std::abs(ramp_rpm_) / spindle_max_rpm_
+            : 0.0;
+    set_output(spindle_pwm_, pwmgen_->tick(duty));
+  }
+  SpindleState state;
+  if (encoder_) {
+    const auto level = [&](int index) {
+      return index >= 0 && input_levels_[static_cast<std::size_t>(index)] != 0;
+    };
+    encoder_->sample(level(encoder_a_), level(encoder_b_), level(encoder_index_), time_ns);
+    state.rpm = encoder_->rpm();
+    state.revolutions = encoder_->revolutions();
+  } else {
+    state.rpm = std::abs(ramp_rpm_);
+  }
+  spindle_state_.store(state);
 }
 
 void GpioDriver::read_inputs(MachineInputs& inputs) noexcept {
@@ -144,6 +229,7 @@ void GpioDriver::run_base_period(std::int64_t time_ns) noexcept {
     }
     counts_[k].store(sg.count(), std::memory_order_relaxed);
   }
+  run_io(dt, time_ns);
   backend_->write_outputs(output_levels_.data(), time_ns);
   sample_inputs();
   periods_.fetch_add(1, std::memory_order_relaxed);

@@ -1,14 +1,21 @@
 // Step/dir joints on GPIO lines (DRIVER = gpio). A base thread at [EMCMOT] BASE_PERIOD runs
 // the step generators and writes all output lines of the chip with one bulk request per period;
-// it samples and debounces the switch inputs. The servo thread meets it only through a seqlock
-// mailbox (commands) and atomics (step counts, switches).
+// it samples and debounces the switch inputs. The servo thread meets it only through seqlock
+// mailboxes (commands) and atomics (step counts, switches).
+//
+// The same base thread drives the `gpio:LINE` signals (coolant, digital outputs and inputs)
+// and a spindle with [SPINDLE_0] DRIVER = gpio: enable and direction lines, a PWM line whose
+// duty follows the speed ramped at ACCELERATION, and an optional quadrature encoder.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <set>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "cncd/drivers/driver.hpp"
@@ -19,6 +26,8 @@
 namespace cncd::drivers {
 
 class Stepgen;
+class Pwmgen;
+class QuadratureDecoder;
 
 class GpioDriver final : public Driver {
  public:
@@ -32,6 +41,10 @@ class GpioDriver final : public Driver {
   CNCD_RT void write(const JointCommand* commands, int count) noexcept override;
   CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
   CNCD_RT void read_inputs(MachineInputs& inputs) noexcept override;
+  // RT: hands the spindle and output commands to the base thread.
+  CNCD_RT void write_io(const IoCommand& command) noexcept override;
+  // RT: the spindle's speed (encoder or ramp) and the debounced digital inputs.
+  CNCD_RT void read_io(IoFeedback& feedback) noexcept override;
   std::uint32_t capabilities() const noexcept override { return capabilities_; }
   const char* name() const noexcept override { return "gpio"; }
 
@@ -67,6 +80,24 @@ class GpioDriver final : public Driver {
     std::array<double, kMaxJoints> velocity{};
     std::array<bool, kMaxJoints> enable{};
   };
+  // Servo thread -> base thread.
+  struct IoBlock {
+    bool spindle_enable = false;
+    bool spindle_reverse = false;
+    double spindle_rpm = 0;
+    bool flood = false;
+    bool mist = false;
+    std::uint32_t digital = 0;
+  };
+  // Base thread -> servo thread.
+  struct SpindleState {
+    double rpm = 0;  // >= 0
+    double revolutions = 0;
+  };
+  struct OutputLine {
+    int output = -1;  // index into output_levels_, -1 = none
+    bool active_low = false;
+  };
   struct JointLines {
     double scale = 1;
     int step_output = -1;
@@ -81,6 +112,11 @@ class GpioDriver final : public Driver {
   void base_loop() noexcept;
   void sample_inputs() noexcept;
   bool input(int index) const noexcept;
+  std::string configure_io(const config::MachineConfig& machine, std::vector<GpioOutput>& outputs,
+                           std::vector<int>& input_lines,
+                           std::vector<std::pair<bool, int>>& input_specs, std::set<int>& used);
+  CNCD_RT void run_io(double dt, std::int64_t time_ns) noexcept;
+  CNCD_RT void set_output(const OutputLine& line, bool on) noexcept;
 
   std::unique_ptr<GpioBackend> backend_;
   std::vector<JointLines> joints_;
@@ -106,6 +142,30 @@ class GpioDriver final : public Driver {
   std::atomic<std::uint64_t> periods_{0};
   std::atomic<std::int64_t> max_late_ns_{0};
   std::atomic<std::int64_t> total_late_ns_{0};
+
+  // Signals and the spindle.
+  OutputLine flood_;
+  OutputLine mist_;
+  std::array<OutputLine, kMaxDigitalIo> digital_out_{};
+  std::array<int, kMaxDigitalIo> digital_in_{};  // index into inputs_, -1 = none
+  bool spindle_ = false;
+  OutputLine spindle_enable_;
+  OutputLine spindle_dir_;
+  OutputLine spindle_pwm_;
+  double spindle_max_rpm_ = 0;
+  double pwm_min_duty_ = 0;
+  double spindle_acceleration_ = 0;  // rpm/s, 0 = at once
+  int encoder_a_ = -1;               // index into input_levels_, -1 = no encoder
+  int encoder_b_ = -1;
+  int encoder_index_ = -1;
+  std::unique_ptr<Pwmgen> pwmgen_;
+  std::unique_ptr<QuadratureDecoder> encoder_;
+  Seqlock<IoBlock> io_mailbox_;
+  IoBlock io_{};  // base thread's copy of the latest command
+  std::uint64_t io_version_ = 0;
+  double ramp_rpm_ = 0;  // base thread: signed, negative in reverse
+  Seqlock<SpindleState> spindle_state_;
+  SpindleState spindle_feedback_{};  // servo thread: kept while the base thread publishes
 
   bool manual_clock_ = false;
   std::atomic<bool> running_{false};
