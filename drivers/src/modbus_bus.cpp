@@ -8,8 +8,11 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include "monotonic_clock.hpp"
 
@@ -52,6 +55,9 @@ bool connected_to_itself(int fd) {
   return local_size == peer_size && std::memcmp(&local, &peer, local_size) == 0;
 }
 
+// A VFD told to run shows its running bit within this time, or it has tripped.
+constexpr std::int64_t kVfdStartNs = 1'000'000'000;
+
 // An exception reply: the drive answered, the request was wrong; the link itself is fine.
 bool is_exception(int error) {
   return error >= EMBXILFUN && error <= EMBXGTAR;
@@ -59,12 +65,14 @@ bool is_exception(int error) {
 
 }  // namespace
 
-ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives)
+ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives, IoSettings io)
     : bus_(std::move(bus)),
       drives_(std::move(drives)),
       setpoints_(std::make_unique<Seqlock<Setpoint>[]>(drives_.size())),
       readbacks_(std::make_unique<Seqlock<Readback>[]>(drives_.size())),
-      state_(drives_.size()) {}
+      state_(drives_.size()),
+      io_(std::move(io)),
+      point_written_(io_.points.size(), std::numeric_limits<double>::quiet_NaN()) {}
 
 ModbusBus::~ModbusBus() {
   stop();
@@ -101,6 +109,10 @@ bool ModbusBus::connect() {
   }
   ctx_ = ctx;
   link_failed_ = false;
+  // A new connection may be a drive that restarted: every output is written once again.
+  std::fill(point_written_.begin(), point_written_.end(), std::numeric_limits<double>::quiet_NaN());
+  vfd_command_written_ = -1;
+  vfd_speed_written_ = -1;
   return true;
 }
 
@@ -209,6 +221,221 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
   return true;
 }
 
+void ModbusBus::vfd_problem(const char* format, ...) {
+  FaultText current;
+  vfd_reason_.copy(current.text.data(), current.text.size());
+  if (current.text[0] != '\0') return;  // the first problem is the one to tell
+  char text[kFaultReasonSize];
+  const int n = std::snprintf(text, sizeof text,
+                              "modbus bus %d slave %d (spindle VFD): ", bus_.number, io_.vfd.slave);
+  const auto used = static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof text) - 1));
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(text + used, sizeof text - used, format, args);
+  va_end(args);
+  vfd_reason_.set(text);
+}
+
+// Outputs are written when they change (and once per connection); inputs are read every
+// update. Digital values on registers are 0/1 (any other value reads as on); analog values on
+// holding registers are rounded to the nearest integer (halves away from zero) and clamped to
+// -32768 .. 65535, negative ones written as 16-bit two's complement; registers read back as
+// 0 .. 65535.
+bool ModbusBus::exchange_points(const IoCommand& command) {
+  modbus_t* ctx = as_ctx(ctx_);
+  for (std::size_t k = 0; k < io_.points.size(); ++k) {
+    const IoPoint& p = io_.points[k];
+    modbus_set_slave(ctx, p.slave);
+    int result = 0;
+    if (p.output()) {
+      double value = 0;
+      switch (p.signal) {
+        case IoPoint::Signal::flood:
+          value = command.flood ? 1 : 0;
+          break;
+        case IoPoint::Signal::mist:
+          value = command.mist ? 1 : 0;
+          break;
+        case IoPoint::Signal::digital_out:
+          value = (command.digital >> p.index) & 1u ? 1 : 0;
+          break;
+        default:
+          value = std::clamp(std::round(command.analog[static_cast<std::size_t>(p.index)]),
+                             -32768.0, 65535.0);
+          break;
+      }
+      if (point_written_[k] == value) continue;
+      if (p.table == IoTable::coil) {
+        result = modbus_write_bit(ctx, p.address, value != 0 ? 1 : 0);
+      } else {
+        const auto reg = static_cast<std::uint16_t>(static_cast<std::int32_t>(value));
+        result = modbus_write_register(ctx, p.address, reg);
+      }
+      if (result != -1) point_written_[k] = value;
+    } else {
+      std::uint8_t bit = 0;
+      std::uint16_t reg = 0;
+      switch (p.table) {
+        case IoTable::coil:
+          result = modbus_read_bits(ctx, p.address, 1, &bit);
+          break;
+        case IoTable::discrete:
+          result = modbus_read_input_bits(ctx, p.address, 1, &bit);
+          break;
+        case IoTable::holding:
+          result = modbus_read_registers(ctx, p.address, 1, &reg);
+          break;
+        case IoTable::input:
+          result = modbus_read_input_registers(ctx, p.address, 1, &reg);
+          break;
+      }
+      if (result != -1) {
+        const bool bits = p.table == IoTable::coil || p.table == IoTable::discrete;
+        const double value = bits ? bit : reg;
+        if (p.signal == IoPoint::Signal::digital_in) {
+          const std::uint32_t mask = 1u << p.index;
+          io_last_.digital = value != 0 ? io_last_.digital | mask : io_last_.digital & ~mask;
+        } else {
+          io_last_.analog[static_cast<std::size_t>(p.index)] = value;
+        }
+      }
+    }
+    if (result == -1 && !is_exception(errno)) return false;  // the link is gone: start over
+  }
+  return true;
+}
+
+bool ModbusBus::exchange_vfd(const IoCommand& command) {
+  const VfdSettings& v = io_.vfd;
+  modbus_t* ctx = as_ctx(ctx_);
+  modbus_set_slave(ctx, v.slave);
+  const SpindleCommand& sp = command.spindle;
+  // A profile whose reverse command is its stop command cannot reverse: M4 stops the spindle
+  // and faults rather than turn it forward.
+  const bool refused = sp.enable && sp.reverse && v.command_reverse == v.command_stop;
+  const int run = !sp.enable || refused ? v.command_stop
+                  : sp.reverse          ? v.command_reverse
+                                        : v.command_forward;
+  const long scaled = std::lround(std::abs(sp.rpm) * v.speed_scale);
+  const int speed = static_cast<int>(std::clamp(scaled, 0L, 65535L));
+  const auto failed = [&](const char* what, int reg) {
+    const int error = errno;
+    if (error == ETIMEDOUT) {
+      vfd_problem("no answer (timeout)");
+    } else {
+      vfd_problem("%s register %d (0x%04x): %s", what, reg, static_cast<unsigned>(reg),
+                  modbus_strerror(error));
+    }
+    return is_exception(error);  // an exception leaves the link usable
+  };
+  const auto write_command = [&] {
+    if (run == vfd_command_written_) return true;
+    if (modbus_write_register(ctx, v.command_register, static_cast<std::uint16_t>(run)) == -1) {
+      return failed("writing holding", v.command_register) && false;
+    }
+    if (run != v.command_stop) vfd_run_since_ns_ = monotonic_ns();
+    vfd_command_written_ = run;
+    return true;
+  };
+  const auto write_speed = [&] {
+    if (speed == vfd_speed_written_) return true;
+    if (modbus_write_register(ctx, v.speed_register, static_cast<std::uint16_t>(speed)) == -1) {
+      return failed("writing holding", v.speed_register) && false;
+    }
+    vfd_speed_written_ = speed;
+    return true;
+  };
+  // The speed before a run command, the stop before a speed: never a start at an old speed.
+  const bool wrote =
+      run == v.command_stop ? write_command() && write_speed() : write_speed() && write_command();
+  if (!wrote) return errno != 0 && is_exception(errno);
+
+  // Both read-only registers in one request when they are close together in one table.
+  std::uint16_t regs[8] = {};
+  std::uint16_t raw_speed = 0;
+  std::uint16_t status = 0;
+  const auto read = [&](bool input, int first, int count) {
+    const int n = input ? modbus_read_input_registers(ctx, first, count, regs)
+                        : modbus_read_registers(ctx, first, count, regs);
+    if (n == -1) failed(input ? "reading input" : "reading holding", first);
+    return n != -1;
+  };
+  const bool has_speed = v.actual_speed_register >= 0;
+  const bool has_status = v.status_register >= 0;
+  bool ok = true;
+  if (has_speed && has_status && v.actual_speed_input == v.status_input &&
+      std::abs(v.actual_speed_register - v.status_register) < 8) {
+    const int first = std::min(v.actual_speed_register, v.status_register);
+    const int count = std::abs(v.actual_speed_register - v.status_register) + 1;
+    ok = read(v.status_input, first, count);
+    raw_speed = regs[v.actual_speed_register - first];
+    status = regs[v.status_register - first];
+  } else {
+    if (ok && has_speed) {
+      ok = read(v.actual_speed_input, v.actual_speed_register, 1);
+      raw_speed = regs[0];
+    }
+    if (ok && has_status) {
+      ok = read(v.status_input, v.status_register, 1);
+      status = regs[0];
+    }
+  }
+  if (!ok) return is_exception(errno);
+
+  const std::int64_t now = monotonic_ns();
+  io_last_.vfd_time_ns = now;
+  io_last_.vfd_status = status;
+  io_last_.vfd_rpm = has_speed               ? raw_speed / v.speed_scale
+                     : sp.enable && !refused ? std::abs(sp.rpm)
+                                             : 0.0;
+  const auto bit = [&](int n) { return n >= 0 && has_status && ((status >> n) & 1u) != 0; };
+  bool fault = false;
+  if (bit(v.fault_bit)) {
+    fault = true;
+    vfd_problem("reports a fault (status 0x%04x)", status);
+  } else if (refused) {
+    fault = true;
+    vfd_problem("reverse (M4) asked for, but COMMAND_REVERSE is COMMAND_STOP: no reverse");
+  } else if (v.running_bit >= 0 && has_status && run != v.command_stop && !bit(v.running_bit) &&
+             now - vfd_run_since_ns_ > kVfdStartNs) {
+    // Told to run a while ago and not running: tripped, or stopped at its own keypad.
+    fault = true;
+    vfd_problem("not running although told to (status 0x%04x)", status);
+  }
+  io_last_.vfd_fault = fault;
+  if (fault) vfd_healthy_since_ns_ = 0;
+  if (!fault && vfd_healthy_since_ns_ == 0) vfd_healthy_since_ns_ = now;
+  return true;
+}
+
+void ModbusBus::exchange_io(bool connected) {
+  // While the servo thread is storing, the previous outputs stay.
+  io_setpoint_.try_load(io_latest_);
+  const IoSetpoint& setpoint = io_latest_;
+  if (setpoint.spindle_starts != vfd_starts_seen_) {
+    // A new start after a fault: the old reason is history.
+    vfd_starts_seen_ = setpoint.spindle_starts;
+    vfd_reason_.clear();
+  }
+  bool ok = connected && !link_failed_;
+  if (!connected && io_.vfd.present) {
+    vfd_problem(bus_.rtu ? "cannot open the serial line" : "cannot connect");
+  }
+  if (ok) {
+    errno = 0;
+    ok = exchange_points(setpoint.command);
+    if (ok && io_.vfd.present) ok = exchange_vfd(setpoint.command);
+    if (!ok) link_failed_ = true;
+  }
+  if (!ok) vfd_healthy_since_ns_ = 0;
+  // Long healthy again: whoever saw the fault or silence has read why by now.
+  const std::int64_t stale_ns = (5LL * bus_.update_period_ms + 2LL * bus_.timeout_ms) * 1'000'000;
+  if (vfd_healthy_since_ns_ != 0 && monotonic_ns() - vfd_healthy_since_ns_ > 2 * stale_ns) {
+    vfd_reason_.clear();
+  }
+  io_readback_.store(io_last_);
+}
+
 void ModbusBus::loop() {
   if (bus_.rt_priority > 0) {
     // Just below the servo thread: kept waiting for the CPU by ordinary work, the bus would
@@ -257,6 +484,7 @@ void ModbusBus::loop() {
       s.last.fault = s.latched;
       readbacks_[i].store(s.last);
     }
+    if (!io_.empty()) exchange_io(connected);
     cycles_.fetch_add(1, std::memory_order_relaxed);
     next_ns += period_ns;
     const std::int64_t now = monotonic_ns();

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/fault_reason.hpp"
 #include "cncd/drivers/seqlock.hpp"
 
@@ -18,6 +19,7 @@ namespace cncd::drivers {
 
 struct BusSettings {
   std::string section;  // "MODBUS_0", for messages
+  int number = 0;       // n of [MODBUS_n]
   bool rtu = false;
   std::string host;
   int port = 502;
@@ -41,6 +43,64 @@ struct DriveSettings {
   int status_register = 2;
   bool wide = true;        // 32-bit positions in two registers
   bool high_first = true;  // word order of 32-bit positions
+};
+
+enum class IoTable : std::uint8_t { coil, holding, discrete, input };
+
+// A coil or register one of the machine's signals lives in.
+struct IoPoint {
+  enum class Signal : std::uint8_t { flood, mist, digital_out, analog_out, digital_in, analog_in };
+  Signal signal = Signal::flood;
+  int index = 0;  // n of DIGITAL_OUTPUT_n and the like
+  int slave = 1;
+  IoTable table = IoTable::coil;
+  int address = 0;
+  bool output() const {
+    return signal == Signal::flood || signal == Signal::mist || signal == Signal::digital_out ||
+           signal == Signal::analog_out;
+  }
+};
+
+// A spindle VFD's register profile (config::SpindleConfig's modbus fields).
+struct VfdSettings {
+  bool present = false;
+  int slave = 1;
+  double speed_scale = 1;  // register value = rpm x speed_scale
+  int command_register = 0;
+  int speed_register = 1;
+  int actual_speed_register = 0;   // -1 = none
+  int status_register = 1;         // -1 = none
+  bool actual_speed_input = true;  // input registers (function 4), else holding (3)
+  bool status_input = true;
+  int command_stop = 0;
+  int command_forward = 1;
+  int command_reverse = 2;
+  int running_bit = 0;  // -1 = none
+  int at_speed_bit = 1;
+  int fault_bit = 2;
+};
+
+struct IoSettings {
+  std::vector<IoPoint> points;
+  VfdSettings vfd;
+  bool empty() const { return points.empty() && !vfd.present; }
+};
+
+// Servo thread -> I/O thread: the latest outputs, and how many times the spindle was started
+// (a new start forgets the VFD's last fault reason).
+struct IoSetpoint {
+  IoCommand command;
+  std::uint32_t spindle_starts = 0;
+};
+
+// I/O thread -> servo thread.
+struct IoReadback {
+  std::uint32_t digital = 0;  // the bits of the digital inputs on this bus
+  std::array<double, kMaxAnalogIo> analog{};
+  double vfd_rpm = 0;            // actual speed, >= 0
+  std::int64_t vfd_time_ns = 0;  // CLOCK_MONOTONIC of the VFD's last full answer; 0 = never
+  std::uint16_t vfd_status = 0;
+  bool vfd_fault = false;  // the fault bit, a refused reverse, or not running when told to
 };
 
 // Servo thread -> I/O thread.
@@ -75,7 +135,7 @@ inline constexpr std::uint16_t kControlFaultReset = 1u << 1;
 
 class ModbusBus {
  public:
-  ModbusBus(BusSettings bus, std::vector<DriveSettings> drives);
+  ModbusBus(BusSettings bus, std::vector<DriveSettings> drives, IoSettings io = {});
   ~ModbusBus();
   ModbusBus(const ModbusBus&) = delete;
   ModbusBus& operator=(const ModbusBus&) = delete;
@@ -95,6 +155,13 @@ class ModbusBus {
     return readbacks_[drive].try_load(out);
   }
   const FaultReason& reason() const noexcept { return reason_; }
+  // RT, servo thread (the only writer).
+  void put_io(const IoSetpoint& setpoint) noexcept { io_setpoint_.store(setpoint); }
+  // RT-safe, any thread. False while the I/O thread is publishing; keep the previous copy.
+  bool get_io(IoReadback& out) const noexcept { return io_readback_.try_load(out); }
+  // Why the spindle VFD faulted or went quiet (see ModbusBus::exchange_vfd).
+  const FaultReason& vfd_reason() const noexcept { return vfd_reason_; }
+  const IoSettings& io() const { return io_; }
   // Any thread: completed update cycles and their start time span, for rate figures.
   std::uint64_t cycles() const noexcept { return cycles_.load(std::memory_order_relaxed); }
 
@@ -119,6 +186,10 @@ class ModbusBus {
   bool exchange(std::size_t index, const Setpoint& setpoint);
   static void remember_write(DriveState& s, std::uint64_t cycle);
   void fail(std::size_t index, const char* what, int first, int count, bool drop_link);
+  void exchange_io(bool connected);
+  bool exchange_points(const IoCommand& command);
+  bool exchange_vfd(const IoCommand& command);
+  void vfd_problem(const char* format, ...) __attribute__((format(printf, 2, 3)));
 
   BusSettings bus_;
   std::vector<DriveSettings> drives_;
@@ -126,6 +197,19 @@ class ModbusBus {
   std::unique_ptr<Seqlock<Readback>[]> readbacks_;
   std::vector<DriveState> state_;  // I/O thread only
   FaultReason reason_;
+  IoSettings io_;
+  Seqlock<IoSetpoint> io_setpoint_;
+  Seqlock<IoReadback> io_readback_;
+  // I/O thread only.
+  IoSetpoint io_latest_{};
+  IoReadback io_last_{};
+  std::vector<double> point_written_;  // last value written to each output point, NaN = none
+  int vfd_command_written_ = -1;       // -1 = not since the connection opened
+  int vfd_speed_written_ = -1;
+  std::int64_t vfd_run_since_ns_ = 0;  // when a run command was last written
+  std::int64_t vfd_healthy_since_ns_ = 0;
+  std::uint32_t vfd_starts_seen_ = 0;
+  FaultReason vfd_reason_;
   std::uint32_t reason_reset_ = 0;  // the reset request that last cleared reason_
   void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
   bool link_failed_ = false;

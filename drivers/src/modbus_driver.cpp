@@ -19,6 +19,7 @@ namespace {
 
 BusSettings read_bus(IniLookup& ini, int number) {
   BusSettings b;
+  b.number = number;
   b.section = "MODBUS_" + std::to_string(number);
   const std::string& s = b.section;
   const std::string transport = upper(ini.choice(s, "TRANSPORT"));
@@ -41,7 +42,99 @@ BusSettings read_bus(IniLookup& ini, int number) {
   return b;
 }
 
+IoTable table_of(config::SignalAddress::Table t) {
+  switch (t) {
+    case config::SignalAddress::Table::coil:
+      return IoTable::coil;
+    case config::SignalAddress::Table::holding:
+      return IoTable::holding;
+    case config::SignalAddress::Table::discrete:
+      return IoTable::discrete;
+    case config::SignalAddress::Table::input:
+      return IoTable::input;
+  }
+  return IoTable::coil;
+}
+
+// "FILE:LINE: ADDRESS: " for a problem with a signal address.
+std::string where(const config::SignalAddress& a) {
+  std::string out;
+  if (!a.source.file.empty()) out = a.source.file + ":" + std::to_string(a.source.line) + ": ";
+  return out + a.text + ": ";
+}
+
+// The modbus signals and the VFD of the config, by bus; "" or the first problem.
+std::string collect_io(const config::MachineConfig& machine, std::map<int, IoSettings>& by_bus) {
+  using Signal = IoPoint::Signal;
+  std::string problem;
+  const auto add = [&](const config::SignalAddress& a, Signal signal, int index) {
+    if (a.kind != config::SignalAddress::Kind::modbus) return;
+    IoPoint p;
+    p.signal = signal;
+    p.index = index;
+    p.slave = a.slave;
+    p.table = table_of(a.table);
+    p.address = a.address;
+    if (p.output() && (p.table == IoTable::discrete || p.table == IoTable::input)) {
+      if (problem.empty()) {
+        problem = where(a) + "discrete inputs and input registers are read-only: use coil or hr";
+      }
+      return;
+    }
+    by_bus[a.bus].points.push_back(p);
+  };
+  const config::IoConfig& io = machine.io;
+  add(io.flood, Signal::flood, 0);
+  add(io.mist, Signal::mist, 0);
+  for (int n = 0; n < kMaxDigitalIo; ++n) {
+    add(io.digital_outputs[static_cast<std::size_t>(n)], Signal::digital_out, n);
+    add(io.digital_inputs[static_cast<std::size_t>(n)], Signal::digital_in, n);
+  }
+  for (int n = 0; n < kMaxAnalogIo; ++n) {
+    add(io.analog_outputs[static_cast<std::size_t>(n)], Signal::analog_out, n);
+    add(io.analog_inputs[static_cast<std::size_t>(n)], Signal::analog_in, n);
+  }
+  const config::SpindleConfig& sp = machine.spindle;
+  if (!sp.present || sp.driver != config::SpindleDriver::modbus) return problem;
+  const std::string section = "[SPINDLE_0] ";
+  if (sp.modbus < 0 && problem.empty()) problem = section + "MODBUS: missing, the n of [MODBUS_n]";
+  if (!(sp.speed_scale > 0) && problem.empty()) {
+    problem = section + "SPEED_SCALE must be positive (register value = rpm x SPEED_SCALE)";
+  }
+  const auto bit_ok = [](int bit) { return bit >= -1 && bit <= 15; };
+  if (!(bit_ok(sp.running_bit) && bit_ok(sp.at_speed_bit) && bit_ok(sp.fault_bit)) &&
+      problem.empty()) {
+    problem = section + "RUNNING_BIT, AT_SPEED_BIT and FAULT_BIT are 0 .. 15, or -1 for none";
+  }
+  VfdSettings& v = by_bus[std::max(0, sp.modbus)].vfd;
+  v.present = true;
+  v.slave = sp.slave;
+  v.speed_scale = sp.speed_scale;
+  v.command_register = sp.command_register;
+  v.speed_register = sp.speed_register;
+  v.actual_speed_register = sp.actual_speed_register;
+  v.status_register = sp.status_register;
+  v.actual_speed_input = sp.actual_speed_table != config::SignalAddress::Table::holding;
+  v.status_input = sp.status_table != config::SignalAddress::Table::holding;
+  v.command_stop = sp.command_stop;
+  v.command_forward = sp.command_forward;
+  v.command_reverse = sp.command_reverse;
+  v.running_bit = sp.running_bit;
+  v.at_speed_bit = sp.at_speed_bit;
+  v.fault_bit = sp.fault_bit;
+  return problem;
+}
+
 }  // namespace
+
+struct ModbusDriver::IoSlot {
+  ModbusBus* bus = nullptr;
+  std::uint32_t digital_mask = 0;  // the digital inputs it reads
+  std::array<bool, kMaxAnalogIo> analog{};
+  bool vfd = false;
+  std::int64_t stale_ns = 0;
+  IoReadback last{};  // kept while the bus thread publishes
+};
 
 ModbusDriver::ModbusDriver() = default;
 
@@ -85,7 +178,20 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
     by_bus[bus].emplace_back(k, d);
   }
   if (!ini.error().empty()) return ini.error();
+  std::map<int, IoSettings> io_by_bus;
+  if (auto problem = collect_io(machine, io_by_bus); !problem.empty()) return problem;
+  for (const auto& [number, io] : io_by_bus) {
+    if (!machine.ini->has_section("MODBUS_" + std::to_string(number))) {
+      return "no section [MODBUS_" + std::to_string(number) + "] for " +
+             (io.vfd.present ? std::string("the spindle ([SPINDLE_0] MODBUS)")
+                             : "a modbus: signal");
+    }
+    by_bus.try_emplace(number);
+  }
+  has_at_speed_ = machine.spindle.at_speed_bit >= 0 && machine.spindle.status_register >= 0;
+  at_speed_bit_ = std::max(0, machine.spindle.at_speed_bit);
   buses_.clear();
+  io_slots_.clear();
   deadline_ns_ = 0;
   for (auto& [number, members] : by_bus) {
     BusSettings settings = read_bus(ini, number);
@@ -100,7 +206,23 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
     std::vector<DriveSettings> drives;
     for (const auto& member : members)
       drives.push_back(member.second);
-    buses_.push_back(std::make_unique<ModbusBus>(settings, std::move(drives)));
+    IoSettings io;
+    if (auto found = io_by_bus.find(number); found != io_by_bus.end()) io = found->second;
+    IoSlot io_slot;
+    for (const IoPoint& p : io.points) {
+      if (p.signal == IoPoint::Signal::digital_in) io_slot.digital_mask |= 1u << p.index;
+      if (p.signal == IoPoint::Signal::analog_in) {
+        io_slot.analog[static_cast<std::size_t>(p.index)] = true;
+      }
+    }
+    io_slot.vfd = io.vfd.present;
+    io_slot.stale_ns = stale_ns;
+    const bool serves_io = !io.empty();
+    buses_.push_back(std::make_unique<ModbusBus>(settings, std::move(drives), std::move(io)));
+    if (serves_io) {
+      io_slot.bus = buses_.back().get();
+      io_slots_.push_back(io_slot);
+    }
     for (std::size_t i = 0; i < members.size(); ++i) {
       Slot& slot = slots_[members[i].first];
       slot.bus = buses_.back().get();
@@ -119,6 +241,13 @@ void ModbusDriver::enable() {
     Readback rb;
     while (std::chrono::steady_clock::now() < deadline) {
       if (slot.bus->get_readback(slot.drive, rb) && rb.time_ns != 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+  // The VFD's first answer, too, so the spindle does not start out stale.
+  for (IoSlot& slot : io_slots_) {
+    while (slot.vfd && std::chrono::steady_clock::now() < deadline) {
+      if (slot.bus->get_io(slot.last) && slot.last.vfd_time_ns != 0) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   }
@@ -169,11 +298,44 @@ void ModbusDriver::read(JointFeedback* feedback, int count) noexcept {
   }
 }
 
+void ModbusDriver::write_io(const IoCommand& command) noexcept {
+  if (command.spindle.enable && !spindle_enabled_) ++spindle_starts_;
+  spindle_enabled_ = command.spindle.enable;
+  for (IoSlot& slot : io_slots_)
+    slot.bus->put_io(IoSetpoint{command, spindle_starts_});
+}
+
+void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
+  const std::int64_t now = monotonic_ns();
+  for (IoSlot& slot : io_slots_) {
+    slot.bus->get_io(slot.last);
+    const IoReadback& rb = slot.last;
+    feedback.digital = (feedback.digital & ~slot.digital_mask) | (rb.digital & slot.digital_mask);
+    for (std::size_t n = 0; n < slot.analog.size(); ++n) {
+      if (slot.analog[n]) feedback.analog[n] = rb.analog[n];
+    }
+    if (!slot.vfd) continue;
+    SpindleFeedback& fb = feedback.spindle;
+    fb = SpindleFeedback{};
+    fb.present = true;
+    fb.rpm = rb.vfd_rpm;
+    fb.has_at_speed = has_at_speed_;
+    fb.at_speed = has_at_speed_ && rb.vfd_fault == false && rb.vfd_time_ns != 0 &&
+                  ((rb.vfd_status >> at_speed_bit_) & 1u) != 0;
+    fb.fault = rb.vfd_fault;
+    fb.stale = rb.vfd_time_ns == 0 || now - rb.vfd_time_ns > slot.stale_ns;
+  }
+}
+
 bool ModbusDriver::fault_reason(char* out, std::size_t size) const noexcept {
   if (size == 0) return false;
   out[0] = '\0';
   for (const auto& bus : buses_) {
     bus->reason().copy(out, size);
+    if (out[0] != '\0') return true;
+  }
+  for (const auto& bus : buses_) {
+    bus->vfd_reason().copy(out, size);
     if (out[0] != '\0') return true;
   }
   return false;

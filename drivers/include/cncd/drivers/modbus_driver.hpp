@@ -6,6 +6,11 @@
 // latch: the drive gets no further setpoints and reports JointFeedback::fault until the servo
 // turns the drives on again (a rising edge of JointCommand::enable), which also pulses the
 // drive's fault-reset bit. The bus reconnects by itself meanwhile.
+//
+// The same I/O threads write `modbus:` outputs (coils, holding registers) when they change,
+// read `modbus:` inputs every update, and drive a spindle VFD ([SPINDLE_0] DRIVER = modbus)
+// through its command, speed, actual speed and status registers. The VFD's fault and stale
+// feedback are reported as they are; the servo thread latches them.
 #pragma once
 
 #include <array>
@@ -32,6 +37,11 @@ class ModbusDriver final : public Driver {
   void disable() override;
   CNCD_RT void write(const JointCommand* commands, int count) noexcept override;
   CNCD_RT void read(JointFeedback* feedback, int count) noexcept override;
+  // RT: hands the outputs and the spindle command to the bus threads.
+  CNCD_RT void write_io(const IoCommand& command) noexcept override;
+  // RT: the VFD's speed and state and the inputs, as the bus threads last read them.
+  CNCD_RT void read_io(IoFeedback& feedback) noexcept override;
+  // RT-safe, any thread: a joint drive's reason first, else the spindle VFD's.
   CNCD_RT bool fault_reason(char* out, std::size_t size) const noexcept override;
   // The stale deadline of the slowest bus plus its update period.
   std::int64_t feedback_deadline_ns() const noexcept override { return deadline_ns_; }
@@ -56,8 +66,15 @@ class ModbusDriver final : public Driver {
     std::uint64_t command_cycle = 0;  // of the last readback
     std::uint64_t previous_cycle = 0;
   };
+  struct IoSlot;  // a bus that serves signals or the spindle (modbus_driver.cpp)
   std::vector<std::unique_ptr<ModbusBus>> buses_;
   std::vector<Slot> slots_;
+  std::vector<IoSlot> io_slots_;
+  // The spindle (servo thread).
+  bool has_at_speed_ = false;
+  int at_speed_bit_ = 0;
+  bool spindle_enabled_ = false;
+  std::uint32_t spindle_starts_ = 0;
   std::int64_t deadline_ns_ = 0;
 };
 

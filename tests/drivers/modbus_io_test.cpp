@@ -1,0 +1,334 @@
+// Signals and the spindle VFD of the modbus driver over loopback TCP, against VfdServer: a
+// drive modelled from its register map (the generic profile, a Delta VFD-E, an
+// AutomationDirect GS2), with coils, registers and discrete inputs beside it.
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "cncd/drivers/fault_reason.hpp"
+#include "cncd/drivers/modbus_driver.hpp"
+#include "test_util.hpp"
+#include "vfd_server.hpp"
+
+namespace cncd::test {
+namespace {
+
+using drivers::IoCommand;
+using drivers::IoFeedback;
+using drivers::ModbusDriver;
+using Table = config::SignalAddress::Table;
+
+constexpr int kSlave = 3;
+
+config::SignalAddress modbus(Table table, int address) {
+  config::SignalAddress a;
+  a.kind = config::SignalAddress::Kind::modbus;
+  a.bus = 0;
+  a.slave = kSlave;
+  a.table = table;
+  a.address = address;
+  a.text = "modbus:0:3:" + std::to_string(address);
+  return a;
+}
+
+IoCommand spindle(bool enable, bool reverse, double rpm) {
+  IoCommand c;
+  c.spindle = drivers::SpindleCommand{enable, reverse, rpm};
+  return c;
+}
+
+class ModbusIo : public ::testing::Test {
+ protected:
+  // Starts the server with `map`, then the driver with no joints and the spindle and
+  // signals `setup` arranges.
+  template <typename Setup>
+  void start(const VfdMap& map, Setup setup) {
+    server_ = std::make_unique<VfdServer>(map, kSlave);
+    ASSERT_EQ(server_->start(), "");
+    loaded_ = load_machine(
+        dir_, 1, "",
+        "[MODBUS_0]\nTRANSPORT = tcp\nHOST = 127.0.0.1\nPORT = " + std::to_string(server_->port()) +
+            "\nTIMEOUT_MS = 40\nUPDATE_PERIOD_MS = 5\nRETRIES = 1\n");
+    ASSERT_TRUE(loaded_.ok());
+    config::MachineConfig c = *loaded_.config;
+    setup(c);
+    ASSERT_EQ(driver_.configure(c, {}), "");
+    driver_.enable();
+  }
+  void start_vfd(const VfdMap& map, const config::SpindleConfig& spindle) {
+    start(map, [&](config::MachineConfig& c) { c.spindle = spindle; });
+  }
+  void TearDown() override { driver_.disable(); }
+
+  // Plays the servo thread at 1 ms until `done` holds, for at most `ms` periods.
+  template <typename Done>
+  bool servo_until(const IoCommand& command, Done done, int ms = 2000) {
+    for (int i = 0; i < ms; ++i) {
+      driver_.write_io(command);
+      feedback_ = IoFeedback{};
+      driver_.read_io(feedback_);
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return false;
+  }
+  void servo(const IoCommand& command, int ms) {
+    servo_until(
+        command, [] { return false; }, ms);
+  }
+  std::string reason() const {
+    char text[drivers::kFaultReasonSize];
+    driver_.fault_reason(text, sizeof text);
+    return text;
+  }
+
+  TempDir dir_;
+  config::LoadResult loaded_;
+  std::unique_ptr<VfdServer> server_;
+  ModbusDriver driver_;
+  IoFeedback feedback_;
+};
+
+config::SpindleConfig generic_spindle() {
+  config::SpindleConfig s;
+  s.present = true;
+  s.driver = config::SpindleDriver::modbus;
+  s.modbus = 0;
+  s.slave = kSlave;
+  s.max_forward_velocity = 24000;
+  s.speed_scale = 0.1;  // the drive takes tens of rpm
+  return s;             // the rest: the default profile
+}
+
+TEST_F(ModbusIo, GenericVfdRunsForwardReverseAndStops) {
+  start_vfd(VfdMap{}, generic_spindle());
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200), [&] {
+    return feedback_.spindle.at_speed && server_->holding(0) == 1;
+  })) << reason();
+  EXPECT_EQ(server_->holding(1), 120);
+  EXPECT_TRUE(feedback_.spindle.present);
+  EXPECT_TRUE(feedback_.spindle.has_at_speed);
+  EXPECT_FALSE(feedback_.spindle.has_position);
+  EXPECT_DOUBLE_EQ(feedback_.spindle.rpm, 1200);
+  EXPECT_FALSE(feedback_.spindle.fault || feedback_.spindle.stale) << reason();
+  EXPECT_EQ(reason(), "");
+
+  ASSERT_TRUE(servo_until(spindle(true, true, 1200), [&] { return server_->holding(0) == 2; }));
+  ASSERT_TRUE(servo_until(spindle(false, true, 1200),
+                          [&] { return server_->holding(0) == 0 && feedback_.spindle.rpm == 0; }));
+  EXPECT_FALSE(feedback_.spindle.at_speed);
+  // Written once at start (stopped, speed 0), then on every change only: speed 0 and 120,
+  // command 0, 1, 2 and 0.
+  servo(spindle(false, true, 1200), 50);
+  EXPECT_EQ(server_->writes(1), 2);
+  EXPECT_EQ(server_->writes(0), 4);
+}
+
+TEST_F(ModbusIo, SpeedIsRoundedAndClampedToARegister) {
+  auto s = generic_spindle();
+  s.speed_scale = 1.0 / 6.0;
+  start_vfd(VfdMap{}, s);
+  ASSERT_TRUE(servo_until(spindle(true, false, 1000), [&] { return server_->holding(1) == 167; }))
+      << server_->holding(1);
+  ASSERT_TRUE(servo_until(spindle(true, false, 1e9), [&] { return server_->holding(1) == 65535; }));
+}
+
+TEST_F(ModbusIo, TheFaultBitIsAFaultWithAReason) {
+  start_vfd(VfdMap{}, generic_spindle());
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200), [&] { return feedback_.spindle.at_speed; }));
+  server_->set_fault(true);
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200), [&] { return feedback_.spindle.fault; }));
+  EXPECT_EQ(reason(), "modbus bus 0 slave 3 (spindle VFD): reports a fault (status 0x0004)");
+  EXPECT_FALSE(feedback_.spindle.stale);
+  // Cleared at the drive and started again: healthy, and the reason is gone.
+  server_->set_fault(false);
+  servo(spindle(false, false, 0), 20);
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200),
+                          [&] { return feedback_.spindle.at_speed && !feedback_.spindle.fault; }));
+  EXPECT_EQ(reason(), "");
+}
+
+TEST_F(ModbusIo, ASilentVfdGoesStaleWithAReason) {
+  start_vfd(VfdMap{}, generic_spindle());
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200), [&] { return feedback_.spindle.at_speed; }));
+  EXPECT_FALSE(feedback_.spindle.stale);
+  server_->set_silent(true);
+  ASSERT_TRUE(servo_until(spindle(true, false, 1200), [&] { return feedback_.spindle.stale; }));
+  EXPECT_EQ(reason(), "modbus bus 0 slave 3 (spindle VFD): no answer (timeout)");
+  server_->set_silent(false);
+  EXPECT_TRUE(servo_until(spindle(true, false, 1200), [&] { return !feedback_.spindle.stale; }));
+}
+
+TEST_F(ModbusIo, CoilsAndRegistersCarryTheSignals) {
+  start(VfdMap{}, [](config::MachineConfig& c) {
+    c.io.flood = modbus(Table::coil, 5);
+    c.io.mist = modbus(Table::holding, 20);
+    c.io.digital_outputs[1] = modbus(Table::coil, 6);
+    c.io.analog_outputs[0] = modbus(Table::holding, 10);
+    c.io.analog_outputs[15] = modbus(Table::holding, 11);
+    c.io.digital_inputs[2] = modbus(Table::discrete, 3);
+    c.io.digital_inputs[4] = modbus(Table::input, 7);
+    c.io.analog_inputs[1] = modbus(Table::input, 8);
+  });
+  IoCommand c;
+  c.flood = true;
+  c.digital = 1u << 1;
+  c.analog[0] = 12.5;   // half away from zero
+  c.analog[15] = -2.4;  // two's complement
+  server_->set_discrete_input(3, true);
+  server_->set_input_register(7, 9);
+  server_->set_input_register(8, 4321);
+  ASSERT_TRUE(servo_until(c, [&] {
+    return server_->coil(5) && server_->coil(6) && server_->holding(10) == 13 &&
+           server_->holding(11) == 65534 && feedback_.analog[1] == 4321 &&
+           feedback_.digital == ((1u << 2) | (1u << 4));
+  })) << feedback_.digital;
+  EXPECT_EQ(server_->holding(20), 0);
+  EXPECT_FALSE(feedback_.spindle.present);
+  servo(c, 50);
+  EXPECT_EQ(server_->writes(5), 1);  // written once at start, then only on a change
+  EXPECT_EQ(server_->writes(10), 1);
+  EXPECT_EQ(server_->writes(20), 1);  // mist off, written once all the same
+  c.flood = false;
+  c.mist = true;
+  server_->set_discrete_input(3, false);
+  ASSERT_TRUE(servo_until(c, [&] {
+    return !server_->coil(5) && server_->holding(20) == 1 && feedback_.digital == (1u << 4);
+  }));
+  EXPECT_EQ(server_->writes(5), 2);
+  EXPECT_EQ(server_->writes(6), 1);
+}
+
+TEST_F(ModbusIo, OutputsOnReadOnlyTablesAreRefused) {
+  loaded_ = load_machine(dir_, 1, "", "[MODBUS_0]\nHOST = 127.0.0.1\nPORT = 1\n");
+  ASSERT_TRUE(loaded_.ok());
+  auto c = *loaded_.config;
+  c.io.flood = modbus(Table::discrete, 1);
+  EXPECT_NE(driver_.configure(c, {}).find("read-only"), std::string::npos);
+  c.io.flood = {};
+  c.io.digital_outputs[0] = modbus(Table::coil, 1);
+  c.io.digital_outputs[0].bus = 4;
+  EXPECT_NE(driver_.configure(c, {}).find("[MODBUS_4]"), std::string::npos);
+}
+
+// Delta VFD-E (config/examples/modbus_delta_vfd_e.ini): command word 0x2000 (bits 1-0: 01
+// stop, 10 run; bits 5-4: 01 forward, 10 reverse), frequency 0x2001 in 0.01 Hz, status
+// 0x2101 (bits 1-0: 11 running; bits 4-3: 11 reverse) and output frequency 0x2103, both
+// holding registers; no at-speed or fault bit.
+VfdMap delta_vfd_e_map() {
+  VfdMap m;
+  m.command_register = 0x2000;
+  m.speed_register = 0x2001;
+  m.actual_speed_register = 0x2103;
+  m.actual_speed_holding = true;
+  m.status_register = 0x2101;
+  m.status_holding = true;
+  m.command_stop = 0x0001;
+  m.command_forward = 0x0012;
+  m.command_reverse = 0x0022;
+  m.running_bits = 0x0003;
+  m.at_speed_bits = 0;
+  m.fault_bits = 0;
+  m.reverse_bits = 0x0018;
+  return m;
+}
+
+config::SpindleConfig delta_vfd_e_spindle() {
+  config::SpindleConfig s = generic_spindle();
+  s.speed_scale = 100.0 / 60.0;  // 2-pole: rpm / 60 = Hz, in 0.01 Hz
+  s.command_register = 0x2000;
+  s.speed_register = 0x2001;
+  s.actual_speed_register = 0x2103;
+  s.status_register = 0x2101;
+  s.actual_speed_table = Table::holding;
+  s.status_table = Table::holding;
+  s.command_stop = 0x0001;
+  s.command_forward = 0x0012;
+  s.command_reverse = 0x0022;
+  s.running_bit = 1;
+  s.at_speed_bit = -1;
+  s.fault_bit = -1;
+  return s;
+}
+
+TEST_F(ModbusIo, DeltaVfdEProfile) {
+  start_vfd(delta_vfd_e_map(), delta_vfd_e_spindle());
+  ASSERT_TRUE(servo_until(spindle(true, false, 12000), [&] {
+    return server_->holding(0x2000) == 0x12 && feedback_.spindle.rpm > 11999;
+  })) << reason();
+  EXPECT_EQ(server_->holding(0x2001), 20000);  // 200.00 Hz
+  EXPECT_NEAR(feedback_.spindle.rpm, 12000, 0.01);
+  EXPECT_FALSE(feedback_.spindle.has_at_speed);
+  EXPECT_FALSE(feedback_.spindle.fault || feedback_.spindle.stale) << reason();
+  ASSERT_TRUE(servo_until(spindle(true, true, 6000), [&] {
+    return server_->holding(0x2000) == 0x22 && server_->holding(0x2001) == 10000;
+  }));
+  ASSERT_TRUE(servo_until(spindle(false, true, 6000), [&] {
+    return server_->holding(0x2000) == 0x01 && feedback_.spindle.rpm == 0;
+  }));
+  EXPECT_FALSE(feedback_.spindle.fault) << reason();
+}
+
+TEST_F(ModbusIo, DeltaVfdETrippedWhileRunningIsAFault) {
+  start_vfd(delta_vfd_e_map(), delta_vfd_e_spindle());
+  ASSERT_TRUE(servo_until(spindle(true, false, 12000), [&] { return feedback_.spindle.rpm > 0; }));
+  server_->set_fault(true);  // the drive trips: it stops, its run bits clear
+  ASSERT_TRUE(servo_until(
+      spindle(true, false, 12000), [&] { return feedback_.spindle.fault; }, 3000));
+  EXPECT_EQ(reason(),
+            "modbus bus 0 slave 3 (spindle VFD): not running although told to (status 0x0000)");
+}
+
+// AutomationDirect GS2 (config/examples/modbus_gs2.ini): P9.26 speed reference 0x091A in
+// 0.1 Hz, P9.27 run command 0x091B (0 stop, 1 run), direction in P9.28 (not written: the
+// profile has one command register, so it runs forward only), status monitor 2 at 0x2101 and
+// output frequency at 0x2103 in 0.1 Hz.
+VfdMap gs2_map() {
+  VfdMap m;
+  m.command_register = 0x091B;
+  m.speed_register = 0x091A;
+  m.actual_speed_register = 0x2103;
+  m.actual_speed_holding = true;
+  m.status_register = 0x2101;
+  m.status_holding = true;
+  m.command_stop = 0;
+  m.command_forward = 1;
+  m.command_reverse = -1;  // no such command
+  m.running_bits = 0x0003;
+  m.at_speed_bits = 0;
+  m.fault_bits = 0;
+  return m;
+}
+
+TEST_F(ModbusIo, Gs2ProfileRunsForwardAndRefusesReverse) {
+  config::SpindleConfig s = generic_spindle();
+  s.speed_scale = 10.0 / 60.0;  // 2-pole: rpm / 60 = Hz, in 0.1 Hz
+  s.command_register = 0x091B;
+  s.speed_register = 0x091A;
+  s.actual_speed_register = 0x2103;
+  s.status_register = 0x2101;
+  s.actual_speed_table = Table::holding;
+  s.status_table = Table::holding;
+  s.command_stop = 0;
+  s.command_forward = 1;
+  s.command_reverse = 0;  // = COMMAND_STOP: no reverse
+  s.running_bit = 1;
+  s.at_speed_bit = -1;
+  s.fault_bit = -1;
+  start_vfd(gs2_map(), s);
+  ASSERT_TRUE(servo_until(spindle(true, false, 18000), [&] {
+    return server_->holding(0x091B) == 1 && feedback_.spindle.rpm > 17999;
+  })) << reason();
+  EXPECT_EQ(server_->holding(0x091A), 3000);  // 300.0 Hz
+  EXPECT_NEAR(feedback_.spindle.rpm, 18000, 0.01);
+  EXPECT_FALSE(feedback_.spindle.fault || feedback_.spindle.stale) << reason();
+  ASSERT_TRUE(servo_until(spindle(true, true, 18000), [&] { return feedback_.spindle.fault; }));
+  EXPECT_EQ(server_->holding(0x091B), 0);  // stopped, not turned forward
+  EXPECT_NE(reason().find("no reverse"), std::string::npos) << reason();
+}
+
+}  // namespace
+}  // namespace cncd::test

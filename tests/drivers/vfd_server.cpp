@@ -1,0 +1,142 @@
+#include "vfd_server.hpp"
+
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace cncd::test {
+namespace {
+
+// Room for the registers of the drives under test (Delta and GS2 status words sit at 0x21xx).
+constexpr int kRegisters = 0x2200;
+constexpr int kBits = 0x100;
+
+modbus_t* as_ctx(void* p) {
+  return static_cast<modbus_t*>(p);
+}
+modbus_mapping_t* as_mapping(void* p) {
+  return static_cast<modbus_mapping_t*>(p);
+}
+
+}  // namespace
+
+VfdServer::VfdServer(VfdMap map, int slave) : map_(map), slave_(slave) {}
+
+VfdServer::~VfdServer() {
+  if (running_.exchange(false)) thread_.join();
+  if (listen_fd_ >= 0) close(listen_fd_);
+  if (mapping_ != nullptr) modbus_mapping_free(as_mapping(mapping_));
+  if (ctx_ != nullptr) modbus_free(as_ctx(ctx_));
+}
+
+std::string VfdServer::start() {
+  ctx_ = modbus_new_tcp("127.0.0.1", 0);
+  if (ctx_ == nullptr) return "modbus_new_tcp failed";
+  modbus_set_slave(as_ctx(ctx_), slave_);
+  mapping_ = modbus_mapping_new(kBits, kBits, kRegisters, kRegisters);
+  listen_fd_ = modbus_tcp_listen(as_ctx(ctx_), 4);
+  if (listen_fd_ < 0) return std::string("cannot listen: ") + modbus_strerror(errno);
+  sockaddr_in bound{};
+  socklen_t size = sizeof bound;
+  getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&bound), &size);
+  port_ = ntohs(bound.sin_port);
+  running_.store(true);
+  thread_ = std::thread([this] { serve(); });
+  return "";
+}
+
+std::uint16_t VfdServer::holding(int address) {
+  std::lock_guard lock(mutex_);
+  return as_mapping(mapping_)->tab_registers[address];
+}
+
+bool VfdServer::coil(int address) {
+  std::lock_guard lock(mutex_);
+  return as_mapping(mapping_)->tab_bits[address] != 0;
+}
+
+void VfdServer::set_input_register(int address, std::uint16_t value) {
+  std::lock_guard lock(mutex_);
+  as_mapping(mapping_)->tab_input_registers[address] = value;
+}
+
+void VfdServer::set_discrete_input(int address, bool on) {
+  std::lock_guard lock(mutex_);
+  as_mapping(mapping_)->tab_input_bits[address] = on ? 1 : 0;
+}
+
+int VfdServer::writes(int address) {
+  std::lock_guard lock(mutex_);
+  return writes_[address];
+}
+
+void VfdServer::set_fault(bool fault) {
+  std::lock_guard lock(mutex_);
+  fault_ = fault;
+  update_model();
+}
+
+void VfdServer::update_model() {
+  modbus_mapping_t* m = as_mapping(mapping_);
+  const int command = m->tab_registers[map_.command_register];
+  const bool forward = command == map_.command_forward;
+  const bool reverse = command == map_.command_reverse && !forward;
+  const bool running = (forward || reverse) && !fault_;
+  // The motor reaches the commanded speed at once: this drive ramps in no time.
+  const std::uint16_t speed = running ? m->tab_registers[map_.speed_register] : 0;
+  std::uint16_t status = 0;
+  if (running) status |= map_.running_bits;
+  if (running && speed > 0) status |= map_.at_speed_bits;
+  if (running && reverse) status |= map_.reverse_bits;
+  if (fault_) status |= map_.fault_bits;
+  (map_.actual_speed_holding ? m->tab_registers
+                             : m->tab_input_registers)[map_.actual_speed_register] = speed;
+  (map_.status_holding ? m->tab_registers : m->tab_input_registers)[map_.status_register] = status;
+}
+
+void VfdServer::serve() {
+  // A drive has a processor of its own: where permitted, answer like one on a busy machine.
+  sched_param param{};
+  param.sched_priority = 60;
+  pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  int client = -1;
+  std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+  while (running_.load()) {
+    if (client < 0) {
+      pollfd p{listen_fd_, POLLIN, 0};
+      if (poll(&p, 1, 10) <= 0) continue;
+      client = accept(listen_fd_, nullptr, nullptr);
+      continue;
+    }
+    pollfd p{client, POLLIN, 0};
+    if (poll(&p, 1, 10) <= 0) continue;
+    modbus_set_socket(as_ctx(ctx_), client);
+    const int n = modbus_receive(as_ctx(ctx_), query);
+    if (n < 0) {
+      close(client);
+      client = -1;
+      continue;
+    }
+    if (n == 0 || silent_.load()) continue;
+    const int header = modbus_get_header_length(as_ctx(ctx_));
+    const int function = query[header];
+    const int address = (query[header + 1] << 8) | query[header + 2];
+    std::lock_guard lock(mutex_);
+    if (function == 0x05 || function == 0x06 || function == 0x0F || function == 0x10) {
+      ++writes_[address];
+    }
+    modbus_reply(as_ctx(ctx_), query, n, as_mapping(mapping_));
+    update_model();
+    answered_.fetch_add(1);
+  }
+  if (client >= 0) close(client);
+}
+
+}  // namespace cncd::test

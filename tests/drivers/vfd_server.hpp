@@ -1,0 +1,77 @@
+// A spindle VFD on loopback Modbus TCP for the driver tests, modelled from a register map
+// alone: a small libmodbus server of its own (not cncd-drive-sim), so the driver is checked
+// against the map and not against its own idea of it.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+
+namespace cncd::test {
+
+// What a drive's manual says about its registers.
+struct VfdMap {
+  int command_register = 0;  // holding
+  int speed_register = 1;    // holding, the commanded speed in the drive's unit
+  int actual_speed_register = 0;
+  bool actual_speed_holding = false;  // else an input register
+  int status_register = 1;
+  bool status_holding = false;
+  int command_stop = 0;
+  int command_forward = 1;
+  int command_reverse = 2;
+  // Status bits; a Delta-style two-bit run state has its bit 0 and 1 both set when running.
+  std::uint16_t running_bits = 1u << 0;
+  std::uint16_t at_speed_bits = 1u << 1;  // 0: the drive has no at-speed bit
+  std::uint16_t fault_bits = 1u << 2;
+  std::uint16_t reverse_bits = 0;  // set while turning in reverse
+};
+
+class VfdServer {
+ public:
+  VfdServer(VfdMap map, int slave);
+  ~VfdServer();
+  VfdServer(const VfdServer&) = delete;
+  VfdServer& operator=(const VfdServer&) = delete;
+
+  // Listens on 127.0.0.1 at a free port and serves from a thread; "" or what went wrong.
+  std::string start();
+  int port() const { return port_; }
+
+  std::uint16_t holding(int address);
+  bool coil(int address);
+  void set_input_register(int address, std::uint16_t value);
+  void set_discrete_input(int address, bool on);
+  // How many write requests reached a coil or holding register.
+  int writes(int address);
+  // The drive trips (fault bits set, stops) or is healthy again.
+  void set_fault(bool fault);
+  // The drive stops answering (requests time out) or answers again.
+  void set_silent(bool silent) { silent_.store(silent); }
+  // Requests answered so far.
+  int answered() const { return answered_.load(); }
+
+ private:
+  void serve();
+  void update_model();  // with mutex_ held
+
+  VfdMap map_;
+  int slave_;
+  void* ctx_ = nullptr;      // modbus_t*
+  void* mapping_ = nullptr;  // modbus_mapping_t*
+  int listen_fd_ = -1;
+  int port_ = 0;
+  std::mutex mutex_;
+  std::map<int, int> writes_;
+  bool fault_ = false;
+  std::atomic<bool> silent_{false};
+  std::atomic<int> answered_{0};
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+};
+
+}  // namespace cncd::test
