@@ -155,10 +155,22 @@ void Interpreter::Impl::do_tool_and_spindle() {
   if (change == 6) {
     const int tool = tool_prepped_ < 0 ? tool_in_spindle_ : tool_prepped_;
     emit(StartChange{});
-    emit(StopSpindleTurning{});
+    if (options_.tool_change_quill_up) {
+      // Z up to machine zero, the other axes where they are.
+      Pose machine = program_to_machine(pos_);
+      machine[kZ] = 0;
+      Pose up = pos_;
+      up[kZ] = machine_to_program(machine)[kZ];
+      emit(Comment{"AXIS,hide"});
+      emit_straight(StraightKind::traverse, up);
+      emit(Comment{"AXIS,show"});
+    }
+    if (!options_.tool_change_with_spindle_on) {
+      emit(StopSpindleTurning{});
+      modal_.spindle = SpindleDir::stopped;
+    }
     emit(ChangeTool{tool});
     tool_in_spindle_ = tool;
-    modal_.spindle = SpindleDir::stopped;
   } else if (change == 61) {
     if (!block_.has('q') || block_.get('q') < 0) {
       fail("Need non-negative Q-word to specify tool number with M61", block_.m_column[6]);

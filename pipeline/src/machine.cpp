@@ -20,6 +20,8 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   // As LinuxCNC's task looks for M100-M199: the first program directory, then [RS274NGC]
   // USER_M_PATH (the config lists them in that order).
   options.user_m_path = config.io.user_m_path;
+  options.tool_change_quill_up = config.tool_change.quill_up;
+  options.tool_change_with_spindle_on = config.tool_change.with_spindle_on;
   options.startup_code = config.startup_code;
   return options;
 }

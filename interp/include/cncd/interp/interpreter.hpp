@@ -40,6 +40,10 @@ struct InterpOptions {
   std::vector<std::filesystem::path> user_m_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'
+  // [EMCIO] TOOL_CHANGE_QUILL_UP: M6 first raises Z to machine zero (a traverse, as LinuxCNC's
+  // interpreter emits it); TOOL_CHANGE_WITH_SPINDLE_ON: M6 leaves the spindle turning.
+  bool tool_change_quill_up = false;
+  bool tool_change_with_spindle_on = false;
   // O-word loop iterations in a row without a move or dwell before the program is rejected as
   // an endless loop (LinuxCNC would spin forever).
   std::uint64_t max_loops_without_motion = 1'000'000;
