@@ -17,8 +17,9 @@ namespace {
 // The feed loop's target: the motion controller's queue, counting the moves it takes.
 class ControllerTarget final : public pipeline::MoveTarget {
  public:
-  ControllerTarget(motion::MotionController& motion, std::uint64_t& enqueued)
-      : motion_(motion), enqueued_(enqueued) {}
+  ControllerTarget(motion::MotionController& motion, std::uint64_t& enqueued,
+                   std::uint64_t& actions)
+      : motion_(motion), enqueued_(enqueued), actions_(actions) {}
   Push push(const motion::Move& move) override {
     switch (motion_.enqueue(move)) {
       case motion::MotionController::EnqueueResult::full:
@@ -26,7 +27,7 @@ class ControllerTarget final : public pipeline::MoveTarget {
       case motion::MotionController::EnqueueResult::refused:
         return Push::refused;
       default:
-        ++enqueued_;
+        ++(move.kind == motion::Move::Kind::action ? actions_ : enqueued_);
         return Push::accepted;
     }
   }
@@ -36,6 +37,7 @@ class ControllerTarget final : public pipeline::MoveTarget {
  private:
   motion::MotionController& motion_;
   std::uint64_t& enqueued_;
+  std::uint64_t& actions_;
 };
 
 }  // namespace
@@ -203,8 +205,12 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   interp_->set_machine_position(position);
   feeder_->start_program(&status.commanded);
   path_errors_base_ = status.path_errors;
+  input_wait_pending_ = false;
+  input_waits_seen_ = status.input_waits;
   interp_done_ = false;
   moves_enqueued_ = 0;
+  actions_enqueued_ = 0;
+  actions_done_base_ = status.actions_done;
   moves_done_base_ = status.moves_done;
   motion_.discard();
   mode_ = mode;
@@ -297,7 +303,7 @@ void Task::feed() {
   const auto until = Clock::now() + std::chrono::milliseconds(2);
   for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
     if ((blocks & 63) == 63 && Clock::now() > until) return;
-    ControllerTarget target(motion_, moves_enqueued_);
+    ControllerTarget target(motion_, moves_enqueued_, actions_enqueued_);
     const pipeline::Drained drained = feeder_->drain(target);
     if (drained.result == pipeline::MoveTarget::Push::full) return;
     if (drained.result == pipeline::MoveTarget::Push::refused) {
@@ -308,7 +314,8 @@ void Task::feed() {
     }
     // The move held back for look-ahead goes out when no more come for now, so that the
     // path ends at rest and the program's end, a stop or a step is seen.
-    if (interp_done_ || feeder_->stop_seen || (stepping_ && step_budget_ == 0)) {
+    if (interp_done_ || feeder_->stop_seen || input_wait_pending_ ||
+        (stepping_ && step_budget_ == 0)) {
       motion_.flush();
       return;
     }
@@ -321,6 +328,10 @@ void Task::feed() {
     }
     if (stepping_) --step_budget_;
     if (skip_to_line_ > 0 && !skip_before_start(step == interp::Interpreter::Step::end)) return;
+    if (feeder_->input_wait_seen) {
+      feeder_->input_wait_seen = false;
+      input_wait_pending_ = skip_to_line_ == 0;  // a skipped line's wait is dropped with it
+    }
     if (step == interp::Interpreter::Step::end) interp_done_ = true;
   }
 }
@@ -362,6 +373,12 @@ void Task::poll() {
     return;
   }
   if (!poll_holds(status)) return;
+  if (input_wait_pending_ && status.input_waits > input_waits_seen_) {
+    // The machine has waited for the M66: its answer is #5399 for the lines that follow.
+    input_waits_seen_ = status.input_waits;
+    interp_->set_input_result(status.input_result);
+    input_wait_pending_ = false;
+  }
   // Run from line: the remaining time counts from when the traverse to the line has ended.
   if (skip_moved_ && !approach_done_s_ && status.moves_done > moves_done_base_)
     approach_done_s_ = moving_s();
@@ -372,6 +389,7 @@ void Task::poll() {
   // between enqueue and the servo thread picking a move up for the end of the program.
   const bool drained = feeder_->pending.empty() &&
                        status.moves_done - moves_done_base_ >= moves_enqueued_ &&
+                       status.actions_done - actions_done_base_ >= actions_enqueued_ &&
                        status.motion == motion::MotionState::idle;
   if (!drained) return;
   if (feeder_->stop_seen) {

@@ -186,20 +186,26 @@ class Task {
   std::string program_path_;
   std::uint64_t program_lines_ = 0;
   bool interp_done_ = false;
-  std::uint64_t moves_enqueued_ = 0;   // moves handed to motion since the program started
-  std::uint64_t moves_done_base_ = 0;  // motion's completed-move count when it started
-  std::uint64_t moves_completed_ = 0;  // moves the last finished run completed
-  std::string last_result_;            // "done" | "aborted" | "error" | "" (never ran)
+  std::uint64_t moves_enqueued_ = 0;     // moves handed to motion since the program started
+  std::uint64_t moves_done_base_ = 0;    // motion's completed-move count when it started
+  std::uint64_t actions_enqueued_ = 0;   // actions (spindle, outputs, waits) handed to motion
+  std::uint64_t actions_done_base_ = 0;  // motion's completed-action count when it started
+  std::uint64_t moves_completed_ = 0;    // moves the last finished run completed
+  std::string last_result_;              // "done" | "aborted" | "error" | "" (never ran)
   std::string last_error_;
   int skip_to_line_ = 0;     // run from line: first line that moves, 0 = none
   bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
   motion::AxisPose skip_end_{};
   double spindle_override_ = 1.0;
   std::uint64_t path_errors_base_ = 0;  // motion's path error count when the run started
-  UserMProcess user_m_;                 // the user M code running, if any
-  std::uint32_t user_m_hold_ = 0;       // the hold it answers
-  bool stepping_ = false;               // program.step: one line, then pause
-  int step_budget_ = 0;                 // lines the interpreter may still read in this step
+  // M66 read: the interpreter waits to read on until the machine has waited and #5399 holds
+  // its answer (motion's count of ended input waits passes input_waits_seen_).
+  bool input_wait_pending_ = false;
+  std::uint64_t input_waits_seen_ = 0;
+  UserMProcess user_m_;            // the user M code running, if any
+  std::uint32_t user_m_hold_ = 0;  // the hold it answers
+  bool stepping_ = false;          // program.step: one line, then pause
+  int step_budget_ = 0;            // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
   // The run on the servo clock: servo periods since program.run (rt.cycles) x the period. Falls

@@ -29,6 +29,7 @@ void PathExecutor::flush() noexcept {
   for (; window_count_ > 0; --window_count_, ++head_seq_) {
     ++segments_done_;
     moves_done_ += window_at(head_seq_).moves;
+    if (window_at(head_seq_).action.kind != IoAction::Kind::none) ++actions_done_;
   }
   window_length_ = 0;
   stop_length_ = 0;
@@ -37,6 +38,7 @@ void PathExecutor::flush() noexcept {
   while (segments_.pop(dropped)) {
     ++segments_done_;
     moves_done_ += dropped.moves;
+    if (dropped.action.kind != IoAction::Kind::none) ++actions_done_;
   }
   path_s_ = 0;
   path_v_ = 0;
@@ -196,6 +198,7 @@ void PathExecutor::finish_front() noexcept {
   const Segment& done = window_at(head_seq_);
   ++segments_done_;
   moves_done_ += done.moves;
+  if (done.action.kind != IoAction::Kind::none) ++actions_done_;
   window_length_ = std::max(0.0, window_length_ - done.length);
   if (floor_end_ > floor_first_ && floor_seq_[floor_first_ % kWindow] == head_seq_) ++floor_first_;
   ++head_seq_;

@@ -234,7 +234,11 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   if (rests) {
     seg.kind = Segment::Kind::dwell;
     seg.dwell_s = move.kind == Move::Kind::dwell ? std::max(0.0, move.dwell_s) : 0.0;
-    if (move.kind == Move::Kind::action) seg.action = move.action;
+    if (move.kind == Move::Kind::action) {
+      // An action is no programmed move: Status::actions_done counts it instead.
+      seg.action = move.action;
+      seg.moves = 0;
+    }
     return seg;
   }
   if (move.kind != Move::Kind::traverse && !(move.feed > 0)) {

@@ -13,6 +13,7 @@ void ServoLoop::publish() noexcept {
   status_.queued = path_.queued();
   status_.segments_done = path_.segments_done();
   status_.moves_done = path_.moves_done();
+  status_.actions_done = path_.actions_done();
   status_.homed = joints_.homed;
   status_.spindle = io_.spindle();
   status_.io = io_.io();

@@ -182,7 +182,7 @@ class Simulation final : MoveTarget {
     }
     // Every pushed move is counted once in Status::moves_done, whichever segment (a blend
     // arc, a merged line) completes it: its line is its own, not that segment's.
-    result_.move_line.push_back(move.line);
+    if (move.kind != motion::Move::Kind::action) result_.move_line.push_back(move.line);
     return Push::accepted;
   }
 
@@ -212,6 +212,7 @@ class Simulation final : MoveTarget {
 
   // Adds the programmed move (not the planner's segments, which blends shorten) to the bounds.
   void bound(const motion::Move& move) {
+    if (move.kind == motion::Move::Kind::action) return;  // no time and no path
     std::string error;
     const auto segment = planner_.plan(move, programmed_end_, false, error);
     if (!segment) return;  // push() reports it

@@ -43,7 +43,7 @@ TEST_F(MachineTest, ToolSetRewritesTheTableAndTheInterpreterUsesIt) {
   EXPECT_EQ(tools[3]["number"], 7);
   EXPECT_EQ(tools[3]["pocket"], 7);
 
-  mdi("T2 M6 G43");
+  mdi("M61 Q2 G43");  // the tool is in the spindle: no change to wait for
   EXPECT_EQ(status()["tool"]["length_offset"]["z"], 12.5);
 
   // A restarted daemon reads the new table.

@@ -29,7 +29,7 @@ TEST_F(MachineTest, WorkPositionFollowsOffsetsAndToolLength) {
 
   // G92 shifts the work position again; tool 2 (Z+10 in sim_mm.tbl) with G43 too.
   mdi("G92 X0");
-  mdi("T2 M6 G43");
+  mdi("M61 Q2 G43");  // the tool is in the spindle: no change to wait for
   s = status();
   EXPECT_EQ(s["offsets"]["g92"]["x"], 1.0);
   EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 0.0, 1e-9);

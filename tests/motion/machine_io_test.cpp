@@ -60,7 +60,8 @@ class SpindleDrive final : public FakeDriver {
 config::MachineConfig mill_with_spindle(double acceleration = 3000, double timeout_s = 10) {
   config::MachineConfig c = small_mill();
   c.spindle.present = true;
-  c.spindle.driver = config::SpindleDriver::sim;
+  // Driven by the test's SpindleDrive (the simulated driver simulates only a sim spindle).
+  c.spindle.driver = config::SpindleDriver::modbus;
   c.spindle.max_forward_velocity = 24000;
   c.spindle.min_forward_velocity = 100;
   c.spindle.max_reverse_velocity = 12000;

@@ -69,6 +69,8 @@ class PathExecutor {
   // Segments and programmed moves completed or dropped since the start.
   CNCD_RT std::uint64_t segments_done() const noexcept { return segments_done_; }
   CNCD_RT std::uint64_t moves_done() const noexcept { return moves_done_; }
+  // Actions (Move::Kind::action) completed or dropped since the start.
+  CNCD_RT std::uint64_t actions_done() const noexcept { return actions_done_; }
   // The path's jerk limit, 0 for trapezoidal profiles.
   CNCD_RT double jerk() const noexcept { return jerk_; }
 
@@ -172,6 +174,7 @@ class PathExecutor {
   std::int32_t line_ = 0;
   std::uint64_t segments_done_ = 0;
   std::uint64_t moves_done_ = 0;
+  std::uint64_t actions_done_ = 0;
 };
 
 }  // namespace cncd::motion

@@ -95,6 +95,7 @@ struct ServoStatus {
   std::uint32_t queued = 0;         // segments waiting in the queue (including the active one)
   std::uint64_t segments_done = 0;  // segments completed (or dropped by an abort) since start
   std::uint64_t moves_done = 0;     // programmed moves completed (or dropped) since start
+  std::uint64_t actions_done = 0;   // actions (Move::Kind::action) completed or dropped
   RtEvent fault;                    // latched fault, code none when none
   SpindleStatus spindle;
   IoStatus io;
