@@ -113,7 +113,8 @@ json wait_for(daemon::Client& client, const DaemonProcess& daemon, int seconds, 
 }
 
 // Runs the example program on `ini` (already adapted) and returns the final status.
-json run_example(const TempDir& dir, const std::string& ini) {
+json run_example(const TempDir& dir, const std::string& ini,
+                 const std::string& program = kProgram) {
   DaemonProcess daemon;
   const std::string error = daemon.start(dir.path(), {"--ini", ini});
   EXPECT_EQ(error, "");
@@ -129,7 +130,7 @@ json run_example(const TempDir& dir, const std::string& ini) {
       if (!h.get<bool>()) return false;
     return s["motion"] == "idle";
   });
-  result(client.call("program.open", {{"path", kProgram}}));
+  result(client.call("program.open", {{"path", program}}));
   result(client.call("program.run"));
   wait_until([](const json& s) { return s["exec"] == "idle"; });
   // Let the drives settle onto the last command.
@@ -209,6 +210,65 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
     const json s = run_example(dir, adapt(dir, "modbus_sim.ini", modbus_changes(sim.port())));
     expect_end(s, "modbus");
   }
+}
+
+// The first time `signal` goes to `level` at or after `from`, or -1.
+std::int64_t first_edge(const std::vector<VcdChange>& changes, const std::string& signal, int level,
+                        std::int64_t from = 0) {
+  for (const auto& c : changes) {
+    if (c.signal == signal && c.level == level && c.time_ns >= from && c.time_ns > 0)
+      return c.time_ns;
+  }
+  return -1;
+}
+
+TEST(DriversEndToEnd, TheRecordingShowsTheSpindleCoolantAndOutputsAgainstTheSteps) {
+  TempDir dir;
+  const std::string vcd = (dir.path() / "steps.vcd").string();
+  const auto program = dir.write("spindle.ngc",
+                                 "G21 G17 G90 G94\n"
+                                 "F100\n"
+                                 "G0 X1 Y2 Z3\n"
+                                 "M3 S1000\n"
+                                 "M8\n"
+                                 "M62 P0\n"
+                                 "G1 X2 F600\n"
+                                 "G90 G81 G98 X4 Y5 Z1.5 R2.8\n"
+                                 "G80\n"
+                                 "M9\n"
+                                 "M5\n"
+                                 "M2\n");
+  const json s = run_example(dir,
+                             adapt(dir, "gpio_vcd_mill.ini",
+                                   {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
+                                    {"FERROR = 1\n", "FERROR = 10\n"},
+                                    {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}),
+                             program.string());
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  const auto changes = read_vcd(vcd);
+  const std::int64_t enabled = first_edge(changes, "spindle_enable", 1);
+  ASSERT_GT(enabled, 0);
+  // The feed after M3 waits for the spindle's ramp (8000 rpm/s) to 950 rpm: 0.119 s.
+  const std::int64_t first_x_step = first_edge(changes, "j0_step", 1, enabled);
+  ASSERT_GT(first_x_step, 0);
+  EXPECT_GE(first_x_step - enabled, 110'000'000);
+  // M62 P0 goes on as that move starts, before its first step (3.5 ms in at 500 mm/s^2).
+  const std::int64_t dout = first_edge(changes, "dout0", 1);
+  ASSERT_GT(dout, 0);
+  EXPECT_LE(dout, first_x_step);
+  EXPECT_LT(first_x_step - dout, 10'000'000);
+  // The drill goes down only with the spindle on, and the PWM runs while it is.
+  const std::int64_t first_z_feed_step = first_edge(changes, "j2_step", 1, first_x_step);
+  EXPECT_GT(first_z_feed_step, enabled);
+  EXPECT_GT(first_edge(changes, "spindle_pwm", 1, enabled), 0);
+  // M8 before the moves, M9 and M5 after them.
+  const std::int64_t flood_on = first_edge(changes, "flood", 1);
+  ASSERT_GT(flood_on, 0);
+  EXPECT_LT(flood_on, first_x_step);
+  const std::int64_t flood_off = first_edge(changes, "flood", 0, flood_on);
+  const std::int64_t disabled = first_edge(changes, "spindle_enable", 0, enabled);
+  EXPECT_GT(flood_off, first_z_feed_step);
+  EXPECT_GE(disabled, flood_off);
 }
 
 TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
