@@ -9,7 +9,7 @@ cmake --build --preset release
 
 bin=build/release/bin
 example=${CNCD_DEMO_INI:-config/examples/sim_mm.ini}
-program=${CNCD_DEMO_PROGRAM:-examples/g81_example1.ngc}
+program=${CNCD_DEMO_PROGRAM:-examples/g81_spindle.ngc}
 rundir=$(mktemp -d)
 sock=$rundir/cncd.sock
 # The machine runs from the example INI as it is; its parameter, tool and position files go to

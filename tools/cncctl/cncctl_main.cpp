@@ -125,9 +125,19 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
   const bool tty = isatty(STDOUT_FILENO) != 0 && !json_output;
   int last_line = -1;
   ToolPrompt prompt;
+  std::string last_wait;
   for (;;) {
     const json s = result_of(client.call("status.get"));
-    prompt.update(client, s.contains("wait") ? s["wait"] : json(), tty);
+    const json wait = s.contains("wait") ? s["wait"] : json();
+    prompt.update(client, wait, tty);
+    // Other waits (the spindle coming up to speed, an input, a user M code) are said once.
+    const std::string wait_kind = wait.is_object() ? wait.value("kind", "") : "";
+    if (wait_kind != last_wait && !wait_kind.empty() && wait_kind != "tool_change" &&
+        !json_output) {
+      std::printf("%s%s\n", tty ? "\r\033[K" : "", wait.value("message", "").c_str());
+      std::fflush(stdout);
+    }
+    last_wait = wait_kind;
     const auto& p = s["program"];
     const std::string exec = s.value("exec", "");
     const int line = p.value("line", 0);
