@@ -262,7 +262,28 @@ void program(Rig& rig) {
   using test::arc_to;
   using test::line_to;
   rig.queue(line_to(Move::Kind::traverse, 10, 0, 5));
-  rig.queue(blended(line_to(Move::Kind::feed, 10, 0, 0, 20)));
+  // The spindle, coolant, outputs and waits done where the path rests, and outputs set with
+  // the start of a move.
+  const auto action = [&rig](motion::IoAction::Kind kind) {
+    Move m;
+    m.kind = Move::Kind::action;
+    m.action.kind = kind;
+    m.action.direction = 1;
+    m.action.rpm = 1000;
+    m.action.flood = true;
+    m.action.on = true;
+    m.action.value = 2.5;
+    rig.queue(m);
+  };
+  using Io = motion::IoAction::Kind;
+  for (const Io kind : {Io::spindle, Io::coolant, Io::digital_output, Io::analog_output,
+                        Io::spindle_override_enable, Io::wait_input, Io::wait_at_speed})
+    action(kind);
+  Move synced = blended(line_to(Move::Kind::feed, 10, 0, 0, 20));
+  synced.sync.set = 1u << 3;
+  synced.sync.analog_mask = 1u;
+  synced.sync.analog[0] = 1.5;
+  rig.queue(synced);
   rig.queue(blended(line_to(Move::Kind::feed, 30, 0, 0, 40)));
   rig.queue(blended(arc_to(40, 10, 30, 10, 1, 40)));  // quarter, ccw
   rig.queue(blended(arc_to(40, 10, 40, 0, -1, 40)));  // full circle, cw
