@@ -123,6 +123,16 @@ bool MachineIo::run(const IoAction& action, bool first) noexcept {
   return true;
 }
 
+void MachineIo::not_at_speed() noexcept {
+  RtEvent e;
+  e.code = RtEvent::Code::spindle_not_at_speed;
+  e.error = spindle_.actual_rpm;
+  e.limit = spindle_.commanded_rpm;
+  e.oldest_ago = static_cast<std::uint64_t>(std::llround(config_.at_speed_timeout_s * 1000.0));
+  error_ = e;
+  has_error_ = true;
+}
+
 bool MachineIo::wait_at_speed(bool first) noexcept {
   if (first) {
     waited_ = 0;
@@ -136,13 +146,7 @@ bool MachineIo::wait_at_speed(bool first) noexcept {
   }
   ++waited_;
   if (static_cast<double>(waited_) * period_s_ >= config_.at_speed_timeout_s) {
-    RtEvent e;
-    e.code = RtEvent::Code::spindle_not_at_speed;
-    e.error = spindle_.actual_rpm;
-    e.limit = spindle_.commanded_rpm;
-    e.oldest_ago = static_cast<std::uint64_t>(std::llround(config_.at_speed_timeout_s * 1000.0));
-    error_ = e;
-    has_error_ = true;
+    not_at_speed();
     wait_ = {};
   }
   return false;
@@ -270,13 +274,7 @@ bool MachineIo::resume_ready() noexcept {
   }
   ++resume_waited_;
   if (static_cast<double>(resume_waited_) * period_s_ >= config_.at_speed_timeout_s) {
-    RtEvent e;
-    e.code = RtEvent::Code::spindle_not_at_speed;
-    e.error = spindle_.actual_rpm;
-    e.limit = spindle_.commanded_rpm;
-    e.oldest_ago = static_cast<std::uint64_t>(std::llround(config_.at_speed_timeout_s * 1000.0));
-    error_ = e;
-    has_error_ = true;
+    not_at_speed();
     resuming_ = false;
     wait_ = {};
   }

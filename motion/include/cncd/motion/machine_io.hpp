@@ -68,6 +68,8 @@ class MachineIo final : public ActionGate {
   CNCD_RT void update_command() noexcept;
   CNCD_RT bool at_speed() const noexcept;
   CNCD_RT bool wait_at_speed(bool first) noexcept;
+  // The spindle has not reached its speed within AT_SPEED_TIMEOUT: the error take_error() gives.
+  CNCD_RT void not_at_speed() noexcept;
   CNCD_RT bool wait_input(const IoAction& action, bool first) noexcept;
   CNCD_RT double input_value(const IoAction& action) const noexcept;
 
