@@ -20,6 +20,7 @@
 #include "cncd/drivers/gpio_driver.hpp"
 #include "cncd/drivers/modbus_driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
+#include "cncd/motion/servo_loop.hpp"
 
 namespace {
 
@@ -234,11 +235,73 @@ void pwm_error(const fs::path& dir, double frequency, double duty) {
 
 }  // namespace
 
+// The whole servo period, ServoLoop::cycle() on the simulated driver with the machine on: a
+// machine with a turning sim spindle and 8 sim outputs toggling against the same machine with
+// neither, interleaved. What the spindle and outputs add in all, servo loop and driver.
+void servo_cost(const fs::path& dir) {
+  constexpr int kPeriods = 200'000;
+  const auto plain = load(dir, machine("DRIVER = sim\n", "", 0));
+  auto with_io = plain;
+  add_io(with_io, config::SpindleDriver::sim, config::SignalAddress::Kind::sim, 0);
+  struct Machine {
+    drivers::SimDriver driver;
+    std::unique_ptr<motion::ServoLoop> loop;
+  };
+  const auto make = [](const config::MachineConfig& c, Machine& m) {
+    if (const auto e = m.driver.configure(c, {0, 1, 2}); !e.empty())
+      std::printf("servo: %s\n", e.c_str());
+    m.loop = std::make_unique<motion::ServoLoop>(
+        c, std::vector<motion::DriverBinding>{{&m.driver, {0, 1, 2}}});
+    for (const auto kind : {motion::Command::Kind::reset_estop, motion::Command::Kind::on}) {
+      motion::Command command;
+      command.kind = kind;
+      m.loop->commands().push(command);
+      m.loop->cycle(0);
+    }
+  };
+  Machine a, b;
+  make(plain, a);
+  make(with_io, b);
+  // Spindle on and the 8 outputs set, as actions on the path.
+  motion::Segment spin;
+  spin.kind = motion::Segment::Kind::dwell;
+  spin.action.kind = motion::IoAction::Kind::spindle;
+  spin.action.direction = 1;
+  spin.action.rpm = 12000;
+  b.loop->segments().push(spin);
+  for (int n = 0; n < 8; ++n) {
+    motion::Segment out = spin;
+    out.action.kind = motion::IoAction::Kind::digital_output;
+    out.action.index = static_cast<std::int16_t>(n);
+    out.action.on = true;
+    b.loop->segments().push(out);
+  }
+  std::int64_t plain_ns = 0, io_ns = 0;
+  for (int i = 0; i < kPeriods; ++i) {
+    const auto t0 = Clock::now();
+    a.loop->cycle(0);
+    const auto t1 = Clock::now();
+    b.loop->cycle(0);
+    const auto t2 = Clock::now();
+    plain_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+    io_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(t2 - t1).count();
+  }
+  const auto s = b.loop->status();
+  const double base = static_cast<double>(plain_ns) / kPeriods;
+  const double with = static_cast<double>(io_ns) / kPeriods;
+  std::printf(
+      "servo period (sim, 3 joints): %7.1f ns; with a spindle at %.0f rpm and %d outputs on "
+      "%7.1f ns: %+.1f ns = %.4f %% of a 1 ms period\n",
+      base, s.spindle.actual_rpm, __builtin_popcount(s.io.douts), with, with - base,
+      (with - base) / 1e6 * 100);
+}
+
 int main() {
   std::string pattern = (fs::temp_directory_path() / "cncd-io-bench-XXXXXX").string();
   if (mkdtemp(pattern.data()) == nullptr) return 1;
   const fs::path dir = pattern;
   costs(dir);
+  servo_cost(dir);
   for (const double frequency : {1000.0, 300.0}) {
     for (const double duty : {0.05, 0.25, 1.0 / 3.0, 0.5, 0.9})
       pwm_error(dir, frequency, duty);
