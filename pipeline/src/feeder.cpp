@@ -14,8 +14,7 @@ void ProgramFeeder::start_program(const motion::AxisPose* at) {
   holds.clear();
   sync_ = {};
   need_at_speed_ = false;
-  end_known_ = at != nullptr;
-  if (at != nullptr) end_ = *at;
+  end_ = at != nullptr ? *at : motion::AxisPose{};
 }
 
 motion::IoAction ProgramFeeder::spindle_action() const {
@@ -144,7 +143,6 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     next.sync = sync_;
     sync_ = {};
     end_ = next.end;
-    end_known_ = true;
   };
   auto stop = [&] {
     stop_seen = true;

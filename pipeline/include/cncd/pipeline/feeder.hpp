@@ -106,9 +106,9 @@ class ProgramFeeder final : public interp::CanonSink {
   // M3/M4 or S changed the spindle: the next feed move waits until it is at speed.
   bool need_at_speed_ = false;
   std::uint32_t next_hold_id_ = 1;
-  // Where the last move queued ends (machine coordinates), once known.
+  // Where the last move queued ends (machine coordinates); where the program started until
+  // then (machine zero when start_program() was not told).
   motion::AxisPose end_{};
-  bool end_known_ = false;
 
   // Path control mode and G64 P tolerance (machine units) as the interpreter last set them
   // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).
