@@ -196,7 +196,6 @@ class Task {
   int skip_to_line_ = 0;     // run from line: first line that moves, 0 = none
   bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
   motion::AxisPose skip_end_{};
-  double spindle_override_ = 1.0;
   std::uint64_t path_errors_base_ = 0;  // motion's path error count when the run started
   // M66 read: the interpreter waits to read on until the machine has waited and #5399 holds
   // its answer (motion's count of ended input waits passes input_waits_seen_).

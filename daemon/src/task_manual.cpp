@@ -51,7 +51,6 @@ void Task::set_rapid_override(double ratio) {
 }
 
 void Task::set_spindle_override(double ratio) {
-  spindle_override_ = ratio;
   motion_.set_spindle_override(ratio);
   spdlog::debug("spindle override {}", ratio_text(ratio));
 }
