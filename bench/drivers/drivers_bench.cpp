@@ -91,6 +91,7 @@ void gpio_rate(const fs::path& dir, long base_ns) {
                                      "STEPLEN = 1\nSTEPSPACE = 1\n",
                                      "[GPIO]\nCHIP = vcd:" + vcd + "\n", base_ns));
   drivers::GpioDriver driver;
+  driver.pace_recording_in_real_time(true);  // a wake-up every base period, as for pins
   if (const auto e = driver.configure(cfg, {0}); !e.empty()) {
     std::printf("gpio: %s\n", e.c_str());
     return;

@@ -132,6 +132,10 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
   IniLookup ini(machine);
   base_period_ns_ = machine.base_period_ns;
   servo_period_ns_ = machine.servo_period_ns;
+  // A base period longer than the servo period is silent for a few servo periods by design.
+  stale_reads_ = kStaleServoPeriods *
+                 std::max<std::int64_t>(1, (base_period_ns_ + servo_period_ns_ - 1) /
+                                               std::max<std::int64_t>(1, servo_period_ns_));
   rt_priority_ = machine.cncd.rt_priority;
   if (base_period_ns_ <= 0) {
     ini.fail("EMCMOT", "BASE_PERIOD", "step generation needs a base thread: set BASE_PERIOD");

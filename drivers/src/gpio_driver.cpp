@@ -15,11 +15,9 @@
 namespace cncd::drivers {
 namespace {
 
-// Feedback older than this many servo periods means the base thread has stopped. Virtual
-// machines stall even SCHED_FIFO threads for a few milliseconds now and then; the generator
-// catches up after such a stall (within STEPGEN_MAXVEL, watched by the following error), so
-// only a longer silence is a fault.
-constexpr std::int64_t kStaleServoPeriods = 20;
+std::int64_t to_ns(const timespec& t) {
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
 
 }  // namespace
 
@@ -33,13 +31,15 @@ GpioDriver::~GpioDriver() {
 
 void GpioDriver::enable() {
   if (backend_) backend_->start();
-  if (manual_clock_ || running_.exchange(true)) return;
-  last_period_ns_.store(monotonic_ns());
-  base_thread_ = std::thread([this] { base_loop(); });
+  if (running_.exchange(true)) return;
+  seen_periods_ = periods_.load();
+  silent_reads_ = 0;
+  stale_ = false;
+  if (!manual_clock_) base_thread_ = std::thread([this] { base_loop(); });
 }
 
 void GpioDriver::disable() {
-  if (running_.exchange(false)) base_thread_.join();
+  if (running_.exchange(false) && base_thread_.joinable()) base_thread_.join();
   if (backend_) backend_->stop();
 }
 
@@ -56,9 +56,16 @@ void GpioDriver::write(const JointCommand* commands, int count) noexcept {
 }
 
 void GpioDriver::read(JointFeedback* feedback, int count) noexcept {
-  const bool stale = running_.load(std::memory_order_relaxed) &&
-                     monotonic_ns() - last_period_ns_.load(std::memory_order_relaxed) >
-                         kStaleServoPeriods * std::max(servo_period_ns_, base_period_ns_);
+  // Once per servo period (read() comes before read_io()).
+  const std::uint64_t periods = periods_.load(std::memory_order_relaxed);
+  if (!running_.load(std::memory_order_relaxed) || periods != seen_periods_) {
+    seen_periods_ = periods;
+    silent_reads_ = 0;
+  } else if (silent_reads_ < stale_reads_) {
+    ++silent_reads_;
+  }
+  stale_ = silent_reads_ >= stale_reads_;
+  const bool stale = stale_;
   const int n = std::min(count, static_cast<int>(joints_.size()));
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -99,9 +106,7 @@ void GpioDriver::read_io(IoFeedback& feedback) noexcept {
   fb.has_at_speed = false;
   fb.at_speed = false;
   fb.fault = false;
-  fb.stale = running_.load(std::memory_order_relaxed) &&
-             monotonic_ns() - last_period_ns_.load(std::memory_order_relaxed) >
-                 kStaleServoPeriods * std::max(servo_period_ns_, base_period_ns_);
+  fb.stale = stale_;
   fb.has_position = encoder_ != nullptr;
   fb.revolutions = encoder_ ? spindle_feedback_.revolutions : 0;
 }
@@ -233,7 +238,6 @@ void GpioDriver::run_base_period(std::int64_t time_ns) noexcept {
   backend_->write_outputs(output_levels_.data(), time_ns);
   sample_inputs();
   periods_.fetch_add(1, std::memory_order_relaxed);
-  last_period_ns_.store(time_ns, std::memory_order_relaxed);
 }
 
 void GpioDriver::base_loop() noexcept {
@@ -242,25 +246,39 @@ void GpioDriver::base_loop() noexcept {
   sched_param param{};
   param.sched_priority = std::min(99, rt_priority_ + 1);
   pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  // Pins need every base period on time. A recording does not: it wakes once per servo period
+  // and runs the base periods that came due, each stamped with its own time. A wake-up every
+  // 25 us costs most of a CPU on a virtual machine, enough for the kernel's real-time
+  // throttling to stop the thread for tens of milliseconds.
+  const bool batched = !backend_->drives_pins() && !real_time_recording_;
+  const std::int64_t wake_ns =
+      batched ? std::max(servo_period_ns_, base_period_ns_) : base_period_ns_;
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
+  std::int64_t due_ns = to_ns(next);  // batched: time of the next base period to run
   while (running_.load(std::memory_order_relaxed)) {
-    next.tv_nsec += base_period_ns_;
+    next.tv_nsec += wake_ns;
     while (next.tv_nsec >= 1'000'000'000) {
       next.tv_nsec -= 1'000'000'000;
       ++next.tv_sec;
     }
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
     const std::int64_t now = monotonic_ns();
-    const std::int64_t late =
-        now - (static_cast<std::int64_t>(next.tv_sec) * 1'000'000'000 + next.tv_nsec);
+    const std::int64_t late = now - to_ns(next);
     total_late_ns_.fetch_add(late, std::memory_order_relaxed);
     if (late > max_late_ns_.load(std::memory_order_relaxed)) {
       max_late_ns_.store(late, std::memory_order_relaxed);
     }
-    run_base_period(now);
+    if (batched) {
+      // After a long stall, the periods missed are dropped as on pins, not run in a burst.
+      due_ns = std::max(due_ns, now - 10 * wake_ns);
+      for (; due_ns <= now; due_ns += base_period_ns_)
+        run_base_period(due_ns);
+    } else {
+      run_base_period(now);
+    }
     // After a long stall, catch up with the clock instead of bursting through missed periods.
-    if (late > 10 * base_period_ns_) clock_gettime(CLOCK_MONOTONIC, &next);
+    if (late > 10 * wake_ns) clock_gettime(CLOCK_MONOTONIC, &next);
   }
 }
 

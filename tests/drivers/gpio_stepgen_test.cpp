@@ -114,6 +114,30 @@ TEST_F(GpioStepgenTest, PulseCountsAndTimingInVirtualTime) {
   EXPECT_EQ(step_stats(changes, 1).rising_edges, 750);
 }
 
+// Staleness counts servo periods that ran without a base period, not wall time: after a stall
+// of the whole machine the base thread catches up, and only a base thread that stays silent
+// while the servo thread runs is a fault.
+TEST_F(GpioStepgenTest, FeedbackIsStaleAfterTwentyServoPeriodsWithoutABasePeriod) {
+  ASSERT_NO_FATAL_FAILURE(start(1));
+  const std::vector<double> rest{0};
+  JointFeedback fb;
+  servo_period(driver_, rest, rest, now_ns_);
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));  // 60 servo periods of wall time
+  driver_.read(&fb, 1);
+  EXPECT_FALSE(fb.stale);
+  for (int i = 1; i < 20; ++i) {
+    driver_.read(&fb, 1);
+    ASSERT_FALSE(fb.stale) << "after " << i << " silent servo periods";
+  }
+  driver_.read(&fb, 1);
+  EXPECT_TRUE(fb.stale) << "after 20 silent servo periods";
+  driver_.read(&fb, 1);
+  EXPECT_TRUE(fb.stale);
+  servo_period(driver_, rest, rest, now_ns_);
+  driver_.read(&fb, 1);
+  EXPECT_FALSE(fb.stale);
+}
+
 TEST_F(GpioStepgenTest, EnableLineFollowsTheCommandAndNothingStepsWhileDisabled) {
   ASSERT_NO_FATAL_FAILURE(start(1));
   JointCommand off{10, 0, false};
@@ -163,6 +187,7 @@ TEST(GpioStepgen, RealTimeBaseThreadReachesTheCommand) {
   const auto loaded = load_machine(dir, 1, stepgen_keys(), gpio_section(dir), 20'000);
   ASSERT_TRUE(loaded.ok());
   GpioDriver driver;
+  driver.pace_recording_in_real_time(true);  // a base period every 20 us, as for pins
   ASSERT_EQ(driver.configure(*loaded.config, {0}), "");
   driver.enable();
   // The step generator takes the first command it sees as where the motor stands; hold still at

@@ -40,6 +40,9 @@ class GpioBackend {
   virtual void write_outputs(const std::uint8_t* levels, std::int64_t time_ns) noexcept = 0;
   // RT, base thread: reads every input (indexed like request()'s inputs) with one bulk request.
   virtual void read_inputs(std::uint8_t* levels) noexcept = 0;
+  // Any thread: whether outputs reach pins, so that each base period must happen on time. A
+  // recording only needs each transition stamped with its period's time.
+  virtual bool drives_pins() const noexcept { return true; }
 };
 
 inline constexpr int kVcdLines = 64;
@@ -58,6 +61,7 @@ class VcdBackend final : public GpioBackend {
   void stop() override;
   void write_outputs(const std::uint8_t* levels, std::int64_t time_ns) noexcept override;
   void read_inputs(std::uint8_t* levels) noexcept override;
+  bool drives_pins() const noexcept override { return false; }
 
   // Any thread: the electrical level an input line reads from now on.
   void set_input_level(int line, bool high) noexcept;

@@ -51,6 +51,9 @@ class GpioDriver final : public Driver {
   // Non-RT, before enable(): no base thread; the caller advances time with run_base_period().
   // Tests and benchmarks use it to run the driver in virtual time.
   void use_manual_clock(bool manual) { manual_clock_ = manual; }
+  // Non-RT, before enable(): a recording backend's base thread wakes once per base period, as
+  // for pins, instead of once per servo period (tests of the real-time loop use it).
+  void pace_recording_in_real_time(bool real_time) { real_time_recording_ = real_time; }
   // RT, base thread (or the caller with a manual clock): one base period at `time_ns`.
   void run_base_period(std::int64_t time_ns) noexcept;
   // Any thread: the step count of the joint at `index` (position in configure()'s list).
@@ -138,8 +141,18 @@ class GpioDriver final : public Driver {
   std::uint64_t command_version_ = 0;
   double since_command_s_ = 0;
   std::array<std::atomic<std::int64_t>, kMaxJoints> counts_{};
-  std::atomic<std::int64_t> last_period_ns_{0};
   std::atomic<std::uint64_t> periods_{0};
+  // The base thread has stopped when this many servo periods in a row have run without one of
+  // its periods. Counted in servo periods that ran, not in wall time: a virtual machine now and
+  // then stalls every thread, SCHED_FIFO ones too, for tens of milliseconds, and after such a
+  // stall the servo thread may wake before the base thread; the generator catches up (within
+  // STEPGEN_MAXVEL, watched by the following error), so only a base thread that stays silent
+  // while the servo thread runs is a fault.
+  static constexpr std::int64_t kStaleServoPeriods = 20;
+  std::int64_t stale_reads_ = kStaleServoPeriods;  // servo thread's side
+  std::uint64_t seen_periods_ = 0;
+  std::int64_t silent_reads_ = 0;
+  bool stale_ = false;
   std::atomic<std::int64_t> max_late_ns_{0};
   std::atomic<std::int64_t> total_late_ns_{0};
 
@@ -168,6 +181,7 @@ class GpioDriver final : public Driver {
   SpindleState spindle_feedback_{};  // servo thread: kept while the base thread publishes
 
   bool manual_clock_ = false;
+  bool real_time_recording_ = false;
   std::atomic<bool> running_{false};
   std::thread base_thread_;
 };
