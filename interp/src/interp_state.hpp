@@ -128,6 +128,9 @@ struct Interpreter::Impl {
   void emit_preamble();
   void run_line();
   void run_startup_code();
+  // The dialect the first line names ("(dialect numeryx)"), else the machine's; the source is
+  // read again from its start afterwards. Failure for a name that is no dialect.
+  void detect_dialect();
   InterpError make_error(const Failure& failure) const;
 
   // execute.cpp: one block in LinuxCNC's order of execution.
@@ -219,6 +222,7 @@ struct Interpreter::Impl {
   Units tool_table_units() const;
 
   InterpOptions options_;
+  Dialect dialect_ = Dialect::linuxcnc;  // in effect for the open program
   Parameters parameters_;
   BlockParser parser_{parameters_};
   ToolTable tools_;

@@ -1,5 +1,7 @@
 #include "cncd/interp/interpreter.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <variant>
 
@@ -20,7 +22,8 @@ std::string InterpError::to_string() const {
   return text;
 }
 
-Interpreter::Impl::Impl(InterpOptions opts) : options_(std::move(opts)) {
+Interpreter::Impl::Impl(InterpOptions opts)
+    : options_(std::move(opts)), dialect_(options_.dialect) {
   block_.clear();  // no block has run yet: state() reports no group 0 code
   parameters_.set_predefined([this](std::string_view name) { return predefined_parameter(name); });
   // A file that is not there yet starts from the defaults, as LinuxCNC does; whoever owns it
@@ -251,6 +254,58 @@ void Interpreter::Impl::run_line() {
   execute_block();
 }
 
+const char* dialect_name(Dialect dialect) {
+  return dialect == Dialect::numeryx ? "numeryx" : "linuxcnc";
+}
+
+std::optional<Dialect> parse_dialect(std::string_view name) {
+  while (!name.empty() && (name.front() == ' ' || name.front() == '\t'))
+    name.remove_prefix(1);
+  while (!name.empty() && (name.back() == ' ' || name.back() == '\t'))
+    name.remove_suffix(1);
+  std::string lower;
+  for (const char c : name)
+    lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+  if (lower == "linuxcnc") return Dialect::linuxcnc;
+  if (lower == "numeryx") return Dialect::numeryx;
+  return std::nullopt;
+}
+
+void Interpreter::Impl::detect_dialect() {
+  dialect_ = options_.dialect;
+  if (!options_.dialect_from_first_line) return;
+  LineSource& source = sources_.back();
+  std::string line;
+  while (source.read_line(line)) {
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || is_percent_line(line)) continue;
+    const std::size_t last = line.find_last_not_of(" \t\r");
+    std::string text = line.substr(first, last - first + 1);
+    for (char& c : text)
+      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (text.size() > 2 && text.front() == '(' && text.back() == ')' &&
+        text.find(')') == text.size() - 1) {
+      const std::string inner = text.substr(1, text.size() - 2);
+      const std::size_t word = inner.find_first_not_of(" \t");
+      if (word != std::string::npos && inner.compare(word, 7, "dialect") == 0 &&
+          (inner.size() == word + 7 || inner[word + 7] == ' ' || inner[word + 7] == '\t')) {
+        const std::string name = inner.substr(word + 7);
+        const auto dialect = parse_dialect(name);
+        if (!dialect) {
+          current_line_ = source.line_number();
+          fail("Unknown dialect '" +
+               std::string(name.substr(std::min(name.size(), name.find_first_not_of(" \t")))) +
+               "' (linuxcnc or numeryx)");
+        }
+        dialect_ = *dialect;
+      }
+    }
+    break;
+  }
+  source.seek(0, 0);
+  current_line_ = 0;
+}
+
 Interpreter::Interpreter(InterpOptions options)
     : impl_(std::make_unique<Impl>(std::move(options))) {}
 
@@ -282,6 +337,12 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
   impl_->sources_.push_back(std::move(source));
   if (impl_->error_) return impl_->error_;
   impl_->reset_modal_state();
+  try {
+    impl_->detect_dialect();
+  } catch (const Failure& failure) {
+    impl_->error_ = impl_->make_error(failure);
+    return impl_->error_;
+  }
   return std::nullopt;
 }
 
@@ -293,7 +354,9 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   source.open_text(std::move(line), "MDI");
   impl_->sources_.push_back(std::move(source));
   if (impl_->error_) return impl_->error_;
-  // Modal state carries over from the previous MDI line or program, as in LinuxCNC.
+  // Modal state carries over from the previous MDI line or program, as in LinuxCNC; MDI reads
+  // the machine's dialect.
+  impl_->dialect_ = impl_->options_.dialect;
   impl_->mdi_ = true;
   impl_->ended_ = false;
   impl_->loops_without_motion_ = 0;
@@ -312,6 +375,12 @@ std::optional<InterpError> Interpreter::open_string(std::string text, std::strin
   impl_->sources_.push_back(std::move(source));
   if (impl_->error_) return impl_->error_;
   impl_->reset_modal_state();
+  try {
+    impl_->detect_dialect();
+  } catch (const Failure& failure) {
+    impl_->error_ = impl_->make_error(failure);
+    return impl_->error_;
+  }
   return std::nullopt;
 }
 
@@ -338,6 +407,10 @@ void Interpreter::set_input_result(double value) {
 
 int Interpreter::current_line() const {
   return impl_->current_line_;
+}
+
+Dialect Interpreter::dialect() const {
+  return impl_->dialect_;
 }
 
 std::optional<InterpError> Interpreter::save_parameters() const {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cncd/interp/canon.hpp"
@@ -26,6 +27,15 @@ struct InterpError {
   std::string to_string() const;
 };
 
+// Which reading of the program: LinuxCNC's RS274NGC, or the Numeryx (Ncplus) drilling dialect
+// of its application note An-101 (cycle heights R1 = R + clearance and Zi, for/next loops,
+// gil(), polar g10). One core; the dialect changes the cycles and that syntax only.
+enum class Dialect : std::uint8_t { linuxcnc, numeryx };
+// "linuxcnc" or "numeryx".
+const char* dialect_name(Dialect dialect);
+// The dialect a name gives (any case, blanks around it ignored), or nothing.
+std::optional<Dialect> parse_dialect(std::string_view name);
+
 struct InterpOptions {
   Units machine_units = Units::mm;       // units of the machine (INI LINEAR_UNITS)
   std::filesystem::path parameter_file;  // empty = none
@@ -40,6 +50,15 @@ struct InterpOptions {
   std::vector<std::filesystem::path> user_m_path;
   std::string startup_code;   // RS274NGC_STARTUP_CODE, run before the program
   bool block_delete = false;  // skip lines starting with '/'
+  // [RS274NGC] DIALECT. A program's first line (after a '%' line) may name another one:
+  // "(dialect numeryx)" or "(dialect linuxcnc)".
+  Dialect dialect = Dialect::linuxcnc;
+  // false: `dialect` holds whatever the first line says (cncd-check --dialect, to compare the
+  // two readings of one program).
+  bool dialect_from_first_line = true;
+  // [RS274NGC] NUMERYX_CLEARANCE, machine units: R1 = R + clearance in the Numeryx dialect.
+  // Unset: the note's 1 mm in a G21 program, 0.04 in in a G20 one.
+  std::optional<double> numeryx_clearance;
   // [EMCIO] TOOL_CHANGE_QUILL_UP: M6 first raises Z to machine zero (a traverse, as LinuxCNC's
   // interpreter emits it); TOOL_CHANGE_WITH_SPINDLE_ON: M6 leaves the spindle turning.
   bool tool_change_quill_up = false;
@@ -118,6 +137,10 @@ class Interpreter {
 
   // Line number of the block last executed.
   int current_line() const;
+
+  // The dialect in effect for the open program: InterpOptions::dialect, or the one its first
+  // line names.
+  Dialect dialect() const;
 
   InterpState state() const;
   // Coordinate system `system` (1..9 = G54..G59.3) from the parameters, machine units.
