@@ -66,6 +66,39 @@ struct Block {
   double o_value = 0;
   std::vector<double> call_args;
 
+  // Numeryx dialect. The drilling cycle word (ten times: 730, 740, 810 .. 860, or 800 for g80)
+  // and the R, Z, Q and D written after it, which belong to the cycle, not to the NC addresses.
+  int nx_cycle = -1;
+  int nx_cycle_column = 0;
+  std::array<double, 4> nx_cycle_value{};  // r z q d
+  std::array<int, 4> nx_cycle_col{};
+  std::uint8_t nx_cycle_present = 0;
+  // g10: polar positioning (pole I J, angle P in degrees, radius R).
+  bool nx_polar = false;
+  int nx_polar_column = 0;
+  // for #n=start to end [step s] / next [#n]
+  enum class Loop : std::uint8_t { none, for_, next };
+  Loop nx_loop = Loop::none;
+  int nx_loop_var = 0;  // 0 = next without a variable
+  double nx_loop_start = 0;
+  double nx_loop_end = 0;
+  double nx_loop_step = 1;
+  int nx_loop_column = 0;
+
+  static int nx_cycle_slot(char letter) {
+    return letter == 'r' ? 0 : letter == 'z' ? 1 : letter == 'q' ? 2 : letter == 'd' ? 3 : -1;
+  }
+  bool has_cycle(char letter) const {
+    const int slot = nx_cycle_slot(letter);
+    return slot >= 0 && ((nx_cycle_present >> slot) & 1U) != 0;
+  }
+  double cycle_value(char letter) const {
+    return nx_cycle_value[static_cast<std::size_t>(nx_cycle_slot(letter))];
+  }
+  int cycle_col(char letter) const {
+    return nx_cycle_col[static_cast<std::size_t>(nx_cycle_slot(letter))];
+  }
+
   struct NumberedAssignment {
     int number;
     double value;
@@ -96,6 +129,12 @@ struct Block {
     call_args.clear();
     numbered_assignments.clear();
     named_assignment_count = 0;
+    nx_cycle = -1;
+    nx_cycle_present = 0;
+    nx_polar = false;
+    nx_loop = Loop::none;
+    nx_loop_var = 0;
+    nx_loop_step = 1;
   }
 };
 

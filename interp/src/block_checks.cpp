@@ -34,7 +34,7 @@ bool Interpreter::Impl::axes_belong_to_non_modal() const {
   return code == 100 || code == 280 || code == 300 || code == 520 || code == 920;
 }
 
-void Interpreter::Impl::check_block() const {
+void Interpreter::Impl::check_supported_codes() const {
   const Block& b = block_;
   for (int group = 0; group < kGGroups; ++group) {
     const int code = b.g[static_cast<std::size_t>(group)];
@@ -48,6 +48,11 @@ void Interpreter::Impl::check_block() const {
       fail(not_supported('M', code * 10), b.m_column[static_cast<std::size_t>(group)]);
     }
   }
+}
+
+void Interpreter::Impl::check_block() const {
+  const Block& b = block_;
+  check_supported_codes();
   const bool polar = b.has_polar_distance || b.has_polar_angle;
   if (polar && b.has('x')) fail("Cannot specify both polar coordinate and X word", b.col('x'));
   if (polar && b.has('y')) fail("Cannot specify both polar coordinate and Y word", b.col('y'));

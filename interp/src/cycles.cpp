@@ -198,8 +198,16 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
   const bool restart_counterclockwise = modal_.spindle == SpindleDir::counterclockwise;
   auto restart = [&] { start_spindle(restart_counterclockwise); };
 
-  traverse(current_c);
+  if (g.position_first) traverse(current_c);
   if (current_c != g.r) traverse(g.r);
+  // The dwell at the bottom: LinuxCNC's P for the cycles that take one; the Numeryx D for all.
+  auto dwell_at_bottom = [&](bool takes_p) {
+    if (g.dwell) {
+      if (*g.dwell > 0) dwell(*g.dwell);
+    } else if (takes_p) {
+      dwell(cycle_.p);
+    }
+  };
   const bool needs_spindle =
       code == 740 || code == 840 || code == 860 || code == 870 || code == 880;
   if (needs_spindle && modal_.spindle == SpindleDir::stopped) {
@@ -209,18 +217,20 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
   switch (code) {
     case 810:
       feed(g.bottom);
+      dwell_at_bottom(false);
       traverse(g.clear);
       break;
     case 820:
       feed(g.bottom);
-      dwell(cycle_.p);
+      dwell_at_bottom(true);
       traverse(g.clear);
       break;
     case 730:
     case 830: {
       const double clearance = peck_clearance(modal_.units);
       int pecks = 0;
-      for (double depth = g.r - cycle_.q; depth > g.bottom; depth -= cycle_.q) {
+      for (double depth = g.peck_top.value_or(g.r) - cycle_.q; depth > g.bottom;
+           depth -= cycle_.q) {
         if (++pecks > kMaxPecks) {
           fail("Too many pecks in " + g_name(code) + ": Q too small for the depth (more than " +
                std::to_string(kMaxPecks) + " pecks)");
@@ -230,6 +240,7 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
         traverse(depth + clearance);
       }
       feed(g.bottom);
+      dwell_at_bottom(false);
       traverse(g.clear);
       break;
     }
@@ -247,7 +258,7 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
       feed(g.bottom);
       emit(StopSpindleTurning{});
       start_spindle(right_hand);
-      dwell(cycle_.p);
+      dwell_at_bottom(true);
       feed(g.clear);
       emit(StopSpindleTurning{});
       start_spindle(!right_hand);
@@ -257,12 +268,13 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
     }
     case 850:
       feed(g.bottom);
+      dwell_at_bottom(false);
       feed(g.r);
       traverse(g.clear);
       break;
     case 860:
       feed(g.bottom);
-      dwell(cycle_.p);
+      dwell_at_bottom(true);
       emit(StopSpindleTurning{});
       traverse(g.clear);
       restart();

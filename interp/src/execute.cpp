@@ -24,6 +24,10 @@ bool starts_with_word(const std::string& text, const char* word, std::size_t& re
 }  // namespace
 
 void Interpreter::Impl::execute_block() {
+  if (dialect_ == Dialect::numeryx) {
+    execute_numeryx_block();
+    return;
+  }
   check_block();
   do_comment();
   do_feed_mode();

@@ -227,4 +227,45 @@ double BlockParser::read_unary(int col) {
   return std::tan(arg * kDegree);
 }
 
+// Numeryx: an expression written after '=' in an address or assignment ("x=gil(0,10)",
+// "f=1000/13"), without brackets. It ends where a character that is no operator follows a value
+// (the next address letter, a comma, the end of the line). Symbolic operators only, with
+// LinuxCNC's precedence; words such as MOD would be read as addresses.
+double BlockParser::read_nx_expression() {
+  constexpr int kMaxDepth = 16;
+  double values[kMaxDepth];
+  Op ops[kMaxDepth];
+  int op_columns[kMaxDepth];
+  int top = 0;
+  values[0] = read_nx_operand();
+  for (;;) {
+    const char c = peek();
+    Op op = Op::none;
+    const int col = column();
+    if (c == '*' && peek_at(1) == '*') {
+      op = Op::power;
+      pos_ += 2;
+    } else if (c == '*' || c == '/' || c == '+' || c == '-') {
+      op = c == '*' ? Op::times : c == '/' ? Op::divide : c == '+' ? Op::plus : Op::minus;
+      ++pos_;
+    } else {
+      break;
+    }
+    while (top > 0 && precedence(ops[top - 1]) >= precedence(op)) {
+      values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+      --top;
+    }
+    if (top + 1 >= kMaxDepth) error("Expression too complex");
+    ops[top] = op;
+    op_columns[top] = col;
+    values[++top] = read_nx_operand();
+  }
+  while (top > 0) {
+    values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
+    --top;
+  }
+  if (!std::isfinite(values[0])) error("Result is not a finite number (overflow)");
+  return values[0];
+}
+
 }  // namespace cncd::interp

@@ -71,6 +71,39 @@ struct CycleState {
   double initial_level = 0;
 };
 
+// The Numeryx dialect's drilling state: the active cycle and its own variables (kept in the
+// units they were given; switching units while a cycle is active is refused), the initial Z
+// (Zi) and the polar positioning values.
+struct NumeryxState {
+  int cycle = 0;  // ten times the active cycle (730, 810 ..), 0 = g80
+  double r = 0;
+  double z = 0;
+  double q = 0;
+  double d = 0;  // dwell at the bottom, s
+  bool has_r = false;
+  bool has_z = false;
+  bool has_q = false;
+  bool incremental = false;  // the cycle's own g90/g91, for R and Z only
+  bool has_zi = false;
+  double zi = 0;  // the Z last read by a positioning block, in zi_units
+  Units zi_units = Units::mm;
+  double pole_i = 0;  // g10: pole, radius and angle (degrees), kept from block to block
+  double pole_j = 0;
+  double radius = 0;
+  double angle = 0;
+};
+
+// An open Numeryx for loop.
+struct ForFrame {
+  int var = 0;
+  double end = 0;
+  double step = 1;
+  std::int64_t offset = 0;  // the line after the for line
+  int line_before = 0;
+  int for_line = 0;
+  bool skipped = false;  // the loop runs no pass: its next line ends it
+};
+
 // An open O-word block: if/elseif/else, while, do or repeat.
 struct ControlFrame {
   OKind kind = OKind::none;
@@ -117,6 +150,12 @@ struct CycleGeometry {
   double k = 0;       // G87 back-bore height
   double i = 0;       // G87 offsets across the plane
   double j = 0;
+  // Numeryx: the cycle has positioned itself (no move across at the current height first), and
+  // the top pecks are measured from (R, below the R1 the tool feeds from); a dwell at the bottom
+  // for every cycle (D), instead of LinuxCNC's P for the cycles that take one.
+  bool position_first = true;
+  std::optional<double> peck_top;
+  std::optional<double> dwell;
 };
 
 struct Interpreter::Impl {
@@ -136,6 +175,19 @@ struct Interpreter::Impl {
   // execute.cpp: one block in LinuxCNC's order of execution.
   void execute_block();
   void check_block() const;
+  void check_supported_codes() const;
+
+  // numeryx.cpp: the Numeryx dialect's blocks, cycles and loops.
+  void execute_numeryx_block();
+  void check_numeryx_block() const;
+  void numeryx_modes();
+  void numeryx_motion();
+  void define_numeryx_cycle(int code);
+  void numeryx_drill();
+  void set_zi();
+  // for/next: true when the line is done (a for line, or a next that loops back).
+  bool handle_numeryx_loop();
+  void skip_numeryx_loop();
   bool axes_belong_elsewhere() const;
   bool axes_belong_to_non_modal() const;
   void check_word_users(int motion) const;
@@ -250,8 +302,11 @@ struct Interpreter::Impl {
   ModalState modal_;
   int previous_motion_ = -1;  // the motion mode before the current block
   CycleState cycle_;
-  Pose pos_{};         // current position: program coordinates, program units
-  Pose g5x_offset_{};  // active coordinate system origin, program units
+  NumeryxState nx_;
+  std::vector<ForFrame> nx_loops_;
+  int nx_cycle_distance_ = -1;  // this block's g90/g91 that belongs to the drilling cycle
+  Pose pos_{};                  // current position: program coordinates, program units
+  Pose g5x_offset_{};           // active coordinate system origin, program units
   Pose g92_offset_{};
   double rotation_deg_ = 0;
   Pose tool_offset_{};  // tool length offset, in the units it was set in (as LinuxCNC keeps it)

@@ -57,6 +57,8 @@ void Interpreter::Impl::reset_modal_state() {
   modal_ = ModalState{};
   modal_.units = options_.machine_units;
   cycle_ = CycleState{};
+  nx_ = NumeryxState{};
+  nx_loops_.clear();
   const int system = to_int(parameters_.get(5220));
   modal_.coord_system = system >= 1 && system <= 9 ? system : 1;
   parameters_.set(5220, modal_.coord_system);
@@ -158,6 +160,26 @@ bool is_percent_line(const std::string& line) {
   }
   return percent;
 }
+
+// "(dialect NAME)" as the whole line: NAME with its blanks trimmed; otherwise nothing.
+std::optional<std::string> dialect_comment(const std::string& text) {
+  std::string lower;
+  for (const char c : text)
+    lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+  while (!lower.empty() && (lower.back() == ' ' || lower.back() == '\t' || lower.back() == '\r'))
+    lower.pop_back();
+  if (lower.size() < 2 || lower.front() != '(' || lower.find(')') != lower.size() - 1)
+    return std::nullopt;
+  const std::string inner = lower.substr(1, lower.size() - 2);
+  const std::size_t word = inner.find_first_not_of(" \t");
+  if (word == std::string::npos || inner.compare(word, 7, "dialect") != 0) return std::nullopt;
+  if (inner.size() > word + 7 && inner[word + 7] != ' ' && inner[word + 7] != '\t')
+    return std::nullopt;
+  std::string name = inner.substr(word + 7);
+  const std::size_t from = name.find_first_not_of(" \t");
+  const std::size_t to = name.find_last_not_of(" \t");
+  return from == std::string::npos ? std::string() : name.substr(from, to - from + 1);
+}
 }  // namespace
 
 Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
@@ -228,6 +250,12 @@ void Interpreter::Impl::run_startup_code() {
 }
 
 void Interpreter::Impl::run_line() {
+  parser_.set_dialect(dialect_);
+  if (nx_loops_.empty()) {
+    parser_.set_gil_loop(0, 0);
+  } else {
+    parser_.set_gil_loop(nx_loops_.back().var, nx_loops_.back().end);
+  }
   parser_.parse(line_, block_);
   if (block_.block_delete && options_.block_delete) return;
   // The tool (#5400-#5413) and position (#5420-#5428) parameters and the predefined names
@@ -251,6 +279,7 @@ void Interpreter::Impl::run_line() {
     handle_o_word();
     return;
   }
+  if (block_.nx_loop != Block::Loop::none && handle_numeryx_loop()) return;
   execute_block();
 }
 
@@ -273,37 +302,27 @@ std::optional<Dialect> parse_dialect(std::string_view name) {
 
 void Interpreter::Impl::detect_dialect() {
   dialect_ = options_.dialect;
-  if (!options_.dialect_from_first_line) return;
-  LineSource& source = sources_.back();
-  std::string line;
-  while (source.read_line(line)) {
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || is_percent_line(line)) continue;
-    const std::size_t last = line.find_last_not_of(" \t\r");
-    std::string text = line.substr(first, last - first + 1);
-    for (char& c : text)
-      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (text.size() > 2 && text.front() == '(' && text.back() == ')' &&
-        text.find(')') == text.size() - 1) {
-      const std::string inner = text.substr(1, text.size() - 2);
-      const std::size_t word = inner.find_first_not_of(" \t");
-      if (word != std::string::npos && inner.compare(word, 7, "dialect") == 0 &&
-          (inner.size() == word + 7 || inner[word + 7] == ' ' || inner[word + 7] == '\t')) {
-        const std::string name = inner.substr(word + 7);
-        const auto dialect = parse_dialect(name);
+  if (options_.dialect_from_first_line) {
+    LineSource& source = sources_.back();
+    std::string line;
+    while (source.read_line(line)) {
+      const std::size_t first = line.find_first_not_of(" \t");
+      if (first == std::string::npos || is_percent_line(line)) continue;
+      if (const auto named = dialect_comment(line.substr(first))) {
+        const auto dialect = parse_dialect(*named);
         if (!dialect) {
           current_line_ = source.line_number();
-          fail("Unknown dialect '" +
-               std::string(name.substr(std::min(name.size(), name.find_first_not_of(" \t")))) +
-               "' (linuxcnc or numeryx)");
+          fail("Unknown dialect '" + *named + "' (linuxcnc or numeryx)");
         }
         dialect_ = *dialect;
       }
+      break;
     }
-    break;
+    source.seek(0, 0);
+    current_line_ = 0;
   }
-  source.seek(0, 0);
-  current_line_ = 0;
+  // Numeryx cycles start with G98 (retract to the initial Z); LinuxCNC starts with G99.
+  if (dialect_ == Dialect::numeryx) modal_.retract_r_plane = false;
 }
 
 Interpreter::Interpreter(InterpOptions options)

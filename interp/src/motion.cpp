@@ -60,6 +60,12 @@ Pose Interpreter::Impl::target_from_words() const {
     const auto a = static_cast<std::size_t>(axis);
     end[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
   }
+  if (block_.nx_polar) {
+    // Numeryx g10: around the pole (I, J) at radius R and angle P (degrees).
+    const double degree = std::numbers::pi / 180.0;
+    end[kX] = nx_.pole_i + nx_.radius * std::cos(nx_.angle * degree);
+    end[kY] = nx_.pole_j + nx_.radius * std::sin(nx_.angle * degree);
+  }
   if (block_.has_polar_distance || block_.has_polar_angle) {
     // Polar words give X and Y around the origin; incremental ones add to the current
     // distance and angle.

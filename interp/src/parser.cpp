@@ -33,9 +33,18 @@ void BlockParser::normalize(std::string_view line) {
   text_.clear();
   columns_.clear();
   bool in_comment = false;
+  int function_depth = 0;  // Numeryx: inside gil( ... ), whose brackets are no comment
   for (std::size_t i = 0; i < line.size(); ++i) {
     char c = line[i];
     const int col = static_cast<int>(i) + 1;
+    if (dialect_ == Dialect::numeryx && !in_comment &&
+        ((c == '(' && (function_depth > 0 || text_.ends_with("gil"))) ||
+         (c == ')' && function_depth > 0))) {
+      function_depth += c == '(' ? 1 : -1;
+      text_.push_back(c);
+      columns_.push_back(col);
+      continue;
+    }
     if (in_comment) {
       if (c == ')') in_comment = false;
       text_.push_back(c);
@@ -115,10 +124,16 @@ void BlockParser::read_word(Block& block) {
   if (!is_alpha(c)) {
     error(std::string("Bad character '") + c + "' used");
   }
+  const bool numeryx = dialect_ == Dialect::numeryx;
+  if (numeryx && (c == 'f' || c == 'n') && read_nx_keyword(block, col)) return;
   ++pos_;
   switch (c) {
     case 'g':
-      read_g(block, col);
+      if (numeryx) {
+        read_nx_g(block, col);
+      } else {
+        read_g(block, col);
+      }
       return;
     case 'm':
       read_m(block, col);
@@ -136,11 +151,32 @@ void BlockParser::read_word(Block& block) {
       break;
   }
   const auto index = static_cast<std::size_t>(c - 'a');
+  if (numeryx && Block::nx_cycle_slot(c) >= 0 && block.nx_cycle > 0 && block.nx_cycle != 800) {
+    // R, Z, Q and D after the cycle word are the cycle's own.
+    const auto slot = static_cast<std::size_t>(Block::nx_cycle_slot(c));
+    if ((block.nx_cycle_present >> slot) & 1U) {
+      fail(std::string("Multiple ") + c + " words after the cycle word on one line", col);
+    }
+    block.nx_cycle_value[slot] = read_nx_value();
+    block.nx_cycle_col[slot] = col;
+    block.nx_cycle_present = static_cast<std::uint8_t>(block.nx_cycle_present | (1U << slot));
+    return;
+  }
   if (block.present & (1U << index)) {
     fail(std::string("Multiple ") + c + " words on one line", col);
   }
   double value = 0;
-  if (c == 'l' || c == 't' || c == 'h') {
+  if (numeryx) {
+    value = read_nx_value();
+    if (c == 'l' || c == 't' || c == 'h') {
+      const double rounded = std::nearbyint(value);
+      if (std::fabs(value - rounded) > kTolerance || std::fabs(rounded) > 2e9) {
+        fail("Non integer value for integer", col);
+      }
+      if (rounded < 0) fail(std::string("Negative ") + c + " word used", col);
+      value = rounded;
+    }
+  } else if (c == 'l' || c == 't' || c == 'h') {
     // Integer words.
     value = read_integer_value();
     if (value < 0) fail(std::string("Negative ") + c + " word used", col);
@@ -159,7 +195,10 @@ void BlockParser::read_g(Block& block, int col) {
   if (std::fabs(scaled - code) > kTolerance * 10.0 || code < 0 || code > 999) {
     fail("Unknown g code used", col);
   }
-  const int number = static_cast<int>(code);
+  add_g(block, static_cast<int>(code), col);
+}
+
+void BlockParser::add_g(Block& block, int number, int col) {
   const CodeInfo info = g_code_info(number);
   if (info.group < 0) fail("Unknown g code used", col);
   const auto group = static_cast<std::size_t>(info.group);
@@ -279,13 +318,14 @@ void BlockParser::read_assignment(Block& block) {
     read_name(block.named_assignments[index].first);
     if (peek() != '=') error("Equal sign missing in parameter setting");
     ++pos_;
-    block.named_assignments[index].second = read_real_value();
+    block.named_assignments[index].second =
+        dialect_ == Dialect::numeryx ? read_nx_expression() : read_real_value();
     return;
   }
   const int number = read_parameter_index();
   if (peek() != '=') error("Equal sign missing in parameter setting");
   ++pos_;
-  const double value = read_real_value();
+  const double value = dialect_ == Dialect::numeryx ? read_nx_expression() : read_real_value();
   block.numbered_assignments.push_back({number, value, col});
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "block.hpp"
+#include "cncd/interp/interpreter.hpp"
 #include "parameters.hpp"
 
 namespace cncd::interp {
@@ -24,15 +25,34 @@ class BlockParser {
   // Throws Failure with the column of the offending character.
   void parse(std::string_view line, Block& block);
 
+  // The syntax to read: LinuxCNC's, or the Numeryx dialect's (see numeryx_parser.cpp).
+  void set_dialect(Dialect dialect) { dialect_ = dialect; }
+  // Numeryx: the innermost for loop, whose variable and end value gil() reads; var 0 = none.
+  void set_gil_loop(int var, double end) {
+    gil_var_ = var;
+    gil_end_ = end;
+  }
+
  private:
   void normalize(std::string_view line);
   void read_comment(Block& block);
   void read_word(Block& block);
   void read_g(Block& block, int column);
+  void add_g(Block& block, int number, int column);
   void read_m(Block& block, int column);
   void read_o(Block& block, int column);
   void read_program_number(Block& block);
   void read_assignment(Block& block);
+
+  // Numeryx dialect (numeryx_parser.cpp).
+  bool read_nx_keyword(Block& block, int column);
+  void read_nx_g(Block& block, int column);
+  double read_nx_value();
+  double read_nx_expression();
+  double read_nx_operand();
+  double read_gil(int column);
+  bool nx_value_follows() const;
+  bool match_text(std::string_view word);
 
   double read_real_value();
   double read_nested_value();
@@ -62,6 +82,9 @@ class BlockParser {
   // Only block delete and a line number may come before an O-word (LinuxCNC: "Bad character
   // 'o' used" after anything else).
   bool o_allowed_ = true;
+  Dialect dialect_ = Dialect::linuxcnc;
+  int gil_var_ = 0;
+  double gil_end_ = 0;
 };
 
 }  // namespace cncd::interp
