@@ -76,7 +76,7 @@ void Interpreter::Impl::check_numeryx_block() const {
   }
   const int motion = b.g_code(GGroup::motion);
   const int active_motion = motion >= 0 ? motion : modal_.motion;
-  if (axis_words && !drilling && active_motion < 0 && !axes_belong_elsewhere()) {
+  if (axis_words && !drilling && !b.nx_polar && active_motion < 0 && !axes_belong_elsewhere()) {
     fail("Cannot use axis values without a g code that uses them");
   }
   if (drilling) {
