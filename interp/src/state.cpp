@@ -31,7 +31,8 @@ InterpState Interpreter::state() const {
   auto& g = out.gcodes;
   g.fill(-1);
   g[0] = s.current_line_;
-  g[1] = m.motion;
+  // Numeryx: the drilling cycle in force, else the positioning mode.
+  g[1] = s.nx_.cycle != 0 ? s.nx_.cycle : m.motion;
   g[2] = s.block_.g_code(GGroup::non_modal);
   g[3] = plane_code(m.plane);
   g[4] = 400;  // cutter radius compensation is not supported: always off

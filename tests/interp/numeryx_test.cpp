@@ -551,6 +551,21 @@ TEST(Numeryx, TheDialectComesFromTheFirstLineOrTheMachine) {
   EXPECT_EQ(r.dialect, Dialect::linuxcnc);
 }
 
+TEST(Numeryx, StateShowsTheCycleInForce) {
+  Interpreter interp;
+  ASSERT_FALSE(
+      interp.open_string("(dialect numeryx)\ng x0 y0 z10 f100 g82 r0 z-5 d1 g99\n"
+                         "g80\nm30\n"));
+  Recorder recorder;
+  ASSERT_EQ(interp.step(recorder), Interpreter::Step::block);  // the dialect line
+  ASSERT_EQ(interp.step(recorder), Interpreter::Step::block);
+  EXPECT_EQ(interp.state().gcodes[1], 820);
+  EXPECT_EQ(interp.state().gcodes[10], 990);
+  ASSERT_EQ(interp.step(recorder), Interpreter::Step::block);
+  EXPECT_EQ(interp.state().gcodes[1], 0);     // back to the positioning mode
+  EXPECT_EQ(interp.state().gcodes[10], 980);  // g80 cancelled g99
+}
+
 // The same program read both ways drills at different heights: the reason for the switch.
 TEST(Numeryx, TheTwoReadingsOfOneProgramDiffer) {
   const std::string program = "g0 x0 y0 z10\nf100\ng81 r2 z-5\nx5\ng80\nm30\n";
