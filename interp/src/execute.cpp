@@ -396,6 +396,8 @@ void Interpreter::Impl::program_end_reset() {
   if (modal_.flood) emit(FloodOff{});
   modal_.mist = modal_.flood = false;
   modal_.motion = 10;
+  nx_.cycle = 0;  // Numeryx: the end of the program ends the drilling cycle and its loops
+  nx_loops_.clear();
   if (block_.m_code(MGroup::stopping) == 30) emit(PalletShuttle{});
   emit(ProgramEnd{});
 }

@@ -1,6 +1,7 @@
 // libFuzzer target over the interpreter's lexer, parser, expression evaluator and executor:
 // arbitrary bytes run as a program through the real Interpreter (or, when the first byte is
-// odd, as MDI blocks one line at a time), every command converted to machine coordinates.
+// odd, as MDI blocks one line at a time), every command converted to machine coordinates; bit 1
+// of that byte makes the machine's units inches, bit 2 its dialect Numeryx.
 // Any input must end in a clean error or a clean end: never a crash, hang or leak.
 #include <cstddef>
 #include <cstdint>
@@ -70,6 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
   InterpOptions options;
   options.machine_units = (data[0] & 2) != 0 ? Units::inches : Units::mm;
+  options.dialect = (data[0] & 4) != 0 ? Dialect::numeryx : Dialect::linuxcnc;
   Interpreter interp(options);
   MachineSink sink;
   if (!mdi) {
