@@ -103,6 +103,9 @@ bool finite(const CanonOp& op) {
                         [](const SetOutputValue& c) { return std::isfinite(c.value); },
                         [](const WaitInput& c) { return std::isfinite(c.timeout_s); },
                         [](const UserMCode& c) { return std::isfinite(c.p) && std::isfinite(c.q); },
+                        [](const StraightProbe& c) { return finite(c.end); },
+                        [](const RigidTap& c) { return finite(c.end) && std::isfinite(c.scale); },
+                        [](const StartSpeedFeedSynch& c) { return std::isfinite(c.feed_per_rev); },
                         [](const SetToolTableEntry& c) {
                           return finite(c.offset) && std::isfinite(c.front_angle) &&
                                  std::isfinite(c.back_angle);
@@ -422,6 +425,18 @@ const std::vector<std::string>& Interpreter::load_warnings() const {
 void Interpreter::set_input_result(double value) {
   impl_->input_pending_ = false;
   impl_->parameters_.set(5399, std::isfinite(value) ? value : -1.0);
+}
+
+void Interpreter::set_probe_result(const Pose& trip_machine, bool tripped) {
+  Pose program = trip_machine;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    if (is_linear_axis(static_cast<int>(axis)))
+      program[axis] = impl_->to_program_units(program[axis]);
+  }
+  program = impl_->machine_to_program(program);
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    impl_->parameters_.set(5061 + static_cast<int>(axis), program[axis]);
+  impl_->parameters_.set(5070, tripped ? 1.0 : 0.0);
 }
 
 int Interpreter::current_line() const {

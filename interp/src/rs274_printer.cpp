@@ -231,6 +231,17 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
             append_args(out, c.code, c.p, c.q);
             out += ')';
           },
+          [&](const TurnProbeOn&) { out += "TURN_PROBE_ON()"; },
+          [&](const TurnProbeOff&) { out += "TURN_PROBE_OFF()"; },
+          [&](const StraightProbe& c) { append_pose_call(out, "STRAIGHT_PROBE(", c.end, axes); },
+          [&](const StartSpeedFeedSynch& c) {
+            char text[64];
+            std::snprintf(text, sizeof text, "START_SPEED_FEED_SYNC(%f,%d)", c.feed_per_rev,
+                          c.velocity_mode ? 1 : 0);
+            out += text;
+          },
+          [&](const StopSpeedFeedSynch&) { out += "STOP_SPEED_FEED_SYNCH()"; },
+          [&](const RigidTap& c) { append_pose_call(out, "RIGID_TAP(", c.end, 3); },
       },
       op);
 }

@@ -65,6 +65,9 @@ CanonCommand MachineTracker::to_machine(const CanonCommand& command) {
                  },
                  [&](StraightTraverse& c) { c.end = machine_pose(c.end); },
                  [&](StraightFeed& c) { c.end = machine_pose(c.end); },
+                 [&](StraightProbe& c) { c.end = machine_pose(c.end); },
+                 [&](RigidTap& c) { c.end = machine_pose(c.end); },
+                 [&](StartSpeedFeedSynch& c) { c.feed_per_rev *= length_factor(); },
                  [&](ArcFeed& c) {
                    const Pose machine_center = machine_pose(c.center());
                    c.set_end(machine_pose(c.end()));

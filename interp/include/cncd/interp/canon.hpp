@@ -172,6 +172,35 @@ struct UserMCode {
   double q = -1;
   std::string executable;  // absolute path
 };
+// G38.2-G38.5: TURN_PROBE_ON, a straight move at the feed that the machine ends where the
+// probe trips (toward) or loses contact (away), TURN_PROBE_OFF. The machine reports where it
+// tripped (Interpreter::set_probe_result) before the interpreter reads on.
+enum class ProbeKind : std::uint8_t {
+  toward_or_error = 0,  // G38.2: stop on contact; no contact is an error
+  toward = 1,           // G38.3: stop on contact; no contact is no error
+  away_or_error = 2,    // G38.4: stop on loss of contact; none is an error
+  away = 3,             // G38.5
+};
+struct TurnProbeOn {};
+struct TurnProbeOff {};
+struct StraightProbe {  // STRAIGHT_PROBE(x, y, z, a, b, c)
+  Pose end{};
+  ProbeKind kind = ProbeKind::toward_or_error;
+};
+// G33, G33.1 (and rigid G84/G74): the moves between these follow the spindle's position,
+// `feed_per_rev` (program units per revolution; machine units once to_machine() converted it)
+// per turn. rs274 prints START_SPEED_FEED_SYNC(1.250000,0).
+struct StartSpeedFeedSynch {
+  double feed_per_rev = 0;
+  bool velocity_mode = false;  // LinuxCNC's CSS velocity mode; false for G33/G33.1
+};
+struct StopSpeedFeedSynch {};
+// G33.1: down to `end` in step with the spindle, the spindle reversed there, back up to the
+// start in step with it, and the spindle's direction restored. RIGID_TAP(x, y, z).
+struct RigidTap {
+  Pose end{};
+  double scale = 1.0;  // LinuxCNC's spindle speed scale for the way out
+};
 struct SetToolTableEntry {
   int pocket = 0;
   int tool = 0;
@@ -190,7 +219,8 @@ using CanonOp = std::variant<
     SelectTool, ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
     SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage, ProgramStop,
     OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish, StartChange, OrientSpindle,
-    SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode>;
+    SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode, TurnProbeOn,
+    TurnProbeOff, StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
 
 struct CanonCommand {
   std::int32_t line = 0;  // 1-based source line number in its file

@@ -134,6 +134,14 @@ class Interpreter {
   // digital input 1 if #5399 was not 0 and 0 if it was, for an analog input unchanged. A
   // value that is not finite is taken as -1.
   void set_input_result(double value);
+  // The answer to the last StraightProbe (G38.2-G38.5): where the probe tripped (or lost
+  // contact), latched by the servo thread, in machine coordinates and the machine's units, and
+  // whether it did. #5061-#5069 take that position in the program's coordinates and units,
+  // #5070 1 or 0, and a probe file opened with (PROBEOPEN name) gets a line. The caller stops
+  // calling step() after a StraightProbe until the move is over, calls this, then
+  // set_machine_position() with where the machine stopped. An error the machine raised (no
+  // contact in G38.2/G38.4, tripped already at the start) is the caller's to report.
+  void set_probe_result(const Pose& trip_machine, bool tripped);
 
   // Line number of the block last executed.
   int current_line() const;
