@@ -332,6 +332,14 @@ constexpr std::array kKeys{
              "gpio: line of the maximum limit switch input; empty: none"),
     active_low_key("JOINT_n", "MAX_LIMIT_ACTIVE_LOW",
                    "gpio: the maximum limit switch reads low when tripped"),
+    position_key(
+        "SIM", "PROBE_SURFACE_Z", "",
+        "sim: the probe input trips where Z is at or below this (machine coordinates of the "
+        "simulated motors); unset: the simulated probe never trips"),
+    position_key("SIM", "PROBE_X_MIN", "", "sim: the probed block starts at this X; unset: no end"),
+    position_key("SIM", "PROBE_X_MAX", "", "sim: the probed block ends at this X; unset: no end"),
+    position_key("SIM", "PROBE_Y_MIN", "", "sim: the probed block starts at this Y; unset: no end"),
+    position_key("SIM", "PROBE_Y_MAX", "", "sim: the probed block ends at this Y; unset: no end"),
     real_key("JOINT_n", "SIM_LAG", "0", 0, 10, "s",
              "sim: the simulated motor follows its command through a first-order lag of this time "
              "constant (to try the following-error limits); 0 = it is exactly where commanded"),

@@ -53,6 +53,31 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   for (std::size_t k = 0; k < signal_count_; ++k)
     signals_[k].name = names[k];
 
+  // The probe model, for the driver that has the Z joint.
+  probe_model_ = false;
+  probe_joint_ = {-1, -1, -1};
+  if (ini.has("SIM", "PROBE_SURFACE_Z")) {
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      const char axis = machine.joints[static_cast<std::size_t>(joints[i])].axis;
+      const int k = axis == 'X' ? 0 : axis == 'Y' ? 1 : axis == 'Z' ? 2 : -1;
+      if (k >= 0 && probe_joint_[static_cast<std::size_t>(k)] < 0)
+        probe_joint_[static_cast<std::size_t>(k)] = static_cast<int>(i);
+    }
+    probe_model_ = probe_joint_[2] >= 0;
+    probe_top_ = ini.real("SIM", "PROBE_SURFACE_Z");
+    const auto bound = [&](const char* key, double& value) {
+      if (ini.has("SIM", key)) value = ini.real("SIM", key);
+    };
+    bound("PROBE_X_MIN", probe_x_min_);
+    bound("PROBE_X_MAX", probe_x_max_);
+    bound("PROBE_Y_MIN", probe_y_min_);
+    bound("PROBE_Y_MAX", probe_y_max_);
+    if (!ini.error().empty()) return ini.error();
+    if (probe_x_min_ > probe_x_max_ || probe_y_min_ > probe_y_max_) {
+      return "[SIM] PROBE_X_MIN/PROBE_Y_MIN must not exceed PROBE_X_MAX/PROBE_Y_MAX";
+    }
+  }
+
   const config::SpindleConfig& spindle = machine.spindle;
   spindle_ = spindle.present && spindle.driver == config::SpindleDriver::sim;
   if (spindle_ && spindle.acceleration < 0) {
@@ -94,6 +119,22 @@ void SimDriver::read(JointFeedback* feedback, int count) noexcept {
 
 void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
   if (estop_.load(std::memory_order_relaxed)) inputs.estop = true;
+  const int forced = probe_forced_.load(std::memory_order_relaxed);
+  if (forced >= 0) {
+    if (forced > 0) inputs.probe = true;
+    return;
+  }
+  if (!probe_model_) return;
+  const auto at = [&](int k, double otherwise) {
+    const int i = probe_joint_[static_cast<std::size_t>(k)];
+    return i >= 0 ? position_[static_cast<std::size_t>(i)] : otherwise;
+  };
+  const double x = at(0, 0);
+  const double y = at(1, 0);
+  const double z = at(2, 0);
+  const bool inside = z <= probe_top_ && x >= probe_x_min_ && x <= probe_x_max_ &&
+                      y >= probe_y_min_ && y <= probe_y_max_;
+  if (inside) inputs.probe = true;
 }
 
 void SimDriver::store(int index, double value) noexcept {

@@ -228,6 +228,7 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   seg.end = rests ? start : move.end;
   seg.line = move.line;
   seg.sync = move.sync;
+  seg.probe = move.kind == Move::Kind::feed ? move.probe : ProbeMode::none;
   for (int i = 0; i < kAxes; ++i) {
     if (!config_.axes[static_cast<std::size_t>(i)].present) seg.end[i] = start[i];
   }

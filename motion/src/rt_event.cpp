@@ -101,6 +101,15 @@ int format(const RtEvent& e, char* out, std::size_t size) {
                            e.text[0] ? ": " : "", e.text);
     case Code::no_spindle:
       return std::snprintf(out, size, "the machine has no spindle ([SPINDLE_0] DRIVER = none)");
+    case Code::probe_tripped_at_start:
+      return std::snprintf(out, size,
+                           "probe is already tripped when starting a G38.2 or G38.3 move");
+    case Code::probe_untripped_at_start:
+      return std::snprintf(out, size, "probe is not tripped when starting a G38.4 or G38.5 move");
+    case Code::probe_no_contact:
+      return std::snprintf(out, size, "G38.2 probe move finished without tripping the probe");
+    case Code::probe_contact_kept:
+      return std::snprintf(out, size, "G38.4 probe move finished without losing contact");
   }
   return std::snprintf(out, size, "servo event %d", static_cast<int>(e.code));
 }

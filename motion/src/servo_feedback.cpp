@@ -26,6 +26,7 @@ void ServoLoop::read_drivers() noexcept {
     joints_.feedback[k] = feedback_[k].position - joints_.motor_offset[k];
     joints_.home_switch[k] = feedback_[k].home_switch;
   }
+  probe_input_ = inputs.probe;
   io_.set_cycle(cycle_);
   io_.feedback(io);
   if (inputs.estop && status_.machine != MachineState::estop) {

@@ -145,6 +145,7 @@ void ServoLoop::stop_now(MachineState next) noexcept {
   }
   io_.stop_all();
   resume_pending_ = false;
+  disarm_probe();
   status_.machine = next;
   status_.motion = MotionState::idle;
   status_.velocity = 0;
@@ -187,6 +188,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       // The spindle, coolant and outputs stop at once, not when the path has come to rest.
       io_.stop_all();
       resume_pending_ = false;
+      disarm_probe();
       break;
     case Command::Kind::pause:
       path_.pause();
@@ -355,7 +357,9 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     } else if (jog_.active()) {
       advance_jog();
     } else {
+      watch_probe();
       advance_path();
+      follow_probe();
       advance_io();
     }
   } else {

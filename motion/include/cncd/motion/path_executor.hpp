@@ -58,6 +58,11 @@ class PathExecutor {
   CNCD_RT bool pending() const noexcept { return window_count_ > 0 || segments_.size() > 0; }
   // A segment is being executed: the path is not at rest between two periods.
   CNCD_RT bool active() const noexcept { return has_active_; }
+  // The probing mode of the segment being executed (none when none is).
+  CNCD_RT ProbeMode active_probe() const noexcept {
+    return has_active_ ? window_[static_cast<std::size_t>(head_seq_ % kWindow)].probe
+                       : ProbeMode::none;
+  }
   CNCD_RT std::uint32_t queued() const noexcept {
     return static_cast<std::uint32_t>(segments_.size() + static_cast<std::size_t>(window_count_));
   }

@@ -19,28 +19,32 @@ enum class EventLevel : std::uint8_t { info, warning, fault };
 struct RtEvent {
   enum class Code : std::uint8_t {
     none,
-    estop,                  // the estop command
-    estop_input,            // the estop input asserted
-    home_ignored_not_on,    // a home command while the machine is not on
-    home_ignored_moving,    // a home command while the machine moves
-    homing_aborted,         // homing stopped by an abort
-    homing_in_progress,     // a home command while homing
-    homing_failed,          // `joint`: `words`
-    homing_needs_switch,    // `joint` homes on a switch its driver (`text`) lacks
-    jog_ignored,            // `words`: why
-    feedback_not_a_number,  // `joint`'s feedback position
-    drive_fault,            // `joint`; `text`: the driver's words, if any
-    feedback_stale,         // `joint`; `text`: the driver's words, if any
-    min_limit_switch,       // `joint`'s minimum limit switch tripped
-    max_limit_switch,       // `joint`'s maximum limit switch tripped
-    following_error,        // `joint`: `error` over `limit`, against the commands `*_ago`
-    set_point_not_finite,   // `joint`
-    joints_apart,           // `joint` stands apart from its axis `axis`
-    off_path,               // a queued move starts away from the machine
-    spindle_not_at_speed,   // `error` rpm actual, `limit` commanded, `oldest_ago` ms waited
-    spindle_fault,          // `text`: the driver's words, if any
-    spindle_stale,          // `text`: the driver's words, if any
-    no_spindle,             // the program starts a spindle the machine does not have
+    estop,                     // the estop command
+    estop_input,               // the estop input asserted
+    home_ignored_not_on,       // a home command while the machine is not on
+    home_ignored_moving,       // a home command while the machine moves
+    homing_aborted,            // homing stopped by an abort
+    homing_in_progress,        // a home command while homing
+    homing_failed,             // `joint`: `words`
+    homing_needs_switch,       // `joint` homes on a switch its driver (`text`) lacks
+    jog_ignored,               // `words`: why
+    feedback_not_a_number,     // `joint`'s feedback position
+    drive_fault,               // `joint`; `text`: the driver's words, if any
+    feedback_stale,            // `joint`; `text`: the driver's words, if any
+    min_limit_switch,          // `joint`'s minimum limit switch tripped
+    max_limit_switch,          // `joint`'s maximum limit switch tripped
+    following_error,           // `joint`: `error` over `limit`, against the commands `*_ago`
+    set_point_not_finite,      // `joint`
+    joints_apart,              // `joint` stands apart from its axis `axis`
+    off_path,                  // a queued move starts away from the machine
+    spindle_not_at_speed,      // `error` rpm actual, `limit` commanded, `oldest_ago` ms waited
+    spindle_fault,             // `text`: the driver's words, if any
+    spindle_stale,             // `text`: the driver's words, if any
+    no_spindle,                // the program starts a spindle the machine does not have
+    probe_tripped_at_start,    // G38.2/G38.3 with the probe already in contact
+    probe_untripped_at_start,  // G38.4/G38.5 with the probe out of contact
+    probe_no_contact,          // G38.2 ended without contact
+    probe_contact_kept,        // G38.4 ended without losing contact
   };
   Code code = Code::none;
   EventLevel level = EventLevel::info;

@@ -54,6 +54,8 @@ struct Segment {
   IoAction action;
   // Outputs set as the segment starts (the first segment of a move, or the blend arc into it).
   SyncOutputs sync;
+  // A probing line: the servo loop stops it where the probe trips (ServoLoop::watch_probe).
+  ProbeMode probe = ProbeMode::none;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
   AxisPose start_direction{};

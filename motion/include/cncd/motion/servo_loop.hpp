@@ -119,6 +119,15 @@ class ServoLoop {
   // The path's actions and outputs (MachineIo) after the path's period: an error of theirs
   // stops the path, a pause may stop the spindle, a resume waits for it.
   CNCD_RT void advance_io() noexcept;
+  // G38.x (servo_probe.cpp): before the path advances, a probing move that trips (or loses
+  // contact) latches where the machine is and stops; after it, a probing move that has just
+  // started is armed (or refused when the probe is already as it should end), and one that has
+  // ended is reported.
+  CNCD_RT void watch_probe() noexcept;
+  CNCD_RT void follow_probe() noexcept;
+  CNCD_RT void probe_error(RtEvent::Code code) noexcept;
+  // An abort or a stop ends a probing move without an outcome.
+  CNCD_RT void disarm_probe() noexcept;
   // The first joint whose command stands apart from its axis's position, or -1.
   CNCD_RT int joint_apart() const noexcept;
   CNCD_RT void advance_homing() noexcept;
@@ -173,6 +182,10 @@ class ServoLoop {
   bool has_start_positions_ = false;
   drivers::Driver* spindle_driver_ = nullptr;  // the driver that reports the spindle
   bool resume_pending_ = false;                // a resume waits for the spindle (STOP_ON_PAUSE)
+  bool probe_input_ = false;                   // read this period
+  ProbeMode probe_mode_ = ProbeMode::none;     // of the armed probing move
+  bool probe_tripped_ = false;
+  AxisPose probe_position_{};
 };
 
 }  // namespace cncd::motion

@@ -74,6 +74,15 @@ struct WaitStatus {
   std::uint64_t since = 0;    // servo cycle the wait began in
 };
 
+// G38.x: the probe input and the last probing move's outcome.
+struct ProbeStatus {
+  bool contact = false;    // the probe input now (any driver's)
+  bool armed = false;      // a probing move is under way
+  std::uint64_t done = 0;  // probing moves ended (tripped, or not) since the start
+  bool tripped = false;    // the last one tripped (or lost contact, away)
+  AxisPose position{};     // where it tripped (machine coordinates), else where it ended
+};
+
 // What the servo thread publishes every period.
 struct ServoStatus {
   std::uint64_t sequence = 0;  // servo cycle count at publication
@@ -107,6 +116,7 @@ struct ServoStatus {
   // in time): the last one, and how many there have been since the start.
   RtEvent path_error;
   std::uint64_t path_errors = 0;
+  ProbeStatus probe;
   RtStats rt;
 };
 

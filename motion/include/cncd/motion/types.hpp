@@ -60,6 +60,10 @@ struct SyncOutputs {
 
 // One programmed move as the task layer hands it to the planner: machine coordinates, machine
 // units. Trivially copyable.
+// G38.2-G38.5: a feed line that ends where the probe trips (toward) or loses contact (away);
+// the "or_error" kinds make a move that ends without it an error.
+enum class ProbeMode : std::uint8_t { none, toward_or_error, toward, away_or_error, away };
+
 struct Move {
   // An action is a dwell of no time that does `action` (IoAction) where the path rests.
   enum class Kind : std::uint8_t { traverse, feed, arc, dwell, action };
@@ -83,10 +87,11 @@ struct Move {
   double tolerance = 0;  // units
   // G64 Q: consecutive feed lines of the same feed whose points all lie within this of one
   // straight line are run as that line; 0 = no merging.
-  double merge_tolerance = 0;  // units
-  std::int32_t line = 0;       // source line of the program, 0 = none
-  IoAction action;             // Kind::action
-  SyncOutputs sync;            // set as this move starts (traverse, feed, arc)
+  double merge_tolerance = 0;         // units
+  std::int32_t line = 0;              // source line of the program, 0 = none
+  IoAction action;                    // Kind::action
+  SyncOutputs sync;                   // set as this move starts (traverse, feed, arc)
+  ProbeMode probe = ProbeMode::none;  // a feed line that probes (exact stop at both ends)
 };
 
 }  // namespace cncd::motion
