@@ -207,6 +207,8 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   path_errors_base_ = status.path_errors;
   input_wait_pending_ = false;
   input_waits_seen_ = status.input_waits;
+  probe_pending_ = false;
+  probes_seen_ = status.probe.done;
   interp_done_ = false;
   moves_enqueued_ = 0;
   actions_enqueued_ = 0;
@@ -314,7 +316,7 @@ void Task::feed() {
     }
     // The move held back for look-ahead goes out when no more come for now, so that the
     // path ends at rest and the program's end, a stop or a step is seen.
-    if (interp_done_ || feeder_->stop_seen || input_wait_pending_ ||
+    if (interp_done_ || feeder_->stop_seen || input_wait_pending_ || probe_pending_ ||
         (stepping_ && step_budget_ == 0)) {
       motion_.flush();
       return;
@@ -331,6 +333,17 @@ void Task::feed() {
     if (feeder_->input_wait_seen) {
       feeder_->input_wait_seen = false;
       input_wait_pending_ = skip_to_line_ == 0;  // a skipped line's wait is dropped with it
+    }
+    if (feeder_->probe_seen) {
+      feeder_->probe_seen = false;
+      probe_pending_ = skip_to_line_ == 0;
+    }
+    if (feeder_->unsupported) {
+      motion_.abort();
+      finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
+                                  std::to_string(feeder_->unsupported->line) + ": " +
+                                  feeder_->unsupported->why);
+      return;
     }
     if (step == interp::Interpreter::Step::end) interp_done_ = true;
   }
@@ -378,6 +391,20 @@ void Task::poll() {
     input_waits_seen_ = status.input_waits;
     interp_->set_input_result(status.input_result);
     input_wait_pending_ = false;
+  }
+  if (probe_pending_ && status.probe.done > probes_seen_ && status.queued == 0 &&
+      status.motion == motion::MotionState::idle) {
+    // The probing move is over: where it tripped goes to #5061-#5070, and the interpreter
+    // reads on from where the machine stopped.
+    probes_seen_ = status.probe.done;
+    interp::Pose trip{};
+    std::copy(status.probe.position.begin(), status.probe.position.end(), trip.begin());
+    interp_->set_probe_result(trip, status.probe.tripped);
+    interp::Pose at{};
+    std::copy(status.commanded.begin(), status.commanded.end(), at.begin());
+    interp_->set_machine_position(at);
+    feeder_->set_position(status.commanded);
+    probe_pending_ = false;
   }
   // Run from line: the remaining time counts from when the traverse to the line has ended.
   if (skip_moved_ && !approach_done_s_ && status.moves_done > moves_done_base_)

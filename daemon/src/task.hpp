@@ -201,6 +201,10 @@ class Task {
   // its answer (motion's count of ended input waits passes input_waits_seen_).
   bool input_wait_pending_ = false;
   std::uint64_t input_waits_seen_ = 0;
+  // G38.x read: likewise until the probing move is over (motion's count of ended probing moves
+  // passes probes_seen_) and #5061-#5070 hold where it tripped.
+  bool probe_pending_ = false;
+  std::uint64_t probes_seen_ = 0;
   UserMProcess user_m_;            // the user M code running, if any
   std::uint32_t user_m_hold_ = 0;  // the hold it answers
   bool stepping_ = false;          // program.step: one line, then pause

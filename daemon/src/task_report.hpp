@@ -86,6 +86,16 @@ struct WaitReport {
   double since_s = 0;  // how long it has waited
 };
 
+// G38.x: the probe input and the last probing move's outcome.
+struct ProbeReport {
+  bool contact = false;  // the probe input now
+  bool probing = false;  // a probing move is under way
+  // The last probing move of this daemon: whether it tripped (lost contact, away) and where
+  // (machine coordinates; where it ended when it did not trip). Unset before the first.
+  std::optional<bool> last_tripped;
+  motion::AxisPose last_position{};
+};
+
 struct ToolReport {
   int number = 0;     // in the spindle, 0 = none
   int prepared = -1;  // -1 = none
@@ -124,6 +134,7 @@ struct TaskStatus {
   bool flood = false;
   IoReport io;
   WaitReport wait;
+  ProbeReport probe;
   ToolReport tool;
   ActiveOffsets offsets;
   std::vector<std::string> gcodes;  // active, in modal-group order: "G1", "G17" ...

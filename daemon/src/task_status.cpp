@@ -195,6 +195,12 @@ TaskStatus Task::status() const {
   program.error = last_error_;
 
   const motion::SpindleStatus& sp = s.spindle;
+  out.probe.contact = s.probe.contact;
+  out.probe.probing = s.probe.armed;
+  if (s.probe.done > 0) {
+    out.probe.last_tripped = s.probe.tripped;
+    out.probe.last_position = s.probe.position;
+  }
   out.spindle.direction = sp.direction;
   out.spindle.programmed_speed = sp.programmed_rpm;
   out.spindle.override_ratio = sp.override_ratio;

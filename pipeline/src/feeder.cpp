@@ -11,6 +11,8 @@ void ProgramFeeder::start_program(const motion::AxisPose* at) {
   pending.clear();
   stop_seen = false;
   input_wait_seen = false;
+  probe_seen = false;
+  unsupported.reset();
   holds.clear();
   sync_ = {};
   need_at_speed_ = false;
@@ -175,6 +177,39 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             moving(move);
             return true;
           },
+          [&](const in::StraightProbe& c) {
+            // The path comes to rest before a probing move, which runs alone.
+            add_stop_point();
+            move.kind = motion::Move::Kind::feed;
+            std::copy(c.end.begin(), c.end.end(), move.end.begin());
+            move.feed = tracker_.feed_per_minute() / 60.0;
+            switch (c.kind) {
+              case in::ProbeKind::toward_or_error:
+                move.probe = motion::ProbeMode::toward_or_error;
+                break;
+              case in::ProbeKind::toward:
+                move.probe = motion::ProbeMode::toward;
+                break;
+              case in::ProbeKind::away_or_error:
+                move.probe = motion::ProbeMode::away_or_error;
+                break;
+              case in::ProbeKind::away:
+                move.probe = motion::ProbeMode::away;
+                break;
+            }
+            moving(move);
+            probe_seen = true;
+            return true;
+          },
+          [&](const in::StartSpeedFeedSynch&) {
+            if (!unsupported) {
+              unsupported =
+                  Unsupported{m.line,
+                              "spindle-synchronized motion (G33, G33.1, rigid tapping) is not "
+                              "available: cncd cannot move an axis in step with the spindle yet"};
+            }
+            return false;
+          },
           [&](const in::Dwell& c) {
             move.kind = motion::Move::Kind::dwell;
             move.dwell_s = c.seconds;
@@ -280,7 +315,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       },
       m.op);
   if (!queued) return;
-  move.path_mode = path_mode_;
+  // A probing move stops where the probe trips: nothing may blend into or out of it.
+  move.path_mode =
+      move.probe != motion::ProbeMode::none ? motion::Move::PathMode::exact_stop : path_mode_;
   move.tolerance = tolerance_;
   move.merge_tolerance = path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
   pending.push_back(move);

@@ -78,6 +78,9 @@ class CheckSink final : public interp::CanonSink {
                },
                command.op);
     feeder_.emit(command);
+    if (feeder_.unsupported && !refusal) {
+      refusal = interp::InterpError{file_, feeder_.unsupported->line, 0, feeder_.unsupported->why};
+    }
     while (!feeder_.pending.empty()) {
       const motion::Move move = feeder_.pending.front();
       feeder_.pending.pop_front();

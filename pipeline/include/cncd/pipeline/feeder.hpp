@@ -9,6 +9,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "cncd/config/machine_config.hpp"
@@ -69,6 +70,9 @@ class ProgramFeeder final : public interp::CanonSink {
   // Hands the pending moves to `target` in order, flushing it at stop points, until none is
   // left, the target has no room, or it refuses one (which stays pending).
   Drained drain(MoveTarget& target);
+  // Where the machine stands after a move that ended early (a probing move that tripped): the
+  // next move starts there (machine coordinates).
+  void set_position(const motion::AxisPose& at) { end_ = at; }
   // Offsets, units and feed as the commands so far left them.
   const interp::MachineTracker& tracker() const { return tracker_; }
 
@@ -77,6 +81,17 @@ class ProgramFeeder final : public interp::CanonSink {
   // M66 reached in the stream: the interpreter must not read on until the machine has waited
   // and its result is in #5399 (Interpreter::set_input_result()). The caller clears it.
   bool input_wait_seen = false;
+  // A probing move (G38.x) reached in the stream: likewise, the interpreter must not read on
+  // until the machine has probed and Interpreter::set_probe_result() has the answer. The
+  // caller clears it.
+  bool probe_seen = false;
+  // Something in the stream this machine cannot run (spindle-synchronized motion): its line and
+  // why. The caller stops the program there.
+  struct Unsupported {
+    int line = 0;
+    std::string why;
+  };
+  std::optional<Unsupported> unsupported;
   // The holds queued, by id; the caller erases those it has answered.
   std::map<std::uint32_t, HoldInfo> holds;
   int spindle_direction = 0;  // 1 cw, -1 ccw, 0 stopped
