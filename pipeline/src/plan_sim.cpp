@@ -149,6 +149,11 @@ class Simulation final : MoveTarget {
                               : CheckProblem{program_, interp_.current_line(), "interpreter error"};
         return false;
       }
+      if (feeder_.unsupported) {
+        result_.error =
+            CheckProblem{program_, feeder_.unsupported->line, feeder_.unsupported->why};
+        return false;
+      }
       // M0/M1/M60 wait for the operator: the estimate leaves that time out, but the machine
       // comes to rest there.
       if (feeder_.stop_seen) {
@@ -171,6 +176,9 @@ class Simulation final : MoveTarget {
     if (move.kind == motion::Move::Kind::action &&
         (move.action.kind == Action::hold || move.action.kind == Action::wait_input))
       move.action.kind = Action::none;
+    // Nothing is touched here: a probing move runs its whole length (the longest it can take),
+    // and the program reads on from its end.
+    move.probe = motion::ProbeMode::none;
     bound(move);
     std::string error;
     const double cpu_start = thread_cpu_s();
