@@ -162,7 +162,10 @@ void GpioDriver::run_io(double dt, std::int64_t time_ns) noexcept {
 
 void GpioDriver::read_inputs(MachineInputs& inputs) noexcept {
   if (input(estop_input_)) inputs.estop = true;
-  if (input(probe_input_)) inputs.probe = true;
+  if (probe_input_ >= 0 && (probe_touched_.exchange(false, std::memory_order_relaxed) ||
+                            probe_level_.load(std::memory_order_relaxed))) {
+    inputs.probe = true;
+  }
 }
 
 std::int64_t GpioDriver::step_count(int index) const noexcept {
@@ -189,6 +192,13 @@ GpioDriver::BaseStats GpioDriver::base_stats() const noexcept {
 void GpioDriver::sample_inputs() noexcept {
   if (input_count_ == 0) return;
   backend_->read_inputs(input_levels_.data());
+  if (probe_input_ >= 0) {
+    const Input& probe = inputs_[static_cast<std::size_t>(probe_input_)];
+    const bool touching =
+        (input_levels_[static_cast<std::size_t>(probe.backend_index)] != 0) != probe.active_low;
+    probe_level_.store(touching, std::memory_order_relaxed);
+    if (touching) probe_touched_.store(true, std::memory_order_relaxed);
+  }
   for (std::size_t i = 0; i < input_count_; ++i) {
     Input& in = inputs_[i];
     const bool asserted = (input_levels_[i] != 0) != in.active_low;

@@ -91,13 +91,29 @@ TEST_F(GpioInputs, ActiveHighSwitchesAfterDebounce) {
 
 TEST_F(GpioInputs, BouncesShorterThanTheDebounceTimeAreIgnored) {
   for (int i = 0; i < 20; ++i) {
-    vcd_->set_input_level(41, i % 2 == 0);
+    vcd_->set_input_level(12, i % 2 == 0);  // joint 1 home
     periods(2);
-    EXPECT_FALSE(inputs().probe);
+    EXPECT_FALSE(feedback(1).home_switch);
   }
-  vcd_->set_input_level(41, true);
+  vcd_->set_input_level(12, true);
   periods(5);
+  EXPECT_TRUE(feedback(1).home_switch);
+}
+
+// The probe is not debounced: its first edge counts, and a touch shorter than a servo period
+// is held until the servo thread has read it once.
+TEST_F(GpioInputs, TheProbeLatchesItsFirstEdge) {
+  EXPECT_FALSE(inputs().probe);
+  vcd_->set_input_level(41, true);
+  periods(1);
+  vcd_->set_input_level(41, false);
+  periods(20);
+  EXPECT_TRUE(inputs().probe) << "a one-period touch is seen by the next read";
+  EXPECT_FALSE(inputs().probe) << "and only by that one";
+  vcd_->set_input_level(41, true);
+  periods(1);
   EXPECT_TRUE(inputs().probe);
+  EXPECT_TRUE(inputs().probe) << "held contact reads as contact";
 }
 
 TEST_F(GpioInputs, ActiveLowInputsAssertWhenTheLoopOpens) {

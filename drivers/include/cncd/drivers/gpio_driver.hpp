@@ -129,6 +129,10 @@ class GpioDriver final : public Driver {
   std::size_t input_count_ = 0;
   int estop_input_ = -1;
   int probe_input_ = -1;
+  // The probe, undebounced: its level now, and whether it was asserted in any base period since
+  // the servo thread last read it (a touch shorter than a servo period is not lost).
+  std::atomic<bool> probe_level_{false};
+  std::atomic<bool> probe_touched_{false};
   std::vector<std::uint8_t> output_levels_;
   std::vector<std::uint8_t> input_levels_;
   std::uint32_t capabilities_ = 0;
