@@ -176,6 +176,9 @@ constexpr std::array kKeys{
                "Analog output n (0-15) that M67/M68 write: holding register or sim"),
     signal_key("CNCD", "DIGITAL_INPUT_n",
                "Digital input n (0-31) that M66 P waits for or reads: gpio, di, coil or sim"),
+    signal_key("CNCD", "PROBE_INPUT",
+               "Probe input G38.2-G38.5 stop on: gpio:LINE (read without debounce in the base "
+               "thread) or sim:NAME; Modbus answers too late to stop on contact"),
     signal_key("CNCD", "ANALOG_INPUT_n",
                "Analog input n (0-15) that M66 E reads: input or holding register, or sim"),
     positive_key("CNCD", "USER_M_TIMEOUT", "60", "s",

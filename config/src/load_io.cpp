@@ -223,6 +223,7 @@ void load_io(TypedReader& r, MachineConfig& c) {
   load_numbered(r, "ANALOG_OUTPUT_", io.analog_outputs);
   load_numbered(r, "DIGITAL_INPUT_", io.digital_inputs);
   load_numbered(r, "ANALOG_INPUT_", io.analog_inputs);
+  io.probe_input = r.signal("CNCD", "PROBE_INPUT");
   if (const auto v = r.real("CNCD", "USER_M_TIMEOUT")) io.user_m_timeout_s = *v;
   load_user_m_path(r, c);
   load_tool_change(r, c.tool_change);

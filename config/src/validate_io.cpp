@@ -68,6 +68,7 @@ std::vector<Signal> program_signals(const IoConfig& io) {
     add("DIGITAL_INPUT_" + std::to_string(n), io.digital_inputs[n], SignalUse::digital_input);
   for (std::size_t n = 0; n < io.analog_inputs.size(); ++n)
     add("ANALOG_INPUT_" + std::to_string(n), io.analog_inputs[n], SignalUse::analog_input);
+  add("PROBE_INPUT", io.probe_input, SignalUse::digital_input);
   return out;
 }
 
@@ -273,8 +274,24 @@ void check_tool_change(TypedReader& r, const MachineConfig& c) {
 
 }  // namespace
 
+// The probe must stop the machine in the servo period of contact: a Modbus input arrives an
+// update period or more late, a gpio line is read in the base thread.
+void check_probe(TypedReader& r, const MachineConfig& c) {
+  const SignalAddress& a = c.io.probe_input;
+  if (a.kind == SignalAddress::Kind::modbus) {
+    r.problem("CNCD", "PROBE_INPUT",
+              "'" + a.text +
+                  "': a Modbus input answers an update period (UPDATE_PERIOD_MS) or more late, "
+                  "too late to stop a probe on contact: wire the probe to a gpio line");
+  }
+  if (a.given() && r.given("GPIO", "PROBE_LINE")) {
+    r.problem("CNCD", "PROBE_INPUT", "give the probe once: [GPIO] PROBE_LINE is given too");
+  }
+}
+
 void validate_io(TypedReader& r, const MachineConfig& c) {
   const SpindleConfig& s = c.spindle;
+  check_probe(r, c);
   check_speeds(r, s);
   if (s.driver == SpindleDriver::gpio) check_gpio_spindle(r, c);
   if (s.driver == SpindleDriver::modbus) check_modbus_spindle(r, s);

@@ -230,6 +230,18 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
   }
   estop_input_ = add_input("GPIO", "ESTOP_LINE", "ESTOP_ACTIVE_LOW");
   probe_input_ = add_input("GPIO", "PROBE_LINE", "PROBE_ACTIVE_LOW");
+  const config::SignalAddress& probe = machine.io.probe_input;
+  if (probe_input_ < 0 && probe.kind == config::SignalAddress::Kind::gpio) {
+    std::string why;
+    const int offset = backend_->find_line(probe.line, why);
+    if (offset < 0) return where(probe) + why;
+    if (!used.insert(offset).second) {
+      return where(probe) + "line " + probe.line + " is already used by another signal";
+    }
+    input_lines.push_back(offset);
+    input_specs.emplace_back(probe.active_low, offset);
+    probe_input_ = static_cast<int>(input_lines.size()) - 1;
+  }
   if (estop_input_ >= 0) capabilities_ |= kCapEstopInput;
   if (!ini.error().empty()) return ini.error();
   if (auto problem = configure_io(machine, outputs, input_lines, input_specs, used);

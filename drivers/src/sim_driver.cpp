@@ -48,6 +48,7 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
     digital_in_[n] = slot(io.digital_inputs[n]);
   for (std::size_t n = 0; n < analog_in_.size(); ++n)
     analog_in_[n] = slot(io.analog_inputs[n]);
+  probe_signal_ = slot(io.probe_input);
   signal_count_ = names.size();
   signals_ = std::make_unique<Signal[]>(std::max<std::size_t>(1, signal_count_));
   for (std::size_t k = 0; k < signal_count_; ++k)
@@ -124,6 +125,7 @@ void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
     if (forced > 0) inputs.probe = true;
     return;
   }
+  if (probe_signal_ >= 0 && load(probe_signal_) != 0) inputs.probe = true;
   if (!probe_model_) return;
   const auto at = [&](int k, double otherwise) {
     const int i = probe_joint_[static_cast<std::size_t>(k)];

@@ -277,6 +277,23 @@ TEST_F(IoConfigTest, BadSpindleValuesAreRefusedAtTheirLines) {
                          "hr"}));
 }
 
+TEST_F(IoConfigTest, TheProbeInputIsGpioOrSimAndGivenOnce) {
+  EXPECT_EQ(loaded(minimal_ini() + "[CNCD]\nPROBE_INPUT = sim:probe\n").io.probe_input.name,
+            "probe");
+  EXPECT_EQ(problems_of(minimal_ini() + "[MODBUS_0]\nHOST = x\n[CNCD]\n"
+                                        "PROBE_INPUT = modbus:0:1:di:4\n"),
+            (std::vector<std::string>{
+                at(kFirst + 2) +
+                ": [CNCD] PROBE_INPUT: 'modbus:0:1:di:4': a Modbus input answers an update period "
+                "(UPDATE_PERIOD_MS) or more late, too late to stop a probe on contact: wire the "
+                "probe to a gpio line"}));
+  EXPECT_EQ(problems_of(gpio_ini(chip() + "PROBE_LINE = 5\n[CNCD]\nPROBE_INPUT = gpio:6\n")),
+            (std::vector<std::string>{
+                at(kFirst + 4) +
+                ": [CNCD] PROBE_INPUT: give the probe once: [GPIO] PROBE_LINE is given too"}));
+  EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nPROBE_INPUT = modbus:0:1:coil\n").size(), 1U);
+}
+
 TEST_F(IoConfigTest, MinimumAboveMaximumIsRefused) {
   EXPECT_EQ(problems_of(minimal_ini() + "[SPINDLE_0]\nMAX_FORWARD_VELOCITY = 1000\n"
                                         "MIN_FORWARD_VELOCITY = 2000\n"),

@@ -155,6 +155,19 @@ TEST(SimSignals, OutputsAreReadAndInputsSetByName) {
   EXPECT_FALSE(sim.signal_on("clamp"));
 }
 
+TEST(SimSignals, TheProbeInputIsASignal) {
+  auto config = machine(0);
+  config.io.probe_input = sim("probe");
+  SimDriver sim;
+  ASSERT_EQ(sim.configure(config, {}), "");
+  drivers::MachineInputs in;
+  sim.read_inputs(in);
+  EXPECT_FALSE(in.probe);
+  EXPECT_TRUE(sim.set_signal("probe", true));
+  sim.read_inputs(in);
+  EXPECT_TRUE(in.probe);
+}
+
 TEST(SimSignals, AnOutputAndAnInputOfOneNameAreWiredTogether) {
   auto config = machine(0);
   config.io.digital_outputs[0] = sim("loop");

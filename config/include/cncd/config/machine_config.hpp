@@ -186,6 +186,9 @@ struct IoConfig {
   std::array<SignalAddress, kMaxAnalogIo> analog_outputs;    // ANALOG_OUTPUT_n
   std::array<SignalAddress, kMaxDigitalIo> digital_inputs;   // DIGITAL_INPUT_n
   std::array<SignalAddress, kMaxAnalogIo> analog_inputs;     // ANALOG_INPUT_n
+  // PROBE_INPUT: the probe G38.x stops on (gpio or sim; [GPIO] PROBE_LINE is the same as a
+  // gpio address here).
+  SignalAddress probe_input;
   // User M codes M100-M199: executables looked for in these directories, in order: the first
   // program directory ([DISPLAY] PROGRAM_PREFIX, which LinuxCNC searches first), then
   // [RS274NGC] USER_M_PATH; absolute. Run for at most user_m_timeout_s.

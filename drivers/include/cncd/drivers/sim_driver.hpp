@@ -104,6 +104,7 @@ class SimDriver final : public Driver {
   double probe_top_ = 0;
   double probe_x_min_ = -1e300, probe_x_max_ = 1e300, probe_y_min_ = -1e300, probe_y_max_ = 1e300;
   std::atomic<int> probe_forced_{-1};
+  int probe_signal_ = -1;  // [CNCD] PROBE_INPUT = sim:NAME
   std::array<std::atomic<bool>, kMaxJoints> fault_{};
   std::array<std::atomic<bool>, kMaxJoints> stale_{};
   std::array<std::atomic<bool>, kMaxJoints> min_limit_{};
