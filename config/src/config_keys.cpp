@@ -109,6 +109,12 @@ constexpr std::array kKeys{
                   "Colon-separated directories searched for user M-code programs (M100-M199), "
                   "relative to this INI's directory, after the first program directory "
                   "([DISPLAY] PROGRAM_PREFIX)"),
+    choice_key("RS274NGC", "DIALECT", "linuxcnc", "linuxcnc|numeryx",
+               "How programs are read: linuxcnc (LinuxCNC's RS274NGC) or numeryx (the Numeryx "
+               "drilling dialect); a program's first line \"(dialect NAME)\" overrides it"),
+    positive_key("RS274NGC", "NUMERYX_CLEARANCE", "", "units",
+                 "Numeryx dialect: the height above R a cycle starts its feed at (R1 = R + "
+                 "clearance); unset: 1 mm in a G21 program, 0.04 in in a G20 one"),
     path_key("EMCIO", "TOOL_TABLE", "", "Tool table file"),
     text_key("EMCIO", "TOOL_CHANGE_POSITION", "",
              "Machine position M6 moves to before the tool change: 3 (X Y Z), 6 (X Y Z A B C) "

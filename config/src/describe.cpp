@@ -183,6 +183,12 @@ std::string describe(const MachineConfig& c) {
   line(out, "Tool table:   " + state_file(c.tool_table, c.tool_table_seed));
   line(out, "Positions:    " + state_file(c.position_file, c.position_file_seed));
   if (!c.startup_code.empty()) line(out, "Startup code: " + c.startup_code);
+  line(out, std::string("Dialect:      ") +
+                (c.dialect == Dialect::numeryx ? "numeryx" : "linuxcnc") +
+                " (a program's first line \"(dialect NAME)\" may name the other)");
+  line(out, "Numeryx clearance: " +
+                (c.numeryx_clearance ? num(*c.numeryx_clearance) + " " + lu
+                                     : std::string("1 mm in G21 programs, 0.04 in in G20 ones")));
   for (const auto& dir : c.subroutine_path)
     line(out, "Subroutines:  " + dir.string());
   for (const auto& dir : c.program_dirs)

@@ -218,6 +218,10 @@ void load_general(TypedReader& r, MachineConfig& c) {
 
   c.startup_code = r.text("RS274NGC", "RS274NGC_STARTUP_CODE").value_or("");
   c.subroutine_path = r.path_list("RS274NGC", "SUBROUTINE_PATH");
+  if (const auto v = r.choice("RS274NGC", "DIALECT")) {
+    c.dialect = *v == "numeryx" ? Dialect::numeryx : Dialect::linuxcnc;
+  }
+  c.numeryx_clearance = r.real("RS274NGC", "NUMERYX_CLEARANCE");
 
   load_coordinates(r, c);
   load_linear_units(r, c);

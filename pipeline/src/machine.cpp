@@ -23,6 +23,9 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   options.tool_change_quill_up = config.tool_change.quill_up;
   options.tool_change_with_spindle_on = config.tool_change.with_spindle_on;
   options.startup_code = config.startup_code;
+  options.dialect = config.dialect == config::Dialect::numeryx ? interp::Dialect::numeryx
+                                                               : interp::Dialect::linuxcnc;
+  options.numeryx_clearance = config.numeryx_clearance;
   return options;
 }
 

@@ -27,6 +27,9 @@ int axis_index(char letter);
 enum class LinearUnits { mm, inch };
 enum class AngularUnits { degree, radian, grad };
 enum class JointType { linear, angular };
+// How programs are read ([RS274NGC] DIALECT): LinuxCNC's RS274NGC or the Numeryx drilling
+// dialect (the interpreter's Dialect; config depends on no other part of cncd).
+enum class Dialect { linuxcnc, numeryx };
 
 // Where a value came from, for messages in the form FILE:LINE.
 struct SourceRef {
@@ -226,6 +229,12 @@ struct MachineConfig {
   std::filesystem::path parameter_file_seed;
   std::string startup_code;
   std::vector<std::filesystem::path> subroutine_path;
+  // DIALECT: how programs are read unless their first line names another dialect; MDI is
+  // always read in it.
+  Dialect dialect = Dialect::linuxcnc;
+  // NUMERYX_CLEARANCE, machine units (R1 = R + clearance in Numeryx cycles); unset: the
+  // interpreter's default (1 mm in a G21 program, 0.04 in in a G20 one).
+  std::optional<double> numeryx_clearance;
   // [EMCIO]
   std::filesystem::path tool_table;
   std::filesystem::path tool_table_seed;

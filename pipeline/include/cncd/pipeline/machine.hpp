@@ -15,7 +15,7 @@ namespace cncd::pipeline {
 interp::Units machine_units(const config::MachineConfig& config);
 
 // The interpreter options a machine's INI gives: units, tool table, parameter file, subroutine
-// path, start-up code.
+// path, start-up code, dialect and Numeryx clearance.
 interp::InterpOptions interpreter_options(const config::MachineConfig& config);
 
 // The (first, second, normal) axis indices of an arc's plane, as LinuxCNC's ARC_FEED orders
