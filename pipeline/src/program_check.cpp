@@ -58,6 +58,9 @@ class CheckSink final : public interp::CanonSink {
   // What stops the program besides the interpreter: a spindle the machine lacks.
   std::optional<interp::InterpError> refusal;
 
+  // With CheckOptions::find_holes, the holes so far.
+  const std::vector<Hole>& holes() const { return holes_.holes(); }
+
   void start_at(const Pose& machine) {
     position_ = machine;
     motion::AxisPose at{};
@@ -111,6 +114,10 @@ class CheckSink final : public interp::CanonSink {
   void line(const motion::Move& move) {
     ensure_start();
     const bool feed = move.kind == motion::Move::Kind::feed;
+    // A probing move feeds toward the work without cutting: no hole.
+    if (options_.find_holes)
+      holes_.straight(position_, move.end, feed && move.probe == motion::ProbeMode::none,
+                      move.line);
     ++(feed ? report_.feeds : report_.traverses);
     if (feed) report_.feed_length += xyz_distance(position_, move.end);
     reach(move.end, move.line, feed ? "feed move" : "rapid move");
@@ -192,6 +199,7 @@ class CheckSink final : public interp::CanonSink {
   void arc(const motion::Move& move) {
     ensure_start();
     ++report_.arcs;
+    holes_.other_motion();
     std::string error;
     const auto segment = planner_.plan(move, position_, false, error);
     if (!segment) {
@@ -245,6 +253,7 @@ class CheckSink final : public interp::CanonSink {
   bool started_ = false;
   std::array<bool, kAxes> left_start_{};
   std::vector<Reported> reported_;
+  HoleFinder holes_;
 };
 
 }  // namespace
@@ -303,6 +312,7 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     }
     if (step == interp::Interpreter::Step::end) break;
   }
+  report.holes = sink.holes();
   return report;
 }
 
@@ -335,6 +345,23 @@ std::string describe(const CheckReport& report) {
   } else {
     text += "soft limits: " + std::to_string(report.limit_violations) + " violation" +
             (report.limit_violations == 1 ? "" : "s") + "\n";
+  }
+  return text;
+}
+
+std::string describe_holes(const CheckReport& report) {
+  std::string text = "holes: " + std::to_string(report.holes.size()) + " (machine coordinates, " +
+                     (report.inch_machine ? "in" : "mm") + ")\n";
+  char row[160];
+  std::snprintf(row, sizeof row, "%5s %7s %12s %12s %12s %12s\n", "hole", "line", "X", "Y", "top",
+                "bottom");
+  text += row;
+  for (std::size_t n = 0; n < report.holes.size(); ++n) {
+    const Hole& h = report.holes[n];
+    std::snprintf(row, sizeof row, "%5zu %7d %12s %12s %12s %12s\n", n + 1, h.line,
+                  number(h.x).c_str(), number(h.y).c_str(), number(h.top).c_str(),
+                  number(h.bottom).c_str());
+    text += row;
   }
   return text;
 }

@@ -1,11 +1,11 @@
 // cncd-check: runs a G-code program through the interpreter without a machine. By default it
 // checks the program against the machine in the INI (interpreter errors, every move within the
 // axis soft limits) and prints a summary; --canon prints the canonical commands the way
-// LinuxCNC's rs274 does instead; --plan runs the program through the planner and the servo
-// loop in virtual time and prints the cycle time and what the motion would be like (plan_sim).
-// Problems go to stderr as FILE:LINE: message.
+// LinuxCNC's rs274 does instead, --holes the holes the program drills; --plan runs the program
+// through the planner and the servo loop in virtual time and prints the cycle time and what
+// the motion would be like (plan_sim). Problems go to stderr as FILE:LINE: message.
 //
-//   cncd-check [--ini FILE] [--canon] [--inch] [--tool-units mm|inch] [-t TOOL.tbl]
+//   cncd-check [--ini FILE] [--canon | --holes] [--inch] [--tool-units mm|inch] [-t TOOL.tbl]
 //              [-v PARAMS.var] [--max-seconds S] PROGRAM
 //   cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM
 //
@@ -38,7 +38,7 @@ constexpr int kExitUsage = 2;
 int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "cncd-check: " << why << '\n';
   std::cerr
-      << "usage: cncd-check [--ini FILE [--state-dir DIR]] [--canon] [--inch]\n"
+      << "usage: cncd-check [--ini FILE [--state-dir DIR]] [--canon | --holes] [--inch]\n"
          "                  [--tool-units mm|inch]\n"
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
@@ -48,6 +48,9 @@ int usage(const std::string& why) {
          "               (default as for cncd: [CNCD] STATE_DIR, $STATE_DIRECTORY,\n"
          "               $XDG_STATE_HOME/cncd/<INI name>); read only, never written\n"
          "  --canon      print the canonical commands as LinuxCNC's rs274 does\n"
+         "  --holes      print the holes the program drills instead of the summary: number,\n"
+         "               line, X, Y, top and bottom (machine coordinates and units)\n"
+
          "  --inch       machine units are inches (without --ini)\n"
          "  --tool-units units the tool table is written in (default: the machine's)\n"
          "  -t, -v       tool table and parameter file (without --ini, or to override it)\n"
@@ -146,6 +149,7 @@ int main(int argc, char** argv) {
   interp::InterpOptions overrides;
   bool inch = false;
   bool canon = false;
+  bool holes = false;
   bool plan = false;
   bool json = false;
   std::string trajectory;
@@ -158,6 +162,8 @@ int main(int argc, char** argv) {
     const bool has_value = i + 1 < argc;
     if (arg == "--canon") {
       canon = true;
+    } else if (arg == "--holes") {
+      holes = true;
     } else if (arg == "--plan") {
       plan = true;
     } else if (arg == "--json") {
@@ -174,6 +180,7 @@ int main(int argc, char** argv) {
         load_options.state_dir = value;
       } else if (arg == "--trajectory") {
         trajectory = value;
+
       } else if (arg == "--max-seconds") {
         char* end = nullptr;
         max_seconds = std::strtod(value.c_str(), &end);
@@ -198,6 +205,7 @@ int main(int argc, char** argv) {
   if (plan && ini.empty()) return usage("--plan needs --ini: the machine's limits");
   if (ini.empty() && !load_options.state_dir.empty()) return usage("--state-dir goes with --ini");
   if (plan && canon) return usage("--plan and --canon exclude each other");
+  if (holes && (plan || canon)) return usage("--holes goes without --plan and --canon");
   if (!plan && (json || !trajectory.empty()))
     return usage("--json and --trajectory go with --plan");
 
@@ -251,9 +259,16 @@ int main(int argc, char** argv) {
   }
   interp::Rs274Printer printer(std::cout);
   if (canon) options.trace = &printer;
+  options.find_holes = holes;
   const pipeline::CheckReport report = pipeline::check_program(program, options);
   // A program that could not even be opened has nothing to summarise.
-  if (!canon && (report.blocks > 0 || !report.error)) std::cout << pipeline::describe(report);
+  if (!canon && (report.blocks > 0 || !report.error)) {
+    if (holes) {
+      std::cout << pipeline::describe_holes(report);
+    } else {
+      std::cout << pipeline::describe(report);
+    }
+  }
   std::cout.flush();
   for (const auto& problem : report.problems)
     std::cerr << problem.to_string() << '\n';

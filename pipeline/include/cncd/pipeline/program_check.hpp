@@ -15,6 +15,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "cncd/pipeline/holes.hpp"
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
@@ -47,6 +48,8 @@ struct CheckOptions {
   const std::atomic<bool>* cancel = nullptr;
   // Also receives every canonical command as the interpreter emits it (cncd-check --canon).
   interp::CanonSink* trace = nullptr;
+  // Collect the holes the program drills in CheckReport::holes (cncd-check --holes).
+  bool find_holes = false;
 };
 
 struct CheckReport {
@@ -64,6 +67,8 @@ struct CheckReport {
   std::set<int> tools;        // tools put in the spindle (M6, M61)
   double feed_length = 0;     // length of the feed moves (XYZ, machine units)
   bool inch_machine = false;  // machine units are inches (else mm)
+  // With CheckOptions::find_holes, in the order they are drilled.
+  std::vector<Hole> holes;
   // The interpreter's error, when it stopped the program.
   std::optional<interp::InterpError> error;
   // Set when the check stopped before the end of the program (CheckOptions::max_seconds).
@@ -81,5 +86,9 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
 
 // The human summary cncd-check prints: moves by kind, extents per axis, tools, feed length.
 std::string describe(const CheckReport& report);
+
+// The holes of a report one per line under a header naming the coordinates and units:
+// number, program line, X, Y, top, bottom.
+std::string describe_holes(const CheckReport& report);
 
 }  // namespace cncd::pipeline
