@@ -272,6 +272,7 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     report.error = std::move(error);
     return report;
   }
+  report.dialect = interp.dialect();
   if (options.start_machine) {
     interp.set_machine_position(*options.start_machine);
     sink.start_at(*options.start_machine);
@@ -314,6 +315,18 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
   }
   report.holes = sink.holes();
   return report;
+}
+
+bool names_its_dialect(const std::filesystem::path& program) {
+  // Read with either dialect as the default, a program that names its own is read in it both
+  // times; one that does not follows the default.
+  interp::InterpOptions options;
+  options.dialect = interp::Dialect::linuxcnc;
+  interp::Interpreter as_linuxcnc(options);
+  options.dialect = interp::Dialect::numeryx;
+  interp::Interpreter as_numeryx(options);
+  return !as_linuxcnc.open(program) && !as_numeryx.open(program) &&
+         as_linuxcnc.dialect() == as_numeryx.dialect();
 }
 
 std::string describe(const CheckReport& report) {

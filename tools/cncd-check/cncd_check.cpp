@@ -5,8 +5,8 @@
 // through the planner and the servo loop in virtual time and prints the cycle time and what
 // the motion would be like (plan_sim). Problems go to stderr as FILE:LINE: message.
 //
-//   cncd-check [--ini FILE] [--canon | --holes] [--inch] [--tool-units mm|inch] [-t TOOL.tbl]
-//              [-v PARAMS.var] [--max-seconds S] PROGRAM
+//   cncd-check [--ini FILE] [--canon | --holes] [--dialect linuxcnc|numeryx] [--inch]
+//              [--tool-units mm|inch] [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM
 //   cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM
 //
 // Exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI.
@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,7 @@ int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "cncd-check: " << why << '\n';
   std::cerr
       << "usage: cncd-check [--ini FILE [--state-dir DIR]] [--canon | --holes] [--inch]\n"
-         "                  [--tool-units mm|inch]\n"
+         "                  [--dialect linuxcnc|numeryx] [--tool-units mm|inch]\n"
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
@@ -50,7 +51,8 @@ int usage(const std::string& why) {
          "  --canon      print the canonical commands as LinuxCNC's rs274 does\n"
          "  --holes      print the holes the program drills instead of the summary: number,\n"
          "               line, X, Y, top and bottom (machine coordinates and units)\n"
-
+         "  --dialect D  read the program as linuxcnc or numeryx, whatever its first line\n"
+         "               and [RS274NGC] DIALECT say\n"
          "  --inch       machine units are inches (without --ini)\n"
          "  --tool-units units the tool table is written in (default: the machine's)\n"
          "  -t, -v       tool table and parameter file (without --ini, or to override it)\n"
@@ -110,6 +112,14 @@ class TrajectoryFile {
   std::vector<std::size_t> axes_;
 };
 
+// What chose the dialect a program was read in, for the summary.
+std::string dialect_origin(const cncd::interp::InterpOptions& options, bool machine,
+                           const std::string& program) {
+  if (!options.dialect_from_first_line) return "--dialect";
+  if (cncd::pipeline::names_its_dialect(program)) return "the program's first line";
+  return machine ? "[RS274NGC] DIALECT" : "default";
+}
+
 int check_plan(const cncd::config::MachineConfig& machine, const std::string& program,
                cncd::pipeline::PlanSimOptions options, bool json, const std::string& trajectory) {
   std::unique_ptr<TrajectoryFile> csv;
@@ -150,6 +160,7 @@ int main(int argc, char** argv) {
   bool inch = false;
   bool canon = false;
   bool holes = false;
+  std::optional<interp::Dialect> dialect;
   bool plan = false;
   bool json = false;
   std::string trajectory;
@@ -171,7 +182,8 @@ int main(int argc, char** argv) {
     } else if (arg == "--inch") {
       inch = true;
     } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
-               arg == "--max-seconds" || arg == "--trajectory" || arg == "--state-dir") {
+               arg == "--max-seconds" || arg == "--trajectory" || arg == "--state-dir" ||
+               arg == "--dialect") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
@@ -180,7 +192,9 @@ int main(int argc, char** argv) {
         load_options.state_dir = value;
       } else if (arg == "--trajectory") {
         trajectory = value;
-
+      } else if (arg == "--dialect") {
+        dialect = interp::parse_dialect(value);
+        if (!dialect) return usage("--dialect must be linuxcnc or numeryx");
       } else if (arg == "--max-seconds") {
         char* end = nullptr;
         max_seconds = std::strtod(value.c_str(), &end);
@@ -244,6 +258,10 @@ int main(int argc, char** argv) {
   if (!overrides.tool_table.empty()) options.interp.tool_table = overrides.tool_table;
   if (!overrides.parameter_file.empty()) options.interp.parameter_file = overrides.parameter_file;
   if (overrides.tool_table_units) options.interp.tool_table_units = overrides.tool_table_units;
+  if (dialect) {
+    options.interp.dialect = *dialect;
+    options.interp.dialect_from_first_line = false;
+  }
   // A parameter file or tool table not there yet is no reason to refuse: the daemon starts
   // from the defaults too, and writes the file later.
   const interp::Interpreter loader(options.interp);
@@ -266,7 +284,9 @@ int main(int argc, char** argv) {
     if (holes) {
       std::cout << pipeline::describe_holes(report);
     } else {
-      std::cout << pipeline::describe(report);
+      std::cout << "dialect: " << interp::dialect_name(report.dialect) << " ("
+                << dialect_origin(options.interp, !ini.empty(), program) << ")\n"
+                << pipeline::describe(report);
     }
   }
   std::cout.flush();

@@ -67,6 +67,8 @@ struct CheckReport {
   std::set<int> tools;        // tools put in the spindle (M6, M61)
   double feed_length = 0;     // length of the feed moves (XYZ, machine units)
   bool inch_machine = false;  // machine units are inches (else mm)
+  // The dialect the program was read in (Interpreter::dialect() once it was opened).
+  interp::Dialect dialect = interp::Dialect::linuxcnc;
   // With CheckOptions::find_holes, in the order they are drilled.
   std::vector<Hole> holes;
   // The interpreter's error, when it stopped the program.
@@ -83,6 +85,10 @@ struct CheckReport {
 
 // Runs `program` from start to end. Never writes the parameter file.
 CheckReport check_program(const std::filesystem::path& program, const CheckOptions& options);
+
+// Whether the first line of `program` names the dialect it is read in ("(dialect numeryx)"),
+// rather than leaving it to InterpOptions::dialect. False when it cannot be opened.
+bool names_its_dialect(const std::filesystem::path& program);
 
 // The human summary cncd-check prints: moves by kind, extents per axis, tools, feed length.
 std::string describe(const CheckReport& report);
