@@ -63,6 +63,7 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
     return fail(message);
   }
   if (report.error) return fail(report.error->to_string());
+  out.dialect = report.dialect;
   out.lines = count_lines(file.path, cancel);
   return out;
 }

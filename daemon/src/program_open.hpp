@@ -37,6 +37,7 @@ struct OpenOutcome {
   std::optional<TaskError> error;  // none: the program passed and may be opened
   std::string path;                // the program file, symlinks resolved
   std::uint64_t lines = 0;
+  interp::Dialect dialect = interp::Dialect::linuxcnc;  // the one the program is read in
   // For the event log: the check stopped before the program's end (its time budget).
   std::vector<std::string> warnings;
 };

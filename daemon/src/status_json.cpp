@@ -97,6 +97,7 @@ json program_object(const ProgramReport& p) {
           {"opening", p.opening},
           {"line", p.line},
           {"total_lines", p.total_lines},
+          {"dialect", p.dialect},
           {"progress", p.progress},
           {"stepping", p.stepping},
           {"moves", p.moves},

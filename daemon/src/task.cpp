@@ -60,6 +60,7 @@ Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& a
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
       opener_(config) {
+  program_dialect_ = interp_->dialect();  // before any program: the machine's
   feeder_->on_warning([this](int line, const std::string& text) {
     const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
     events_.add("warning", "program", where + ":" + std::to_string(line) + ": " + text);
@@ -144,6 +145,8 @@ void Task::run_program(int from_line, bool step) {
   if (auto error = interp_->open(file.path)) {
     throw TaskError(TaskErrorKind::program, error->to_string());
   }
+  // The file may have been changed since it was opened.
+  program_dialect_ = interp_->dialect();
   start_run(Mode::automatic, status);
   skip_to_line_ = from_line > 1 ? from_line : 0;
   from_top_ = skip_to_line_ == 0;

@@ -185,6 +185,8 @@ class Task {
   std::vector<std::uint64_t> abort_tokens_;
   std::string program_path_;
   std::uint64_t program_lines_ = 0;
+  // The dialect the open program is read in; with none open, the machine's (MDI's).
+  interp::Dialect program_dialect_ = interp::Dialect::linuxcnc;
   bool interp_done_ = false;
   std::uint64_t moves_enqueued_ = 0;     // moves handed to motion since the program started
   std::uint64_t moves_done_base_ = 0;    // motion's completed-move count when it started

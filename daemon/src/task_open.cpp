@@ -67,6 +67,7 @@ void Task::finish_open(OpenOutcome outcome) {
   estimator_.start(outcome.path, pipeline::interpreter_options(config_), pending.start);
   program_path_ = outcome.path;
   program_lines_ = outcome.lines;
+  program_dialect_ = outcome.dialect;
   last_result_.clear();
   last_error_.clear();
   spdlog::info("program opened: {} ({} lines)", program_path_, program_lines_);

@@ -45,6 +45,8 @@ struct ProgramReport {
   std::string opening;  // the program being checked for program.open, "" when none
   int line = 0;
   std::uint64_t total_lines = 0;
+  // "linuxcnc" | "numeryx": the open program's dialect, the machine's when none is open.
+  std::string dialect;
   double progress = 0;  // 0 .. 1
   bool stepping = false;
   std::uint64_t moves = 0;

@@ -177,6 +177,7 @@ TaskStatus Task::status() const {
                  : stepping_ && exec_ == ExecState::paused ? interp_->current_line()
                                                            : s.line;
   program.total_lines = program_lines_;
+  program.dialect = interp::dialect_name(program_dialect_);
   program.progress = exec_ != ExecState::idle
                          ? (program_lines_ == 0
                                 ? 0.0
