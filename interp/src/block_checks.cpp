@@ -61,20 +61,25 @@ void Interpreter::Impl::check_block() const {
     if (letter != '\0' && b.has(letter)) axis_words = true;
   }
   const int motion = b.g_code(GGroup::motion);
+  const int motion_column = b.g_column[static_cast<std::size_t>(GGroup::motion)];
   if (axes_belong_to_non_modal() && motion >= 0 && motion != 800) {
     fail("Cannot use two g codes that both use axis values", b.g_column[0]);
   }
   if (motion == 800 && axis_words && !axes_belong_elsewhere()) {
-    fail("Cannot use axis values with g80", b.g_column[static_cast<std::size_t>(GGroup::motion)]);
+    fail("Cannot use axis values with g80", motion_column);
+  }
+  // Only G0-G3 may stand without an axis word (a move to where the tool is).
+  if (motion >= 0 && motion != 800 && motion > 30 && !axis_words) {
+    fail("All axes missing with motion code", motion_column);
   }
   if (axis_words && motion < 0 && !axes_belong_elsewhere() &&
       (modal_.motion < 0 || modal_.motion == 800)) {
     fail("Cannot use axis values without a g code that uses them");
   }
-  const int active_motion = motion >= 0 ? motion : modal_.motion;
+  const int active_motion = motion_to_be();
   const bool cycle = active_motion == 730 || active_motion == 740 ||
                      (active_motion >= 810 && active_motion <= 890);
-  if (cycle && !axes_belong_elsewhere()) {
+  if (cycle) {
     for (const char letter : {'a', 'b', 'c'}) {
       if (b.has(letter)) {
         char message[40];
@@ -127,6 +132,24 @@ void Interpreter::Impl::check_word_users(int motion) const {
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
   require('r', arc || cycle || g10, "R word with no g code that uses it");
+}
+
+// LinuxCNC's "motion to be": the block's motion code; else, when the block has axis words that
+// no group 0 code (or G43.1) takes, the modal motion; else the modal arc for a block of only
+// I, J or K words; else none (-1). The words of a block are checked against it.
+int Interpreter::Impl::motion_to_be() const {
+  const Block& b = block_;
+  const int motion = b.g_code(GGroup::motion);
+  if (motion >= 0) return motion;
+  if (axes_belong_elsewhere()) return -1;
+  bool axis_words = b.has_polar_distance || b.has_polar_angle;
+  for (const char letter : kAxisLetters) {
+    if (letter != '\0' && b.has(letter)) axis_words = true;
+  }
+  if (axis_words) return modal_.motion;
+  const bool ijk = b.has('i') || b.has('j') || b.has('k');
+  if (ijk && (modal_.motion == 20 || modal_.motion == 30)) return modal_.motion;
+  return -1;
 }
 
 }  // namespace cncd::interp

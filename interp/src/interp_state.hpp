@@ -191,6 +191,7 @@ struct Interpreter::Impl {
   bool axes_belong_elsewhere() const;
   bool axes_belong_to_non_modal() const;
   void check_word_users(int motion) const;
+  int motion_to_be() const;
   void do_comment();
   std::string substitute_parameters(const std::string& text) const;
   std::optional<double> predefined_parameter(std::string_view name) const;

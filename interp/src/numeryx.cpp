@@ -76,6 +76,9 @@ void Interpreter::Impl::check_numeryx_block() const {
   }
   const int motion = b.g_code(GGroup::motion);
   const int active_motion = motion >= 0 ? motion : modal_.motion;
+  if (motion >= 0 && motion > 30 && !axis_words) {
+    fail("All axes missing with motion code", b.g_column[static_cast<std::size_t>(GGroup::motion)]);
+  }
   if (axis_words && !drilling && !b.nx_polar && active_motion < 0 && !axes_belong_elsewhere()) {
     fail("Cannot use axis values without a g code that uses them");
   }
