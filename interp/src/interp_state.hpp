@@ -209,6 +209,12 @@ struct Interpreter::Impl {
   bool do_stop();
   void program_end_reset();
 
+  // probe.cpp: G38.2-G38.5 and their results.
+  void do_probe(int code);
+  void read_probe_result();
+  void track_standalone(const CanonOp& op);
+  void sync_standalone();
+
   // motion.cpp
   void do_motion();
   Pose target_from_words() const;
@@ -321,9 +327,22 @@ struct Interpreter::Impl {
   int line_before_ = 0;           // line number before it
   bool input_pending_ = false;    // an M66 ran: #5399 gets its answer before the next line
   bool input_digital_ = true;     // the M66 was for a digital input
-  double last_value_ = 0;         // #<_value>
-  bool value_returned_ = false;   // #<_value_returned>
-  std::string o_scan_name_;       // scratch for skipping lines
+  // A G38.n ran: #5061-#5070 and the position get its result before the next line.
+  bool probe_pending_ = false;
+  Pose probe_end_{};  // its programmed end
+  // LinuxCNC's standalone canon (rs274) keeps a program position of its own: the end of the
+  // last move, shifted by each change of the G5x and G92 offsets (leaving out the XY rotation)
+  // and scaled by each change of units. After a probe, its interpreter takes that position.
+  struct StandaloneCanon {
+    Pose pos{};
+    Pose g5x{};
+    Pose g92{};
+    Units units = Units::mm;
+  };
+  StandaloneCanon standalone_;
+  double last_value_ = 0;        // #<_value>
+  bool value_returned_ = false;  // #<_value_returned>
+  std::string o_scan_name_;      // scratch for skipping lines
 };
 
 }  // namespace cncd::interp

@@ -73,6 +73,7 @@ void Interpreter::Impl::reset_modal_state() {
   loops_without_motion_ = 0;
   seen_percent_ = false;
   input_pending_ = false;
+  probe_pending_ = false;
 }
 
 namespace {
@@ -122,8 +123,11 @@ void Interpreter::Impl::emit_command(const CanonCommand& command) {
   const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
                      std::holds_alternative<StraightFeed>(command.op) ||
                      std::holds_alternative<ArcFeed>(command.op) ||
-                     std::holds_alternative<Dwell>(command.op);
+                     std::holds_alternative<Dwell>(command.op) ||
+                     std::holds_alternative<StraightProbe>(command.op) ||
+                     std::holds_alternative<RigidTap>(command.op);
   if (moves) loops_without_motion_ = 0;  // a move or a dwell
+  track_standalone(command.op);
   sink_->emit(command);
 }
 
@@ -132,6 +136,7 @@ void Interpreter::Impl::emit_comment(const std::string& text) {
 }
 
 void Interpreter::Impl::emit_preamble() {
+  sync_standalone();
   emit(UseLengthUnits{modal_.units});
   emit_g5x();
   emit_g92();
@@ -202,6 +207,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     }
     resend_g5x_ = false;
     resend_g92_ = false;
+    read_probe_result();  // LinuxCNC reads the probe's result before the input's
     read_input_result();
     LineSource& source = sources_.back();
     line_offset_ = source.tell();
@@ -335,6 +341,7 @@ Interpreter::~Interpreter() = default;
 
 void Interpreter::set_position(const Pose& position) {
   impl_->pos_ = position;
+  impl_->sync_standalone();
 }
 
 void Interpreter::set_machine_position(const Pose& machine) {
@@ -344,6 +351,7 @@ void Interpreter::set_machine_position(const Pose& machine) {
       program[axis] = impl_->to_program_units(program[axis]);
   }
   impl_->pos_ = impl_->machine_to_program(program);
+  impl_->sync_standalone();
 }
 
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
@@ -434,6 +442,8 @@ void Interpreter::set_probe_result(const Pose& trip_machine, bool tripped) {
       program[axis] = impl_->to_program_units(program[axis]);
   }
   program = impl_->machine_to_program(program);
+  impl_->probe_pending_ = false;
+  impl_->sync_standalone();
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     impl_->parameters_.set(5061 + static_cast<int>(axis), program[axis]);
   impl_->parameters_.set(5070, tripped ? 1.0 : 0.0);

@@ -128,6 +128,10 @@ void Interpreter::Impl::do_motion() {
   }
   if (non_modal == 530 && modal_.incremental)
     fail("Cannot use g53 incremental", block_.g_column[0]);
+  if (code >= 382 && code <= 385) {
+    if (axis_words) do_probe(code);
+    return;
+  }
   if (code == 10 || code == 20 || code == 30) {
     if (modal_.feed_mode == FeedMode::inverse_time && !block_.has('f') && axis_words) {
       fail(code == 10 ? "F word missing with inverse time g1 move"

@@ -141,6 +141,12 @@ class Interpreter {
   // calling step() after a StraightProbe until the move is over, calls this, then
   // set_machine_position() with where the machine stopped. An error the machine raised (no
   // contact in G38.2/G38.4, tripped already at the start) is the caller's to report.
+  // This call does not move the interpreter's position: until set_machine_position() says
+  // where the machine stopped (before the next step()), the probe move counts as having
+  // reached its programmed end. Without this call, the next step() reads on as LinuxCNC's
+  // standalone rs274 does (what cncd-check and the goldens see): #5061-#5069 the programmed
+  // end, #5070 0, and the position rs274's canon gives, the end backed off 0.254 mm (0.01 in)
+  // toward where the move started.
   void set_probe_result(const Pose& trip_machine, bool tripped);
 
   // Line number of the block last executed.
