@@ -58,7 +58,9 @@ void Interpreter::Impl::do_comment() {
   if (starts_with_word(text, "print,", rest) || starts_with_word(text, "log", rest)) return;
   // Plain comments lose their leading blanks, as LinuxCNC prints them.
   const std::size_t first = text.find_first_not_of(" \t");
-  emit_comment(first == std::string::npos ? std::string() : text.substr(first));
+  const std::string plain = first == std::string::npos ? std::string() : text.substr(first);
+  probe_file_comment(plain);
+  emit_comment(plain);
 }
 
 // (DEBUG, ...) text with #n and #<name> replaced by their values, as LinuxCNC does: six
@@ -400,6 +402,7 @@ void Interpreter::Impl::program_end_reset() {
   nx_loops_.clear();
   if (block_.m_code(MGroup::stopping) == 30) emit(PalletShuttle{});
   emit(ProgramEnd{});
+  close_probe_file();
 }
 
 }  // namespace cncd::interp

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <array>
+#include <cstdio>
+#include <filesystem>
 #include <initializer_list>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -209,11 +212,16 @@ struct Interpreter::Impl {
   bool do_stop();
   void program_end_reset();
 
-  // probe.cpp: G38.2-G38.5 and their results.
+  // probe.cpp: G38.2-G38.5, their results and the probe file.
   void do_probe(int code);
   void read_probe_result();
   void track_standalone(const CanonOp& op);
   void sync_standalone();
+  // (PROBEOPEN name) and (PROBECLOSE); true when the comment was one of them.
+  bool probe_file_comment(const std::string& text);
+  void close_probe_file();
+  // Writes #5061-#5069 as a line of the open probe file; Failure when it cannot.
+  void write_probe_line();
 
   // motion.cpp
   void do_motion();
@@ -340,9 +348,17 @@ struct Interpreter::Impl {
     Units units = Units::mm;
   };
   StandaloneCanon standalone_;
-  double last_value_ = 0;        // #<_value>
-  bool value_returned_ = false;  // #<_value_returned>
-  std::string o_scan_name_;      // scratch for skipping lines
+  // (PROBEOPEN name): the file the probe results go to, absolute. It is opened (and emptied)
+  // with the first result, so that a run without a machine (a check) leaves it as it was.
+  std::filesystem::path probe_path_;
+  struct FileCloser {
+    void operator()(std::FILE* file) const { std::fclose(file); }
+  };
+  std::unique_ptr<std::FILE, FileCloser> probe_file_;
+  std::filesystem::path program_dir_;  // of the program file open(); empty for MDI and text
+  double last_value_ = 0;              // #<_value>
+  bool value_returned_ = false;        // #<_value_returned>
+  std::string o_scan_name_;            // scratch for skipping lines
 };
 
 }  // namespace cncd::interp

@@ -228,6 +228,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
       }
       if (seen_percent_) {
         emit(Finish{});
+        close_probe_file();
         ended_ = true;
         return Step::end;
       }
@@ -237,6 +238,7 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
     return ended_ ? Step::end : Step::block;
   } catch (const Failure& failure) {
     error_ = make_error(failure);
+    close_probe_file();  // the run is over: what it probed is in the file
     return Step::error;
   }
 }
@@ -357,6 +359,10 @@ void Interpreter::set_machine_position(const Pose& machine) {
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
   impl_->mdi_ = false;
   impl_->sources_.clear();
+  impl_->close_probe_file();
+  std::error_code ec;
+  const auto absolute = std::filesystem::absolute(program, ec);
+  impl_->program_dir_ = ec ? program.parent_path() : absolute.parent_path();
   impl_->error_ = impl_->config_error_;  // a new program starts without the last one's error
   impl_->program_name_ = program.string();
   LineSource source;
@@ -378,6 +384,7 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
 
 std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   impl_->sources_.clear();
+  impl_->program_dir_.clear();  // a probe file opened by an earlier MDI line stays open
   impl_->error_ = impl_->config_error_;
   impl_->program_name_ = "MDI";
   LineSource source;
@@ -398,6 +405,8 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
 std::optional<InterpError> Interpreter::open_string(std::string text, std::string name) {
   impl_->mdi_ = false;
   impl_->sources_.clear();
+  impl_->close_probe_file();
+  impl_->program_dir_.clear();
   impl_->error_ = impl_->config_error_;
   impl_->program_name_ = name;
   LineSource source;
@@ -447,6 +456,12 @@ void Interpreter::set_probe_result(const Pose& trip_machine, bool tripped) {
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     impl_->parameters_.set(5061 + static_cast<int>(axis), program[axis]);
   impl_->parameters_.set(5070, tripped ? 1.0 : 0.0);
+  try {
+    impl_->write_probe_line();
+  } catch (const Failure& failure) {
+    // The probe's line is the current one: the next step() reports it there.
+    if (!impl_->error_) impl_->error_ = impl_->make_error(failure);
+  }
 }
 
 int Interpreter::current_line() const {

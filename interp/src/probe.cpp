@@ -1,11 +1,38 @@
-// G38.2-G38.5 straight probes with LinuxCNC's checks, and the result the machine hands back
-// (or, without a machine, the one LinuxCNC's standalone interpreter makes up).
+// G38.2-G38.5 straight probes with LinuxCNC's checks, the result the machine hands back (or,
+// without a machine, the one LinuxCNC's standalone interpreter makes up), and the probe file
+// of (PROBEOPEN name) / (PROBECLOSE).
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
 
 #include "failure.hpp"
 #include "interp_state.hpp"
 
 namespace cncd::interp {
+namespace {
+
+// Why `path` could not be opened for writing, without creating or emptying it; empty if it
+// could. A check (cncd-check, the daemon's program.open) runs the program too, and must leave
+// the results of the last run alone.
+std::string open_problem(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(status)) return std::strerror(EISDIR);
+  if (std::filesystem::exists(status)) {
+    return ::access(path.c_str(), W_OK) == 0 ? std::string() : std::strerror(errno);
+  }
+  const auto dir = path.parent_path();
+  if (!std::filesystem::is_directory(dir, ec)) return std::strerror(ENOENT);
+  return ::access(dir.c_str(), W_OK | X_OK) == 0 ? std::string() : std::strerror(errno);
+}
+
+}  // namespace
 
 void Interpreter::Impl::do_probe(int code) {
   // cncd's own check first (LinuxCNC would probe at the last per-minute feed and ignore the
@@ -91,6 +118,76 @@ void Interpreter::Impl::track_standalone(const CanonOp& op) {
       }
       s.units = units->units;
     }
+  }
+}
+
+// LinuxCNC's canon acts on these two comments (exactly so, in capitals); a relative name is
+// taken from the program's directory (cncd's choice: LinuxCNC's is its own working directory).
+bool Interpreter::Impl::probe_file_comment(const std::string& text) {
+  if (text.starts_with("PROBECLOSE")) {
+    close_probe_file();
+    return true;
+  }
+  if (!text.starts_with("PROBEOPEN")) return false;
+  std::string name = text.substr(9);
+  const std::size_t first = name.find_first_not_of(" \t");
+  const std::size_t last = name.find_last_not_of(" \t");
+  name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
+  if (name.empty()) fail("PROBEOPEN without a file name: (PROBEOPEN results.txt)");
+  std::filesystem::path path = name;
+  if (path.is_relative()) {
+    if (!program_dir_.empty()) {
+      path = program_dir_ / path;
+    } else if (!options_.subroutine_path.empty() && !options_.subroutine_path.front().empty()) {
+      path = options_.subroutine_path.front() / path;
+    } else {
+      fail("Cannot open probe file " + name +
+           ": a relative name is taken from the program's directory, and MDI has none (give a "
+           "full path, or set [RS274NGC] SUBROUTINE_PATH)");
+    }
+  }
+  std::error_code ec;
+  const auto absolute = std::filesystem::absolute(path, ec);
+  if (!ec) path = absolute.lexically_normal();
+  const std::string problem = open_problem(path);
+  if (!problem.empty()) fail("Cannot open probe file " + path.string() + ": " + problem);
+  close_probe_file();
+  probe_path_ = path;
+  return true;
+}
+
+void Interpreter::Impl::close_probe_file() {
+  probe_file_.reset();
+  probe_path_.clear();
+}
+
+// "%f %f %f %f %f %f %f %f %f": X Y Z A B C U V W of #5061-#5069, as LinuxCNC writes them.
+// The first result empties the file, as LinuxCNC's opening it does; each is flushed.
+void Interpreter::Impl::write_probe_line() {
+  if (probe_path_.empty()) return;
+  if (!probe_file_) {
+    probe_file_.reset(std::fopen(probe_path_.c_str(), "w"));
+    if (!probe_file_) {
+      const std::string why = std::strerror(errno);
+      const std::string name = probe_path_.string();
+      close_probe_file();
+      fail("Cannot open probe file " + name + ": " + why);
+    }
+  }
+  std::string line;
+  char number[400];
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const int n = std::snprintf(number, sizeof number, "%f", parameters_.get(5061 + axis));
+    if (n > 0) line.append(number, static_cast<std::size_t>(n));
+    line += axis + 1 < kAxes ? ' ' : '\n';
+  }
+  const bool written = std::fwrite(line.data(), 1, line.size(), probe_file_.get()) == line.size() &&
+                       std::fflush(probe_file_.get()) == 0;
+  if (!written) {
+    const std::string why = std::strerror(errno);
+    const std::string name = probe_path_.string();
+    close_probe_file();
+    fail("Cannot write probe file " + name + ": " + why);
   }
 }
 

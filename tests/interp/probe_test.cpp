@@ -1,8 +1,14 @@
-// G38.2-G38.5 with a machine that answers (Interpreter::set_probe_result). What rs274 can show (the
-// canon, its checks, #5061-#5070 and the position without a machine) is in the goldens
-// (tests/golden/probe_*, error_probe_*).
+// G38.2-G38.5 with a machine that answers (Interpreter::set_probe_result) and the probe file of
+// (PROBEOPEN name). What rs274 can show (the canon, its checks, #5061-#5070 and the position
+// without a machine) is in the goldens (tests/golden/probe_*, error_probe_*).
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -42,6 +48,34 @@ Pose pose(double x, double y, double z) {
   p[1] = y;
   p[2] = z;
   return p;
+}
+
+// A scratch directory for one test.
+class TempDir {
+ public:
+  TempDir() {
+    path_ = std::filesystem::temp_directory_path() /
+            ("cncd-probe-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(path_ / name) << text;
+    return path_ / name;
+  }
+
+ private:
+  static inline int counter_ = 0;
+  std::filesystem::path path_;
+};
+
+std::string read(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 // Runs a program whose machine answers each probe: the probe trips at `trips[n]` (machine
@@ -174,6 +208,145 @@ TEST(Probe, ALoopOfProbesIsNoLoopWithoutMotion) {
   Recorder r;
   EXPECT_EQ(run_answering(interp, r, {}), "");
   EXPECT_EQ(r.all<StraightProbe>().size(), 20U);
+}
+
+// --- the probe file -------------------------------------------------------------------------
+
+constexpr const char* kFileProgram =
+    "(PROBEOPEN results.txt)\nG21 F100\nG38.2 Z-1\nG38.2 Z-2 A10\n( PROBECLOSE)\nG38.2 Z-3\n"
+    "M2\n";
+
+TEST(ProbeFile, EachAnswerIsALineInTheFileNamedFromTheProgramsDirectory) {
+  TempDir dir;
+  const auto program = dir.write("prog.ngc", kFileProgram);
+  Interpreter interp;
+  ASSERT_FALSE(interp.open(program));
+  Recorder r;
+  Pose second = pose(1.5, -2.25, -1.75);
+  second[3] = 10;
+  ASSERT_EQ(run_answering(interp, r, {pose(0, 0, -0.5), second, pose(0, 0, -2.5)}), "");
+  // LinuxCNC's "%f %f %f %f %f %f %f %f %f": X Y Z A B C U V W, program coordinates.
+  EXPECT_EQ(read(dir.path() / "results.txt"),
+            "0.000000 0.000000 -0.500000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+            "0.000000\n"
+            "1.500000 -2.250000 -1.750000 10.000000 0.000000 0.000000 0.000000 0.000000 "
+            "0.000000\n");
+}
+
+// A run without a machine (cncd-check, the daemon's program check) answers no probe: the file
+// of the last run stays as it was, and none is made.
+TEST(ProbeFile, ARunWithoutAnswersLeavesTheFileAlone) {
+  TempDir dir;
+  const auto program = dir.write("prog.ngc", kFileProgram);
+  dir.write("results.txt", "last run\n");
+  Interpreter interp;
+  ASSERT_FALSE(interp.open(program));
+  NullSink sink;
+  EXPECT_FALSE(run_program(interp, sink));
+  EXPECT_EQ(read(dir.path() / "results.txt"), "last run\n");
+  std::filesystem::remove(dir.path() / "results.txt");
+  ASSERT_FALSE(interp.open(program));
+  EXPECT_FALSE(run_program(interp, sink));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "results.txt"));
+}
+
+TEST(ProbeFile, TheFirstAnswerEmptiesTheFile) {
+  TempDir dir;
+  const auto program = dir.write("prog.ngc", "(PROBEOPEN r.txt)\nF1 G38.3 X1\nM2\n");
+  dir.write("r.txt", "last run\nlast run\n");
+  Interpreter interp;
+  ASSERT_FALSE(interp.open(program));
+  Recorder r;
+  ASSERT_EQ(run_answering(interp, r, {pose(0.5, 0, 0)}), "");
+  EXPECT_EQ(read(dir.path() / "r.txt"),
+            "0.500000 0.000000 0.000000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+            "0.000000\n");
+}
+
+// Closed at PROBECLOSE, at the program's end and when another program opens: an answer after
+// that writes nothing.
+TEST(ProbeFile, ClosedAtTheEndAndWhenAnotherProgramOpens) {
+  TempDir dir;
+  const auto ends = dir.write("ends.ngc", "(PROBEOPEN a.txt)\nF1 G38.3 X1 M2\n");
+  Interpreter interp;
+  ASSERT_FALSE(interp.open(ends));
+  Recorder r;
+  while (interp.step(r) == Interpreter::Step::block) {
+  }
+  interp.set_probe_result(pose(1, 0, 0), true);  // after M2
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "a.txt"));
+
+  const auto open = dir.write("open.ngc", "(PROBEOPEN b.txt)\nF1 G38.3 X1\nM2\n");
+  ASSERT_FALSE(interp.open(open));
+  ASSERT_EQ(interp.step(r), Interpreter::Step::block);
+  ASSERT_EQ(interp.step(r), Interpreter::Step::block);
+  interp.set_probe_result(pose(1, 0, 0), true);
+  EXPECT_EQ(read(dir.path() / "b.txt").size(), 81U);
+  ASSERT_FALSE(interp.open(ends));
+  interp.set_probe_result(pose(2, 0, 0), true);
+  EXPECT_EQ(read(dir.path() / "b.txt").size(), 81U);
+}
+
+TEST(ProbeFile, AFileThatCannotBeOpenedIsAnErrorAtItsComment) {
+  TempDir dir;
+  auto error_of = [&](const std::string& text) {
+    const auto program = dir.write("prog.ngc", text);
+    Interpreter interp;
+    if (auto error = interp.open(program)) return error->to_string();
+    NullSink sink;
+    const auto error = run_program(interp, sink);
+    return error ? error->to_string() : std::string("no error");
+  };
+  const std::string prog = (dir.path() / "prog.ngc").string();
+  EXPECT_EQ(error_of("G21\n(PROBEOPEN no/such/dir.txt)\nM2\n"),
+            prog + ":2: Cannot open probe file " + (dir.path() / "no/such/dir.txt").string() +
+                ": No such file or directory");
+  std::filesystem::create_directory(dir.path() / "sub");
+  EXPECT_EQ(
+      error_of("(PROBEOPEN sub)\nM2\n"),
+      prog + ":1: Cannot open probe file " + (dir.path() / "sub").string() + ": Is a directory");
+  EXPECT_EQ(error_of("(PROBEOPEN   )\nM2\n"),
+            prog + ":1: PROBEOPEN without a file name: (PROBEOPEN results.txt)");
+  // Only LinuxCNC's capitals open a file.
+  EXPECT_EQ(error_of("(probeopen no/such/dir.txt)\nM2\n"), "no error");
+}
+
+// A result that cannot be written stops the program at the probe's line.
+TEST(ProbeFile, AFailedWriteIsAnErrorAtTheProbesLine) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("(PROBEOPEN /dev/full)\nF1\nG38.3 X1\nM2\n", "p.ngc"));
+  Recorder r;
+  const std::string error = run_answering(interp, r, {pose(1, 0, 0)});
+  EXPECT_EQ(error, "p.ngc:3: Cannot write probe file /dev/full: No space left on device");
+}
+
+TEST(ProbeFile, MdiNeedsAFullNameOrTheSubroutinePath) {
+  TempDir dir;
+  {
+    Interpreter interp;
+    ASSERT_FALSE(interp.open_mdi("(PROBEOPEN r.txt)"));
+    NullSink sink;
+    const auto error = run_program(interp, sink);
+    ASSERT_TRUE(error);
+    EXPECT_EQ(error->to_string(),
+              "MDI:1: Cannot open probe file r.txt: a relative name is taken from the program's "
+              "directory, and MDI has none (give a full path, or set [RS274NGC] "
+              "SUBROUTINE_PATH)");
+  }
+  InterpOptions options;
+  options.subroutine_path = {dir.path()};
+  Interpreter interp(options);
+  Recorder r;
+  // The file stays open from one MDI line to the next.
+  for (const char* line : {"(PROBEOPEN r.txt)", "G21 F10", "G38.2 Z-1", "G38.2 Z-2"}) {
+    ASSERT_FALSE(interp.open_mdi(line));
+    ASSERT_EQ(run_answering(interp, r, {pose(0, 0, -0.25)}), "") << line;
+  }
+  EXPECT_EQ(read(dir.path() / "r.txt"),
+            "0.000000 0.000000 -0.250000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+            "0.000000\n"
+            "0.000000 0.000000 -0.250000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+            "0.000000\n");
 }
 
 }  // namespace

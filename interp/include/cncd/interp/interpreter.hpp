@@ -146,7 +146,8 @@ class Interpreter {
   // reached its programmed end. Without this call, the next step() reads on as LinuxCNC's
   // standalone rs274 does (what cncd-check and the goldens see): #5061-#5069 the programmed
   // end, #5070 0, and the position rs274's canon gives, the end backed off 0.254 mm (0.01 in)
-  // toward where the move started.
+  // toward where the move started. A probe file line that cannot be written makes the next
+  // step() fail at the probe's line.
   void set_probe_result(const Pose& trip_machine, bool tripped);
 
   // Line number of the block last executed.
