@@ -108,14 +108,16 @@ void Interpreter::Impl::check_word_users(int motion) const {
   auto require = [&](char letter, bool used, const char* message) {
     if (b.has(letter) && !used) fail(message, b.col(letter));
   };
+  const bool synced = motion == 330 || motion == 331;
   require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
   require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
-  require('i', arc || g10 || motion == 870,
+  require('i', arc || g10 || motion == 870 || motion == 331,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
   require('j', arc || g10 || motion == 870,
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
-  require('k', arc || motion == 870, "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
+  require('k', arc || motion == 870 || synced,
+          "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
   require('l', g10 || cycle || io == 66,
           "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
           "NURBS code");
@@ -132,6 +134,16 @@ void Interpreter::Impl::check_word_users(int motion) const {
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
   require('r', arc || cycle || g10, "R word with no g code that uses it");
+  check_spindle_words(motion);
+}
+
+// The word checks of G33/G33.1 that close LinuxCNC's list, in both dialects.
+void Interpreter::Impl::check_spindle_words(int motion) const {
+  const Block& b = block_;
+  if (motion == 330 || motion == 331) {
+    if (!b.has('k')) fail("K word missing with g33/g33.1");
+    if (b.has('f')) fail("F word used with a g33/g33.1", b.col('f'));
+  }
 }
 
 // LinuxCNC's "motion to be": the block's motion code; else, when the block has axis words that

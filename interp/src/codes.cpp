@@ -26,7 +26,7 @@ constexpr std::array kGCodes{
     GEntry{200, GGroup::units, true},          GEntry{210, GGroup::units, true},
     GEntry{280, GGroup::non_modal, true},      GEntry{281, GGroup::non_modal, true},
     GEntry{300, GGroup::non_modal, true},      GEntry{301, GGroup::non_modal, true},
-    GEntry{330, GGroup::motion, false},        GEntry{331, GGroup::motion, false},
+    GEntry{330, GGroup::motion, true},         GEntry{331, GGroup::motion, true},
     GEntry{382, GGroup::motion, true},         GEntry{383, GGroup::motion, true},
     GEntry{384, GGroup::motion, true},         GEntry{385, GGroup::motion, true},
     GEntry{400, GGroup::cutter_comp, true},    GEntry{410, GGroup::cutter_comp, false},

@@ -194,6 +194,7 @@ struct Interpreter::Impl {
   bool axes_belong_elsewhere() const;
   bool axes_belong_to_non_modal() const;
   void check_word_users(int motion) const;
+  void check_spindle_words(int motion) const;
   int motion_to_be() const;
   void do_comment();
   std::string substitute_parameters(const std::string& text) const;
@@ -222,6 +223,9 @@ struct Interpreter::Impl {
   void close_probe_file();
   // Writes #5061-#5069 as a line of the open probe file; Failure when it cannot.
   void write_probe_line();
+
+  // spindle_sync.cpp: G33 and G33.1.
+  void do_spindle_synced(int code);
 
   // motion.cpp
   void do_motion();

@@ -132,6 +132,10 @@ void Interpreter::Impl::do_motion() {
     if (axis_words) do_probe(code);
     return;
   }
+  if (code == 330 || code == 331) {
+    if (axis_words) do_spindle_synced(code);
+    return;
+  }
   if (code == 10 || code == 20 || code == 30) {
     if (modal_.feed_mode == FeedMode::inverse_time && !block_.has('f') && axis_words) {
       fail(code == 10 ? "F word missing with inverse time g1 move"

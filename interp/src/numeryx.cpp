@@ -90,6 +90,7 @@ void Interpreter::Impl::check_numeryx_block() const {
     }
   }
   const bool arc = !drilling && (active_motion == 20 || active_motion == 30);
+  const int synced = drilling ? -1 : motion_to_be();
   const int non_modal = b.g_code(GGroup::non_modal);
   const int overrides = b.m_code(MGroup::overrides);
   const int io = b.m_code(MGroup::io);
@@ -103,9 +104,10 @@ void Interpreter::Impl::check_numeryx_block() const {
   require('d', false, "D word with no drilling cycle to use it" + cycle_hint);
   require('e', io >= 66, "E word with no M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 to use it");
-  require('i', arc || b.nx_polar, "I word with no g2, g3 or g10 to use it");
+  require('i', arc || b.nx_polar || synced == 331, "I word with no g2, g3, g10 or g33.1 to use it");
   require('j', arc || b.nx_polar, "J word with no g2, g3 or g10 to use it");
-  require('k', arc, "K word with no g2 or g3 to use it");
+  require('k', arc || synced == 330 || synced == 331,
+          "K word with no g2, g3, g33 or g33.1 to use it");
   require('l', io == 66, "L word with no M66 to use it");
   require('p',
           arc || b.nx_polar || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
@@ -116,6 +118,7 @@ void Interpreter::Impl::check_numeryx_block() const {
               io >= 66 || user_m,
           "Q word with no g64, M61, M66-M68 or user M code to use it" + cycle_hint);
   require('r', arc || b.nx_polar, "R word with no g2, g3 or g10 to use it" + cycle_hint);
+  check_spindle_words(synced);
   if (b.has('f') && b.get('f') < 0) fail("Negative f word used", b.col('f'));
   if (b.has('s') && b.get('s') < 0) fail("Negative spindle speed used", b.col('s'));
   if (b.has('t') && b.get('t') < 0) fail("Negative t word used", b.col('t'));

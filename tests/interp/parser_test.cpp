@@ -102,7 +102,6 @@ TEST(Errors, Wording) {
 TEST(Errors, UnsupportedFeaturesAreRejected) {
   expect_errors({
       {"G41 D1\nM2\n", "G41 is not supported"},
-      {"G33 Z-1 K1\nM2\n", "G33 is not supported"},
       {"G76 P1 Z-1\nM2\n", "G76 is not supported"},
       {"G5.1 X1 I1\nM2\n", "G5.1 is not supported"},
   });

@@ -1,0 +1,126 @@
+// G33 and G33.1: the typed commands and cncd's own checks. The canon rs274 gives is in the goldens
+// (tests/golden/sync_*, error_sync_*).
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/interp/rs274_printer.hpp"
+#include "cncd/interp/to_machine.hpp"
+
+namespace cncd::interp {
+namespace {
+
+struct Recorder final : CanonSink {
+  void emit(const CanonCommand& command) override {
+    commands.push_back(command);
+    const std::string text = format_rs274(command, 3);
+    if (!text.empty()) lines.push_back(text);
+  }
+  template <class T>
+  std::vector<T> all() const {
+    std::vector<T> found;
+    for (const auto& c : commands) {
+      if (const auto* op = std::get_if<T>(&c.op)) found.push_back(*op);
+    }
+    return found;
+  }
+  // The lines from the first one that starts with `first` on (X Y Z only).
+  std::vector<std::string> from(const std::string& first) const {
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (lines[i].starts_with(first)) return {lines.begin() + static_cast<long>(i), lines.end()};
+    }
+    return {};
+  }
+  std::vector<CanonCommand> commands;
+  std::vector<std::string> lines;
+};
+
+struct Outcome {
+  Recorder recorder;
+  std::string error;  // "" at a clean end
+};
+
+Outcome run(const std::string& program, InterpOptions options = {}) {
+  Interpreter interp(std::move(options));
+  Outcome out;
+  auto error = interp.open_string(program, "s.ngc");
+  if (!error) error = run_program(interp, out.recorder);
+  if (error) out.error = error->to_string();
+  return out;
+}
+
+// --- G33 and G33.1 ------------------------------------------------------------------------
+
+TEST(SpindleSync, G33IsAFeedInStepWithTheSpindle) {
+  const auto out = run("G21 S500 M3\nG0 X1 Z2\nG33 Z-10 K1.5\nM2\n");
+  ASSERT_EQ(out.error, "");
+  const auto synch = out.recorder.all<StartSpeedFeedSynch>();
+  ASSERT_EQ(synch.size(), 1U);
+  EXPECT_EQ(synch[0].feed_per_rev, 1.5);
+  EXPECT_FALSE(synch[0].velocity_mode);
+  EXPECT_EQ(out.recorder.from("START_SPEED_FEED_SYNC"),
+            (std::vector<std::string>{
+                "START_SPEED_FEED_SYNC(1.500000,0)",
+                "STRAIGHT_FEED(1.0000, 0.0000, -10.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "SET_G5X_OFFSET(1, 0.0000, 0.0000, 0.0000)",
+                "SET_XY_ROTATION(0.0000)",
+                "SET_FEED_MODE(0, 0)",
+                "SET_FEED_RATE(0.0000)",
+                "STOP_SPINDLE_TURNING(0)",
+                "SET_SPINDLE_MODE(0 0.0000)",
+                "PROGRAM_END()",
+            }));
+}
+
+// The pitch reaches the machine in its units.
+TEST(SpindleSync, ThePitchIsConvertedToMachineUnits) {
+  const auto out = run("G20 S500 M3\nG33 Z-1 K0.05\nM2\n");
+  ASSERT_EQ(out.error, "");
+  MachineTracker tracker(Units::mm);
+  double pitch = 0;
+  for (const auto& command : out.recorder.commands) {
+    const auto converted = tracker.to_machine(command);
+    if (const auto* s = std::get_if<StartSpeedFeedSynch>(&converted.op)) pitch = s->feed_per_rev;
+  }
+  EXPECT_NEAR(pitch, 1.27, 1e-12);
+}
+
+TEST(SpindleSync, G331TapsDownAndBackToWhereItStarted) {
+  const auto out =
+      run("G21 S500 M3\nG0 X1 Y2 Z3\nG33.1 Z-5 K1.5 I2\nG33.1 Z-6 K1 I0.5\nG33.1 Z-7 K1\n"
+          "G1 X4 F100\nM2\n");
+  ASSERT_EQ(out.error, "");
+  const auto taps = out.recorder.all<RigidTap>();
+  ASSERT_EQ(taps.size(), 3U);
+  Pose end{};
+  end[0] = 1;
+  end[1] = 2;
+  end[2] = -5;
+  EXPECT_EQ(taps[0].end, end);
+  EXPECT_EQ(taps[0].scale, 2.0);  // I: faster on the way out
+  EXPECT_EQ(taps[1].scale, 1.0);  // never slower
+  EXPECT_EQ(taps[2].scale, 1.0);
+  EXPECT_EQ(out.recorder.from("STRAIGHT_FEED").front(), "STRAIGHT_FEED(4.0000, 2.0000, 3.0000)");
+}
+
+// cncd's own: a move that would wait for ever, or turn an axis the tap leaves out.
+TEST(SpindleSync, CncdRefusesWhatWouldNeverFinish) {
+  EXPECT_EQ(run("G21 S500 M3\nG33 Z-1 K0\nM2\n").error,
+            "s.ngc:2:9: K word must be positive with G33 (the distance per revolution)");
+  EXPECT_EQ(run("G21 S500 M3\nG33.1 Z-1 K-1\nM2\n").error,
+            "s.ngc:2:11: K word must be positive with G33.1 (the distance per revolution)");
+  EXPECT_EQ(run("G21 M3\nG33 Z-1 K1\nM2\n").error,
+            "s.ngc:2: Cannot do G33 with zero spindle speed");
+  EXPECT_EQ(
+      run("G21 S500 M3\nG33.1 Z-1 A10 K1\nM2\n").error,
+      "s.ngc:2:11: Cannot move A, B, C, U, V or W with G33.1: the tap moves along X, Y and Z");
+  EXPECT_EQ(run("G21 S500 M3\nG33.1 Z-1 A0 K1\nM2\n").error, "");  // A stays where it is
+}
+
+}  // namespace
+}  // namespace cncd::interp
