@@ -108,8 +108,9 @@ void Interpreter::Impl::check_word_users(int motion) const {
   auto require = [&](char letter, bool used, const char* message) {
     if (b.has(letter) && !used) fail(message, b.col(letter));
   };
+  const bool css = b.g_code(GGroup::spindle_mode) == 960;
   const bool synced = motion == 330 || motion == 331;
-  require('d', false, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+  require('d', css, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
   require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
   require('i', arc || g10 || motion == 870 || motion == 331,
@@ -137,9 +138,13 @@ void Interpreter::Impl::check_word_users(int motion) const {
   check_spindle_words(motion);
 }
 
-// The word checks of G33/G33.1 that close LinuxCNC's list, in both dialects.
+// The word checks of G96 and G33/G33.1 that close LinuxCNC's list, in both dialects.
 void Interpreter::Impl::check_spindle_words(int motion) const {
   const Block& b = block_;
+  const int css = b.g_code(GGroup::spindle_mode);
+  if (css == 960 && !b.has('s')) {
+    fail("S word missing with G96", b.g_column[static_cast<std::size_t>(GGroup::spindle_mode)]);
+  }
   if (motion == 330 || motion == 331) {
     if (!b.has('k')) fail("K word missing with g33/g33.1");
     if (b.has('f')) fail("F word used with a g33/g33.1", b.col('f'));

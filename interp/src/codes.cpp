@@ -56,7 +56,7 @@ constexpr std::array kGCodes{
     GEntry{921, GGroup::non_modal, true},      GEntry{922, GGroup::non_modal, true},
     GEntry{923, GGroup::non_modal, true},      GEntry{930, GGroup::feed_mode, true},
     GEntry{940, GGroup::feed_mode, true},      GEntry{950, GGroup::feed_mode, true},
-    GEntry{960, GGroup::spindle_mode, false},  GEntry{970, GGroup::spindle_mode, true},
+    GEntry{960, GGroup::spindle_mode, true},   GEntry{970, GGroup::spindle_mode, true},
     GEntry{980, GGroup::retract, true},        GEntry{990, GGroup::retract, true},
 };
 

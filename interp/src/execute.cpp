@@ -3,6 +3,7 @@
 // compensation, tool length, coordinate system, path control, distance modes, retract mode,
 // non-modal codes, motion, stop.
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 
 #include "failure.hpp"
@@ -30,6 +31,7 @@ void Interpreter::Impl::execute_block() {
   }
   check_block();
   do_comment();
+  do_spindle_mode();
   do_feed_mode();
   do_tool_and_spindle();
   do_coolant_and_overrides();
@@ -61,6 +63,17 @@ void Interpreter::Impl::do_comment() {
   const std::string plain = first == std::string::npos ? std::string() : text.substr(first);
   probe_file_comment(plain);
   emit_comment(plain);
+}
+
+// G96 D.. S.. (constant surface speed, D the highest rpm) and G97, before the feed mode and
+// the speed as in LinuxCNC: SET_SPINDLE_MODE(max rpm), 0 for G97; without D, 1e30.
+void Interpreter::Impl::do_spindle_mode() {
+  const int code = block_.g_code(GGroup::spindle_mode);
+  if (code < 0) return;
+  modal_.css = code == 960;
+  modal_.css_max_rpm = 0;
+  if (modal_.css) modal_.css_max_rpm = block_.has('d') ? std::fabs(block_.get('d')) : 1e30;
+  emit(SetSpindleMode{modal_.css_max_rpm});
 }
 
 // (DEBUG, ...) text with #n and #<name> replaced by their values, as LinuxCNC does: six
@@ -394,6 +407,8 @@ void Interpreter::Impl::program_end_reset() {
   modal_.spindle = SpindleDir::stopped;
   emit(StopSpindleTurning{});
   emit(SetSpindleMode{0.0});
+  modal_.css = false;  // the canon is back in rpm mode (LinuxCNC's state keeps G96 here)
+  modal_.css_max_rpm = 0;
   if (modal_.mist) emit(MistOff{});
   if (modal_.flood) emit(FloodOff{});
   modal_.mist = modal_.flood = false;

@@ -47,6 +47,8 @@ struct ModalState {
   double feed_rate = 0;
   double speed = 0;
   SpindleDir spindle = SpindleDir::stopped;
+  bool css = false;        // G96: S is a surface speed (units per minute), G97: rpm
+  double css_max_rpm = 0;  // G96 D (absent: LinuxCNC's 1e30)
   bool mist = false;
   bool flood = false;
   bool feed_override = true;
@@ -197,6 +199,7 @@ struct Interpreter::Impl {
   void check_spindle_words(int motion) const;
   int motion_to_be() const;
   void do_comment();
+  void do_spindle_mode();
   std::string substitute_parameters(const std::string& text) const;
   std::optional<double> predefined_parameter(std::string_view name) const;
   void publish_parameters();

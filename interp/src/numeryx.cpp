@@ -35,6 +35,7 @@ double loop_slack(double end) {
 void Interpreter::Impl::execute_numeryx_block() {
   check_numeryx_block();
   do_comment();
+  do_spindle_mode();
   do_feed_mode();
   do_tool_and_spindle();
   do_coolant_and_overrides();
@@ -101,7 +102,8 @@ void Interpreter::Impl::check_numeryx_block() const {
   const std::string cycle_hint =
       " (a drilling cycle's R, Z, Q and D are written after the "
       "cycle word: g81 r.. z..)";
-  require('d', false, "D word with no drilling cycle to use it" + cycle_hint);
+  require('d', b.g_code(GGroup::spindle_mode) == 960,
+          "D word with no drilling cycle or G96 to use it" + cycle_hint);
   require('e', io >= 66, "E word with no M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 to use it");
   require('i', arc || b.nx_polar || synced == 331, "I word with no g2, g3, g10 or g33.1 to use it");

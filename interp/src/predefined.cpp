@@ -155,7 +155,9 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
     case Name::retract_old_z:
       return flag(!modal_.retract_r_plane);
     case Name::spindle_rpm_mode:
-      return 1.0;
+      return flag(!modal_.css);
+    case Name::spindle_css_mode:
+      return flag(modal_.css);
     case Name::ijk_absolute_mode:
       return flag(!modal_.arc_incremental);
     case Name::lathe_radius_mode:

@@ -46,7 +46,7 @@ InterpState Interpreter::state() const {
   g[9] = m.tool_length_code != 490 || any_nonzero(s.tool_offset_) ? 430 : 490;
   g[10] = m.retract_r_plane ? 990 : 980;
   g[11] = path_control_code(m.control);
-  g[13] = 970;  // constant surface speed (G96) is not supported
+  g[13] = m.css ? 960 : 970;
   g[14] = m.arc_incremental ? 911 : 901;
   g[15] = 80;  // lathe diameter mode (G7) is not supported
   if (s.parameters_.get(5210) == 1.0) g[16] = 923;

@@ -515,9 +515,10 @@ TEST(Numeryx, ErrorsNameTheLineAndWhatIsWrong) {
   EXPECT_EQ(error_of("g x0 y0 z10 r2 f100 g81 z-5\nm30\n"),
             "nx.ngc:2:13: R word with no g2, g3 or g10 to use it (a drilling cycle's R, Z, Q "
             "and D are written after the cycle word: g81 r.. z..)");
-  EXPECT_EQ(error_of("g x0 d2\nm30\n"),
-            "nx.ngc:2:6: D word with no drilling cycle to use it (a drilling cycle's R, Z, Q "
-            "and D are written after the cycle word: g81 r.. z..)");
+  EXPECT_EQ(
+      error_of("g x0 d2\nm30\n"),
+      "nx.ngc:2:6: D word with no drilling cycle or G96 to use it (a drilling cycle's R, Z, Q "
+      "and D are written after the cycle word: g81 r.. z..)");
   EXPECT_EQ(error_of("g x0 y0 z10 f100 g87 r2 z-5\nm30\n"),
             "nx.ngc:2:18: g87 is no Numeryx drilling cycle (g73, g74, g81 to g86; g80 cancels)");
   EXPECT_EQ(error_of("g x0 y0 z10 g81 r2 z-5\nm30\n"), "nx.ngc:2: Cannot feed with zero feed rate");

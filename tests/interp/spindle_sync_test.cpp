@@ -1,5 +1,5 @@
-// G33 and G33.1: the typed commands and cncd's own checks. The canon rs274 gives is in the goldens
-// (tests/golden/sync_*, error_sync_*).
+// G33, G33.1 and G96/G97: the typed commands and cncd's own checks. The canon rs274 gives is in the
+// goldens (tests/golden/sync_*, css_*, error_sync_*, error_css_*).
 #include <gtest/gtest.h>
 
 #include <optional>
@@ -120,6 +120,24 @@ TEST(SpindleSync, CncdRefusesWhatWouldNeverFinish) {
       run("G21 S500 M3\nG33.1 Z-1 A10 K1\nM2\n").error,
       "s.ngc:2:11: Cannot move A, B, C, U, V or W with G33.1: the tap moves along X, Y and Z");
   EXPECT_EQ(run("G21 S500 M3\nG33.1 Z-1 A0 K1\nM2\n").error, "");  // A stays where it is
+}
+
+// --- G96 and G97 --------------------------------------------------------------------------
+
+TEST(SpindleSync, G96SetsTheSpindleModeAndTheStateShowsIt) {
+  Interpreter interp;
+  ASSERT_FALSE(
+      interp.open_string("G21\nG96 D2500 S120\nG96 S100\nG97 S800\nG96 S90\nM2\n", "c.ngc"));
+  Recorder r;
+  std::vector<int> modes;
+  while (interp.step(r) == Interpreter::Step::block)
+    modes.push_back(interp.state().gcodes[13]);
+  modes.push_back(interp.state().gcodes[13]);
+  EXPECT_EQ(modes, (std::vector<int>{970, 960, 960, 970, 960, 970}));
+  std::vector<double> max_rpm;
+  for (const auto& m : r.all<SetSpindleMode>())
+    max_rpm.push_back(m.css_max_rpm);
+  EXPECT_EQ(max_rpm, (std::vector<double>{2500, 1e30, 0, 1e30, 0}));  // the last: M2
 }
 
 }  // namespace
