@@ -11,6 +11,9 @@ namespace {
 
 // "G41.1 is not supported"; `code` is ten times the number.
 std::string not_supported(char letter, int code) {
+  if (letter == 'G' && code == 760) {
+    return "G76 is not supported: threading cycles are for lathe mode, which cncd does not have";
+  }
   char text[48];
   if (code % 10 != 0) {
     std::snprintf(text, sizeof text, "%c%d.%d is not supported", letter, code / 10, code % 10);
