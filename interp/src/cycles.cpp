@@ -208,6 +208,10 @@ void Interpreter::Impl::cycle_body(int code, const CycleGeometry& g, double a, d
       dwell(cycle_.p);
     }
   };
+  if ((code == 740 || code == 840) && tapping_is_rigid(code)) {
+    rigid_tap_hole(code, g, a, b, current_c);
+    return;
+  }
   const bool needs_spindle =
       code == 740 || code == 840 || code == 860 || code == 870 || code == 880;
   if (needs_spindle && modal_.spindle == SpindleDir::stopped) {

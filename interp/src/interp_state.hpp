@@ -227,8 +227,10 @@ struct Interpreter::Impl {
   // Writes #5061-#5069 as a line of the open probe file; Failure when it cannot.
   void write_probe_line();
 
-  // spindle_sync.cpp: G33 and G33.1.
+  // spindle_sync.cpp: G33, G33.1 and rigid tapping in canned cycles.
   void do_spindle_synced(int code);
+  bool tapping_is_rigid(int code) const;
+  void rigid_tap_hole(int code, const CycleGeometry& g, double a, double b, double& current_c);
 
   // motion.cpp
   void do_motion();

@@ -50,13 +50,6 @@ void Interpreter::Impl::execute_numeryx_block() {
 void Interpreter::Impl::check_numeryx_block() const {
   const Block& b = block_;
   check_supported_codes();
-  if (b.nx_cycle == 740) {
-    fail(
-        "g74 is rigid tapping: it needs the tap's Z to follow the spindle's position "
-        "(spindle-synchronized motion), which this machine cannot do; tap with g84 and a "
-        "floating holder",
-        b.nx_cycle_column);
-  }
   if (b.nx_polar) {
     for (const char letter : {'x', 'y'}) {
       if (b.has(letter)) {

@@ -337,8 +337,9 @@ TEST(Numeryx, BoringFeedsOutToR1AndG86StopsTheSpindle) {
   EXPECT_EQ(*(bottom + 3), "START_SPINDLE_CLOCKWISE(0)");
 }
 
-// "G84 is used for flexible tapping": LinuxCNC's cycle from R1; g74 is rigid tapping.
-TEST(Numeryx, G84IsFlexibleTappingAndG74IsRefused) {
+// "G84 is used for flexible tapping and either g84 or g74 for rigid tapping": g84 is
+// LinuxCNC's floating cycle from R1 unless the machine taps rigidly (rigid_tapping).
+TEST(Numeryx, G84IsFlexibleTappingUnlessTheMachineTapsRigidly) {
   Outcome r = run("(dialect numeryx)\ns300 m3\ng x0 y0 z10 f375 g84 r0 z-8\ng80\nm30\n");
   ASSERT_FALSE(r.error) << r.error->to_string();
   const auto& all = r.recorder.all;
@@ -349,10 +350,88 @@ TEST(Numeryx, G84IsFlexibleTappingAndG74IsRefused) {
   EXPECT_EQ(*(bottom + 2), "START_SPINDLE_COUNTERCLOCKWISE(0)");
   EXPECT_EQ(*(bottom + 3), "STRAIGHT_FEED(0.0000, 0.0000, 10.0000, 0.0000, 0.0000, 0.0000)");
   EXPECT_EQ(error_of("g x0 y0 z10 f100 g84 r0 z-8\nm30\n"), "nx.ngc:2: Spindle not turning in G84");
-  EXPECT_EQ(error_of("s300 m3\ng x0 y0 z10 f1.25 g74 r0 z-8\nm30\n"),
-            "nx.ngc:3:19: g74 is rigid tapping: it needs the tap's Z to follow the spindle's "
-            "position (spindle-synchronized motion), which this machine cannot do; tap with "
-            "g84 and a floating holder");
+
+  InterpOptions options;
+  options.rigid_tapping = true;
+  Outcome rigid =
+      run("(dialect numeryx)\ns300 m3\ng x0 y0 z10 f1250 g84 r0 z-8\ng80\nm30\n", options);
+  ASSERT_FALSE(rigid.error) << rigid.error->to_string();
+  EXPECT_NE(std::find(rigid.recorder.all.begin(), rigid.recorder.all.end(),
+                      "RIGID_TAP(0.0000, 0.0000, -8.0000)"),
+            rigid.recorder.all.end());
+}
+
+// The lines of a program from its first START_SPEED_FEED_SYNC (or the spindle's start before
+// it) up to g80 or m30, without the SET_ commands.
+std::vector<std::string> tap_lines(const std::string& program) {
+  Outcome r = run("(dialect numeryx)\n" + program);
+  EXPECT_FALSE(r.error) << r.error->to_string();
+  const auto& all = r.recorder.all;
+  auto from = std::find_if(all.begin(), all.end(), [](const std::string& line) {
+    return line.starts_with("START_SPEED_FEED_SYNC");
+  });
+  if (from != all.begin() && from != all.end() && (from - 1)->starts_with("START_SPINDLE")) --from;
+  const auto to = std::find_if(from, all.end(), [](const std::string& line) {
+    return line == "COMMENT(\"interpreter: retract mode set to old_z\")" ||
+           line.starts_with("SET_G5X_OFFSET");  // m30
+  });
+  std::vector<std::string> lines(from, to);
+  std::erase_if(lines, [](const std::string& line) { return line.starts_with("SET_"); });
+  return lines;
+}
+
+// g74 is rigid tapping, right hand: no M3 needed (a spindle at rest turns for the hole and
+// stops after it), F the pitch in thousandths of the program's unit as the note's table writes
+// it (f1250 = 1.25 mm), from R1 down and back, then to Zi (g98).
+TEST(Numeryx, G74IsRigidTappingWithThePitchInThousandths) {
+  EXPECT_EQ(tap_lines("s500\ng x0 y0 z10 f1250 g74 r0 z-8\ng80\nm30\n"),
+            (std::vector<std::string>{
+                "START_SPINDLE_CLOCKWISE(0)",
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(0.0000, 0.0000, -8.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "STRAIGHT_TRAVERSE(0.0000, 0.0000, 10.0000, 0.0000, 0.0000, 0.0000)",
+                "STOP_SPINDLE_TURNING(0)",
+            }));
+  // Turning already (M3): it keeps turning. g99 comes back to R1 only.
+  EXPECT_EQ(tap_lines("s500 m3\ng99\ng x0 y0 z10 f1250 g74 r0 z-8\nx5\ng80\nm30\n"),
+            (std::vector<std::string>{
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(0.0000, 0.0000, -8.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "STRAIGHT_TRAVERSE(5.0000, 0.0000, 1.0000, 0.0000, 0.0000, 0.0000)",
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(5.0000, 0.0000, -8.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+            }));
+  // The note's pitch table: inch f125 = 0.125 in, f=1000/13 = 13 TPI, f=1250/25.4 = 1.25 mm;
+  // metric f=25400/13 = 13 TPI, f=125*25.4 = 0.125 in.
+  const std::vector<std::pair<std::string, std::string>> table{
+      {"g20\ns500\ng x0 y0 z1 f125 g74 r0 z-.5\n", "START_SPEED_FEED_SYNC(0.125000,0)"},
+      {"g20\ns500\ng x0 y0 z1 f=1000/13 g74 r0 z-.5\n", "START_SPEED_FEED_SYNC(0.076923,0)"},
+      {"g20\ns500\ng x0 y0 z1 f=1250/25.4 g74 r0 z-.5\n", "START_SPEED_FEED_SYNC(0.049213,0)"},
+      {"s500\ng x0 y0 z10 f=25400/13 g74 r0 z-8\n", "START_SPEED_FEED_SYNC(1.953846,0)"},
+      {"s500\ng x0 y0 z10 f=125*25.4 g74 r0 z-8\n", "START_SPEED_FEED_SYNC(3.175000,0)"},
+  };
+  for (const auto& [program, synch] : table) {
+    const auto lines = tap_lines(program + "g80\nm30\n");
+    ASSERT_GE(lines.size(), 2U) << program;
+    EXPECT_EQ(lines[1], synch) << program;
+  }
+}
+
+TEST(Numeryx, RigidTappingErrorsSayWhatIsWrong) {
+  EXPECT_EQ(error_of("s500\ng x0 y0 z10 f1.25 g74 r0 z-8\nm30\n"),
+            "nx.ngc:3:13: Tapping pitch F1.25 is 0.00125 mm per revolution: in the Numeryx "
+            "dialect F gives the pitch in thousandths of a mm (f1250 = 1.25 mm)");
+  EXPECT_EQ(error_of("g20\ns500\ng x0 y0 z1 f.125 g74 r0 z-.5\nm30\n"),
+            "nx.ngc:4:12: Tapping pitch F0.125 is 0.000125 in per revolution: in the Numeryx "
+            "dialect F gives the pitch in thousandths of an inch (f125 = 0.125 in)");
+  EXPECT_EQ(error_of("g x0 y0 z10 f1250 g74 r0 z-8\nm30\n"),
+            "nx.ngc:2: Cannot do rigid tapping with zero spindle speed in g74");
+  EXPECT_EQ(error_of("s500 m4\ng x0 y0 z10 f1250 g74 r0 z-8\nm30\n"),
+            "nx.ngc:3: Spindle turning counterclockwise in g74: Numeryx taps right-hand with g74 "
+            "and g84");
 }
 
 // --- syntax -------------------------------------------------------------------------------

@@ -1,5 +1,6 @@
-// G33, G33.1 and G96/G97: the typed commands and cncd's own checks. The canon rs274 gives is in the
-// goldens (tests/golden/sync_*, css_*, error_sync_*, error_css_*).
+// G33, G33.1, rigid G84/G74 (InterpOptions::rigid_tapping) and G96/G97: the typed commands,
+// cncd's own checks and what rs274 cannot run. The canon rs274 gives is in the goldens
+// (tests/golden/sync_*, css_*, error_sync_*, error_css_*).
 #include <gtest/gtest.h>
 
 #include <optional>
@@ -51,6 +52,12 @@ Outcome run(const std::string& program, InterpOptions options = {}) {
   if (!error) error = run_program(interp, out.recorder);
   if (error) out.error = error->to_string();
   return out;
+}
+
+InterpOptions rigid() {
+  InterpOptions options;
+  options.rigid_tapping = true;
+  return options;
 }
 
 // --- G33 and G33.1 ------------------------------------------------------------------------
@@ -138,6 +145,108 @@ TEST(SpindleSync, G96SetsTheSpindleModeAndTheStateShowsIt) {
   for (const auto& m : r.all<SetSpindleMode>())
     max_rpm.push_back(m.css_max_rpm);
   EXPECT_EQ(max_rpm, (std::vector<double>{2500, 1e30, 0, 1e30, 0}));  // the last: M2
+}
+
+// --- rigid tapping in canned cycles -------------------------------------------------------
+
+TEST(RigidTapping, G84TapsInStepWithTheSpindleFromR) {
+  const auto out =
+      run("G21 G95 S500 M3\nG0 X0 Y0 Z10\nG98 G84 X1 Y2 Z-5 R2 F1.25\nG80\nM2\n", rigid());
+  ASSERT_EQ(out.error, "");
+  EXPECT_EQ(out.recorder.from("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)"),
+            (std::vector<std::string>{
+                "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)",
+                "STRAIGHT_TRAVERSE(1.0000, 2.0000, 10.0000)",
+                "STRAIGHT_TRAVERSE(1.0000, 2.0000, 2.0000)",
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(1.0000, 2.0000, -5.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "STRAIGHT_TRAVERSE(1.0000, 2.0000, 10.0000)",
+                "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)",
+                "SET_NAIVECAM_TOLERANCE(0.0000)",
+                "COMMENT(\"interpreter: motion mode set to none\")",
+                "SET_G5X_OFFSET(1, 0.0000, 0.0000, 0.0000)",
+                "SET_XY_ROTATION(0.0000)",
+                "SET_FEED_MODE(0, 0)",
+                "SET_FEED_RATE(0.0000)",
+                "STOP_SPINDLE_TURNING(0)",
+                "SET_SPINDLE_MODE(0 0.0000)",
+                "PROGRAM_END()",
+            }));
+}
+
+// Without the option, G84 stays LinuxCNC's floating cycle.
+TEST(RigidTapping, OffByDefault) {
+  const auto out = run("G21 G95 S500 M3\nG0 X0 Y0 Z10\nG84 X1 Y2 Z-5 R2 F1.25\nG80\nM2\n");
+  ASSERT_EQ(out.error, "");
+  EXPECT_TRUE(out.recorder.all<RigidTap>().empty());
+  EXPECT_TRUE(out.recorder.all<StartSpeedFeedSynch>().empty());
+}
+
+// G94: the pitch is F/S. G99 comes back to R only; L repeats step in G91; G74 taps with M4.
+TEST(RigidTapping, PitchInG94RepeatsAndG74) {
+  const auto out =
+      run("G21 G94 S400 M3 F500\nG0 X0 Y0 Z10\nG91 G99 G84 X10 Z-7 R-8 L2\nG80 G90\n"
+          "M4\nG74 X0 Y0 Z-3 R1\nM2\n",
+          rigid());
+  ASSERT_EQ(out.error, "");
+  EXPECT_EQ(out.recorder.from("START_SPEED_FEED_SYNC"),
+            (std::vector<std::string>{
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(10.0000, 0.0000, -5.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "STRAIGHT_TRAVERSE(20.0000, 0.0000, 2.0000)",
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(20.0000, 0.0000, -5.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)",
+                "SET_NAIVECAM_TOLERANCE(0.0000)",
+                "COMMENT(\"interpreter: distance mode changed to absolute\")",
+                "COMMENT(\"interpreter: motion mode set to none\")",
+                "START_SPINDLE_COUNTERCLOCKWISE(0)",
+                "SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)",
+                "STRAIGHT_TRAVERSE(0.0000, 0.0000, 2.0000)",
+                "STRAIGHT_TRAVERSE(0.0000, 0.0000, 1.0000)",
+                "START_SPEED_FEED_SYNC(1.250000,0)",
+                "RIGID_TAP(0.0000, 0.0000, -3.0000)",
+                "STOP_SPEED_FEED_SYNCH()",
+                "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)",
+                "SET_NAIVECAM_TOLERANCE(0.0000)",
+                "SET_G5X_OFFSET(1, 0.0000, 0.0000, 0.0000)",
+                "SET_XY_ROTATION(0.0000)",
+                "SET_FEED_MODE(0, 0)",
+                "SET_FEED_RATE(0.0000)",
+                "STOP_SPINDLE_TURNING(0)",
+                "SET_SPINDLE_MODE(0 0.0000)",
+                "PROGRAM_END()",
+            }));
+}
+
+TEST(RigidTapping, TheSpindleMustTurnTheTapsWay) {
+  auto error_of = [](const std::string& program) { return run(program, rigid()).error; };
+  EXPECT_EQ(error_of("G21 G94 M3 F500\nG84 X1 Z-5 R2\nM2\n"),
+            "s.ngc:2: Cannot do rigid tapping with zero spindle speed in G84: the pitch is F/S in "
+            "G94");
+  EXPECT_EQ(error_of("G21 G95 M3 F1\nG84 X1 Z-5 R2\nM2\n"),
+            "s.ngc:2: Cannot do rigid tapping with zero spindle speed in G84");
+  EXPECT_EQ(error_of("G21 S100 F500\nG84 X1 Z-5 R2\nM2\n"), "s.ngc:2: Spindle not turning in G84");
+  EXPECT_EQ(error_of("G21 S100 M4 F500\nG84 X1 Z-5 R2\nM2\n"),
+            "s.ngc:2: Spindle turning counterclockwise in G84");
+  EXPECT_EQ(error_of("G21 S100 M3 F500\nG74 X1 Z-5 R2\nM2\n"),
+            "s.ngc:2: Spindle turning clockwise in G74");
+  EXPECT_EQ(error_of("G21 G96 S100 M3 F500\nG84 X1 Z-5 R2\nM2\n"),
+            "s.ngc:2: Cannot do rigid tapping in G84 with constant surface speed: the pitch is "
+            "F/S in G94, with S in rpm (G97)");
+  EXPECT_EQ(error_of("G21 G93 S100 M3\nG84 X1 Z-5 R2 F2\nM2\n"),
+            "s.ngc:2: Cannot use inverse time feed with canned cycles");
+}
+
+// A dwell at the bottom has no place in a rigid tap: the machine reverses there.
+TEST(RigidTapping, NoDwellAtTheBottom) {
+  const auto out = run("G21 G95 S500 M3 F1\nG84 X1 Z-5 R2 P0.5\nM2\n", rigid());
+  ASSERT_EQ(out.error, "");
+  EXPECT_TRUE(out.recorder.all<Dwell>().empty());
+  EXPECT_EQ(out.recorder.all<RigidTap>().size(), 1U);
 }
 
 }  // namespace

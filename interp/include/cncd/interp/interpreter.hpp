@@ -66,6 +66,11 @@ struct InterpOptions {
   // O-word loop iterations in a row without a move or dwell before the program is rejected as
   // an endless loop (LinuxCNC would spin forever).
   std::uint64_t max_loops_without_motion = 1'000'000;
+  // [RS274NGC] RIGID_TAPPING: G84 and G74 tap in step with the spindle (StartSpeedFeedSynch,
+  // RigidTap, StopSpeedFeedSynch per hole, the pitch F in G95 and F/S in G94) instead of
+  // LinuxCNC's floating-holder cycle; in the Numeryx dialect g84 (its g74 always is). Whether
+  // the machine can (spindle position feedback) is for its configuration to say.
+  bool rigid_tapping = false;
 };
 
 // What the interpreter holds between blocks, for status displays. Lengths in machine units,
