@@ -201,6 +201,15 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             probe_seen = true;
             return true;
           },
+          [&](const in::SetSpindleMode& c) {
+            if (c.css_max_rpm > 0 && !unsupported) {
+              unsupported =
+                  Unsupported{m.line,
+                              "constant surface speed (G96) is not available: the spindle turns at "
+                              "the rpm S gives (G97)"};
+            }
+            return false;
+          },
           [&](const in::StartSpeedFeedSynch&) {
             if (!unsupported) {
               unsupported =
