@@ -206,7 +206,7 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   interp::Pose position{};
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
   interp_->set_machine_position(position);
-  feeder_->start_program(&status.commanded);
+  feeder_->start_program(&status.commanded, mode == Mode::mdi);
   path_errors_base_ = status.path_errors;
   input_wait_pending_ = false;
   input_waits_seen_ = status.input_waits;

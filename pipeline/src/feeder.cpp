@@ -7,12 +7,13 @@
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
-void ProgramFeeder::start_program(const motion::AxisPose* at) {
+void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   pending.clear();
   stop_seen = false;
   input_wait_seen = false;
   probe_seen = false;
   unsupported.reset();
+  if (!mdi) per_revolution_ = false;
   holds.clear();
   sync_ = {};
   need_at_speed_ = false;
@@ -161,7 +162,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           [&](const in::StraightFeed& c) {
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
-            move.feed = tracker_.feed_per_minute() / 60.0;
+            move.feed = feed_per_second();
             moving(move);
             return true;
           },
@@ -169,7 +170,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             move.kind = motion::Move::Kind::arc;
             const in::Pose end = c.end();
             std::copy(end.begin(), end.end(), move.end.begin());
-            move.feed = tracker_.feed_per_minute() / 60.0;
+            move.feed = feed_per_second();
             move.plane_axes = plane_axes(c.plane);
             move.center_first = c.first_axis;
             move.center_second = c.second_axis;
@@ -182,7 +183,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             add_stop_point();
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
-            move.feed = tracker_.feed_per_minute() / 60.0;
+            move.feed = feed_per_second();
             switch (c.kind) {
               case in::ProbeKind::toward_or_error:
                 move.probe = motion::ProbeMode::toward_or_error;
@@ -200,6 +201,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             moving(move);
             probe_seen = true;
             return true;
+          },
+          [&](const in::SetFeedMode& c) {
+            per_revolution_ = c.mode == in::FeedRateMode::per_revolution;
+            return false;
           },
           [&](const in::SetSpindleMode& c) {
             if (c.css_max_rpm > 0 && !unsupported) {
@@ -330,6 +335,12 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   move.tolerance = tolerance_;
   move.merge_tolerance = path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
   pending.push_back(move);
+}
+
+double ProgramFeeder::feed_per_second() const {
+  const double f = tracker_.feed_per_minute();
+  // G95: F per revolution at the programmed speed (the interpreter refuses it at S 0).
+  return (per_revolution_ ? f * spindle_speed : f) / 60.0;
 }
 
 Drained ProgramFeeder::drain(MoveTarget& target) {

@@ -55,6 +55,14 @@ TEST_F(PlanSimTest, AStraightFeedTakesItsTrapezoidAndStaysWithinTheLimits) {
   EXPECT_EQ(r.move_line[0], 2);
 }
 
+// G95: F per revolution at the programmed speed: 0.1 mm x 600 rpm = 1 mm/s over 10 mm.
+TEST_F(PlanSimTest, FeedPerRevolutionRunsAtFTimesTheSpindleSpeed) {
+  const auto r = simulate("G21 G90\nS600 M3\nG95 G1 X10 F0.1\nG94 G1 X20 F600\nM2\n");
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+  EXPECT_NEAR(r.feed_bound_s, 10.0 + 1.0, 1e-9);
+  EXPECT_NEAR(r.peak_velocity[0], 10.0, 1e-6);  // the G94 move; the G95 one at 1 mm/s
+}
+
 TEST_F(PlanSimTest, RapidsRunAtTheFastestSpeedTheAxesAllowAlongThem) {
   // Diagonal: each axis would allow 200 * sqrt(2) mm/s, [TRAJ] MAX_LINEAR_VELOCITY caps at 250.
   const auto r = simulate("G21 G90\nG0 X100 Y100\nM2\n");

@@ -58,7 +58,9 @@ class ProgramFeeder final : public interp::CanonSink {
   void on_warning(MessageHandler handler) { on_warning_ = std::move(handler); }
   // Resets what a new program run must not inherit; `at` is where the machine stands
   // (machine coordinates), when known.
-  void start_program(const motion::AxisPose* at = nullptr);
+  // An MDI block (`mdi`) keeps the feed mode the interpreter keeps for it; a program starts in
+  // G94, as the interpreter does.
+  void start_program(const motion::AxisPose* at = nullptr, bool mdi = false);
   // Puts the spindle and coolant as the program has left them in front of the pending moves
   // (run from line: the lines skipped set them).
   void restore_io_state();
@@ -116,6 +118,10 @@ class ProgramFeeder final : public interp::CanonSink {
   // Warns when the spindle's limits clamp the speed the program sets (once per speed).
   void check_speed(int line);
   double warned_rpm_ = -1;
+  // The feed of the next feed move, machine units per second: F, or under G95 F per revolution
+  // times the programmed spindle speed.
+  double feed_per_second() const;
+  bool per_revolution_ = false;  // G95
   // M62/M63/M67 waiting for the next move.
   motion::SyncOutputs sync_{};
   // M3/M4 or S changed the spindle: the next feed move waits until it is at speed.
