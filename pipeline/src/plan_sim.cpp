@@ -150,8 +150,7 @@ class Simulation final : MoveTarget {
         return false;
       }
       if (feeder_.unsupported) {
-        result_.error =
-            CheckProblem{program_, feeder_.unsupported->line, feeder_.unsupported->why};
+        result_.error = CheckProblem{program_, feeder_.unsupported->line, feeder_.unsupported->why};
         return false;
       }
       // M0/M1/M60 wait for the operator: the estimate leaves that time out, but the machine
