@@ -6,6 +6,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 scripts/setup.sh
+# Rebuilds reuse compiled objects through ccache, also from another checkout of the same tree:
+# paths under the checkout are hashed relative to it.
+if command -v ccache >/dev/null && [[ -z "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ]]; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CMAKE_C_COMPILER_LAUNCHER=ccache
+  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
+fi
 presets=("$@")
 ((${#presets[@]} > 0)) || presets=(dev)
 for preset in "${presets[@]}"; do
