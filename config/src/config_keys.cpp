@@ -115,6 +115,9 @@ constexpr std::array kKeys{
     positive_key("RS274NGC", "NUMERYX_CLEARANCE", "", "units",
                  "Numeryx dialect: the height above R a cycle starts its feed at (R1 = R + "
                  "clearance); unset: 1 mm in a G21 program, 0.04 in in a G20 one"),
+    bool_key("RS274NGC", "RIGID_TAPPING", "0",
+             "G84 and G74 tap in step with the spindle (pitch F in G95, F/S in G94), as Fanuc "
+             "and Numeryx machines do; 0: LinuxCNC's floating-holder cycles"),
     path_key("EMCIO", "TOOL_TABLE", "", "Tool table file"),
     text_key("EMCIO", "TOOL_CHANGE_POSITION", "",
              "Machine position M6 moves to before the tool change: 3 (X Y Z), 6 (X Y Z A B C) "

@@ -189,6 +189,9 @@ std::string describe(const MachineConfig& c) {
   line(out, "Numeryx clearance: " +
                 (c.numeryx_clearance ? num(*c.numeryx_clearance) + " " + lu
                                      : std::string("1 mm in G21 programs, 0.04 in in G20 ones")));
+  line(out, std::string("Tapping:      G84/G74 ") +
+                (c.rigid_tapping ? "rigid, in step with the spindle ([RS274NGC] RIGID_TAPPING)"
+                                 : "with a floating holder, as LinuxCNC"));
   for (const auto& dir : c.subroutine_path)
     line(out, "Subroutines:  " + dir.string());
   for (const auto& dir : c.program_dirs)

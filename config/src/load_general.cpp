@@ -222,6 +222,7 @@ void load_general(TypedReader& r, MachineConfig& c) {
     c.dialect = *v == "numeryx" ? Dialect::numeryx : Dialect::linuxcnc;
   }
   c.numeryx_clearance = r.real("RS274NGC", "NUMERYX_CLEARANCE");
+  c.rigid_tapping = r.boolean("RS274NGC", "RIGID_TAPPING").value_or(false);
 
   load_coordinates(r, c);
   load_linear_units(r, c);

@@ -26,6 +26,7 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   options.dialect = config.dialect == config::Dialect::numeryx ? interp::Dialect::numeryx
                                                                : interp::Dialect::linuxcnc;
   options.numeryx_clearance = config.numeryx_clearance;
+  options.rigid_tapping = config.rigid_tapping;
   return options;
 }
 

@@ -1,5 +1,5 @@
-// [RS274NGC] DIALECT and NUMERYX_CLEARANCE: read, defaulted, refused at their FILE:LINE, and
-// shown in the --check-config summary.
+// [RS274NGC] DIALECT, NUMERYX_CLEARANCE and RIGID_TAPPING: read, defaulted, refused at their
+// FILE:LINE, and shown in the --check-config summary.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -95,6 +95,28 @@ TEST_F(DialectConfigTest, ClearanceMustBeAPositiveNumber) {
                        "greater than 0 units"));
   EXPECT_EQ(problems_of(minimal_ini() + "[RS274NGC]\nNUMERYX_CLEARANCE = 1 mm\n"),
             problem_at(kFirst + 1, "[RS274NGC] NUMERYX_CLEARANCE: '1 mm' is not a number"));
+}
+
+TEST_F(DialectConfigTest, RigidTappingIsOffUnlessAsked) {
+  const KeySpec* rigid = find_key_spec("RS274NGC", "RIGID_TAPPING");
+  ASSERT_NE(rigid, nullptr);
+  EXPECT_EQ(rigid->type, KeyType::boolean);
+  EXPECT_EQ(rigid->default_value, "0");
+  const MachineConfig floating = loaded("");
+  EXPECT_FALSE(floating.rigid_tapping);
+  EXPECT_NE(
+      describe(floating).find("\nTapping:      G84/G74 with a floating holder, as LinuxCNC\n"),
+      std::string::npos);
+  const MachineConfig rigid_machine = loaded("[RS274NGC]\nRIGID_TAPPING = YES\n");
+  EXPECT_TRUE(rigid_machine.rigid_tapping);
+  EXPECT_NE(describe(rigid_machine)
+                .find("\nTapping:      G84/G74 rigid, in step with the spindle ([RS274NGC] "
+                      "RIGID_TAPPING)\n"),
+            std::string::npos);
+  EXPECT_EQ(problems_of(minimal_ini() + "[RS274NGC]\nRIGID_TAPPING = sometimes\n"),
+            problem_at(kFirst + 1,
+                       "[RS274NGC] RIGID_TAPPING: 'sometimes' is not a yes/no value (use 1/0, "
+                       "YES/NO, TRUE/FALSE)"));
 }
 
 }  // namespace

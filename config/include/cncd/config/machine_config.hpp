@@ -235,6 +235,8 @@ struct MachineConfig {
   // NUMERYX_CLEARANCE, machine units (R1 = R + clearance in Numeryx cycles); unset: the
   // interpreter's default (1 mm in a G21 program, 0.04 in in a G20 one).
   std::optional<double> numeryx_clearance;
+  // RIGID_TAPPING: G84/G74 are rigid (in step with the spindle) instead of floating.
+  bool rigid_tapping = false;
   // [EMCIO]
   std::filesystem::path tool_table;
   std::filesystem::path tool_table_seed;
