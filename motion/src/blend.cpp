@@ -47,7 +47,8 @@ bool Planner::push(const Move& move, bool check_limits, std::string& error) {
   auto planned = plan(move, end_, check_limits, error);
   if (!planned) return false;
   const AxisPose start = end_;
-  end_ = planned->end;
+  // A tap goes down its line and back: the next move starts where it started.
+  end_ = planned->spindle_sync == SpindleSync::tap ? start : planned->end;
   if (merge_ && extends_merge(move, *planned)) {
     merge_->points.push_back(merge_->move.end);
     merge_->move.end = planned->end;
@@ -65,9 +66,10 @@ bool Planner::push(const Move& move, bool check_limits, std::string& error) {
 }
 
 bool Planner::mergeable(const Move& move, const Segment& seg) const {
-  return move.kind == Move::Kind::feed && !move.sync.any() &&
-         move.path_mode == Move::PathMode::blend && move.merge_tolerance > 0 &&
-         seg.kind == Segment::Kind::line && seg.length > 0 && euclidean(seg);
+  return move.kind == Move::Kind::feed && !move.sync.any() && move.probe == ProbeMode::none &&
+         move.spindle_sync == SpindleSync::none && move.path_mode == Move::PathMode::blend &&
+         move.merge_tolerance > 0 && seg.kind == Segment::Kind::line && seg.length > 0 &&
+         euclidean(seg);
 }
 
 bool Planner::extends_merge(const Move& move, const Segment& seg) const {

@@ -35,20 +35,97 @@ void MachineIo::update_command() noexcept {
     spindle_.actual_rpm = rpm;
     spindle_.at_speed = true;
   }
+  if (tapping_) apply_tap();
+}
+
+void MachineIo::apply_tap() noexcept {
+  const double rpm = std::abs(tap_rps_) * 60.0;
+  spindle_.enabled = spindle_.present;
+  spindle_.commanded_rpm = rpm;
+  out_.spindle.enable = spindle_.present;
+  out_.spindle.reverse = tap_rps_ < 0;
+  out_.spindle.rpm = rpm;
+  if (ideal_) spindle_.actual_rpm = rpm;
 }
 
 void MachineIo::feedback(const drivers::IoFeedback& in) noexcept {
   in_ = in;
   io_.dins = in.digital;
   io_.ains = in.analog;
+  const double commanded_rps =
+      !out_.spindle.enable ? 0.0 : (out_.spindle.reverse ? -1.0 : 1.0) * out_.spindle.rpm / 60.0;
   if (in.spindle.present && !ideal_) {
     spindle_.actual_rpm = std::isfinite(in.spindle.rpm) ? std::abs(in.spindle.rpm) : 0.0;
     spindle_.has_position = in.spindle.has_position;
-    spindle_.revolutions = in.spindle.revolutions;
+    spindle_.revolutions = std::isfinite(in.spindle.revolutions) ? in.spindle.revolutions : 0.0;
+    if (spindle_.has_position && has_last_revolutions_) {
+      spindle_rps_ = (spindle_.revolutions - last_revolutions_) / period_s_;
+    } else {
+      // No position: the speed it reports, in the direction it was told.
+      spindle_rps_ = std::copysign(spindle_.actual_rpm / 60.0, commanded_rps);
+    }
+    has_last_revolutions_ = spindle_.has_position;
+    last_revolutions_ = spindle_.revolutions;
   } else {
     spindle_.actual_rpm = spindle_.commanded_rpm;
+    // The ideal spindle is where its command has taken it.
+    spindle_rps_ = spindle_.present ? commanded_rps : 0.0;
+    spindle_.has_position = spindle_.present;
+    spindle_.revolutions += spindle_rps_ * period_s_;
   }
   spindle_.at_speed = at_speed();
+}
+
+SyncFollower::Spindle MachineIo::sync_spindle() const noexcept {
+  SyncFollower::Spindle s;
+  s.revolutions = spindle_.revolutions;
+  s.rps = spindle_rps_;
+  s.direction = spindle_.direction;
+  s.programmed_rps = std::isfinite(spindle_.programmed_rpm) ? spindle_.programmed_rpm / 60.0 : 0.0;
+  // A tap turns both ways: within the lower of the two limits.
+  s.max_rps = std::min(config_.max_forward_velocity, config_.max_reverse_velocity) / 60.0;
+  if (!(s.max_rps > 0)) s.max_rps = 1e300;
+  s.acceleration = !ideal_ && config_.acceleration > 0 ? config_.acceleration / 60.0 : 1e300;
+  s.stall_timeout_s = config_.at_speed_timeout_s;
+  return s;
+}
+
+bool MachineIo::follow(const Segment& segment, bool first, double feed_override, bool stop,
+                       double dt, double& s, double& v) noexcept {
+  const SyncFollower::Spindle spindle = sync_spindle();
+  if (first) {
+    sync_.start(segment, spindle);
+    tapping_ = segment.spindle_sync == SpindleSync::tap;
+  }
+  const SyncFollower::Step step = sync_.step(segment, spindle, feed_override, stop, dt);
+  if (tapping_) {
+    tap_rps_ = step.spindle_rps;
+    apply_tap();
+  }
+  s = step.s;
+  v = step.v;
+  if (step.error != RtEvent::Code::none) {
+    // The program stops there (ServoLoop::advance_io), the spindle with it.
+    RtEvent e;
+    e.code = step.error;
+    e.error = step.error_value;
+    e.limit = step.error_limit;
+    error_ = e;
+    has_error_ = true;
+    v = 0;
+    return false;
+  }
+  return step.done;
+}
+
+void MachineIo::sync_ended() noexcept {
+  sync_.end();
+  ++syncs_done_;
+  if (!tapping_) return;
+  // The spindle turns again as the program has it.
+  tapping_ = false;
+  tap_rps_ = 0;
+  update_command();
 }
 
 bool MachineIo::at_speed() const noexcept {
@@ -247,7 +324,7 @@ void MachineIo::set_override(double ratio) noexcept {
 }
 
 void MachineIo::path_paused() noexcept {
-  if (!config_.stop_on_pause || spindle_.direction == 0 || spindle_.paused_off) return;
+  if (tapping_ || !config_.stop_on_pause || spindle_.direction == 0 || spindle_.paused_off) return;
   spindle_.paused_off = true;
   update_command();
 }

@@ -25,6 +25,7 @@ PathExecutor::PathExecutor(const config::MachineConfig& config, double period_s)
 
 void PathExecutor::flush() noexcept {
   Segment dropped;
+  if (syncing() && gate_ != nullptr) gate_->sync_ended();
   has_active_ = false;
   for (; window_count_ > 0; --window_count_, ++head_seq_) {
     ++segments_done_;
@@ -196,6 +197,8 @@ void PathExecutor::activate(const Segment& segment) noexcept {
 
 void PathExecutor::finish_front() noexcept {
   const Segment& done = window_at(head_seq_);
+  if (has_active_ && done.spindle_sync != SpindleSync::none && gate_ != nullptr)
+    gate_->sync_ended();
   ++segments_done_;
   moves_done_ += done.moves;
   if (done.action.kind != IoAction::Kind::none) ++actions_done_;
@@ -244,7 +247,20 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
     const Segment& active = window_at(head_seq_);
     line_ = active.line;
     bool done;
-    if (active.kind == Segment::Kind::dwell) {
+    if (active.spindle_sync != SpindleSync::none && gate_ != nullptr) {
+      // The spindle's position, not time, moves the path; a pause waits for the move's end.
+      double s = path_s_;
+      double v = 0;
+      done = gate_->follow(active, !action_started_, feed_override_, abort_requested_, dt, s, v);
+      action_started_ = true;
+      path_s_ = s;
+      path_v_ = done ? 0.0 : v;
+      path_a_ = 0;
+      // Where it ends: back at the start (a tap), at the end (a thread), or where an abort
+      // brought it to rest.
+      pose = done && s >= active.length ? active.end : active.point_at(s);
+      dt = 0;
+    } else if (active.kind == Segment::Kind::dwell) {
       if (abort_requested_) {
         done = true;
       } else if (pause_requested_) {
@@ -287,7 +303,7 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
   if (!pending()) {
     motion_ = MotionState::idle;
   } else if (pause_requested_) {
-    motion_ = path_v_ == 0 ? MotionState::paused : MotionState::pausing;
+    motion_ = path_v_ == 0 && !syncing() ? MotionState::paused : MotionState::pausing;
   } else {
     motion_ = abort_requested_ ? MotionState::stopping : MotionState::moving;
   }

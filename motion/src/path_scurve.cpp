@@ -259,10 +259,10 @@ void PathExecutor::scurve_step(double& dt, AxisPose& pose) noexcept {
       break;
     }
     const Segment& next = window_at(head_seq_);
-    if (next.kind == Segment::Kind::dwell) {
+    if (next.kind == Segment::Kind::dwell || next.spindle_sync != SpindleSync::none) {
       path_v_ = path_a_ = 0;
       s = 0;
-      break;  // the dwell starts with the next period
+      break;  // the dwell (or the move in step with the spindle) starts with the next period
     }
     has_active_ = true;
     if (!starts_here(next, pose)) return;

@@ -229,6 +229,16 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   seg.line = move.line;
   seg.sync = move.sync;
   seg.probe = move.kind == Move::Kind::feed ? move.probe : ProbeMode::none;
+  if (move.kind == Move::Kind::feed && move.spindle_sync != SpindleSync::none) {
+    if (!(move.per_rev > 0) || !std::isfinite(move.per_rev) || !(move.retract_scale >= 1) ||
+        !std::isfinite(move.retract_scale)) {
+      error = "spindle-synchronized move needs a positive distance per revolution";
+      return std::nullopt;
+    }
+    seg.spindle_sync = move.spindle_sync;
+    seg.per_rev = move.per_rev;
+    seg.retract_scale = move.retract_scale;
+  }
   for (int i = 0; i < kAxes; ++i) {
     if (!config_.axes[static_cast<std::size_t>(i)].present) seg.end[i] = start[i];
   }

@@ -110,6 +110,21 @@ int format(const RtEvent& e, char* out, std::size_t size) {
       return std::snprintf(out, size, "G38.2 probe move finished without tripping the probe");
     case Code::probe_contact_kept:
       return std::snprintf(out, size, "G38.4 probe move finished without losing contact");
+    case Code::sync_overrun:
+      return std::snprintf(out, size,
+                           "spindle 0 turned %.3g revolutions past the end of the rigid tap "
+                           "(more than %.3g): the tap was stopped there",
+                           clamped(e.error), clamped(e.limit));
+    case Code::sync_stalled:
+      return std::snprintf(out, size,
+                           "spindle 0 did not turn for %.3g s during a move in step with it "
+                           "(G33, G33.1, rigid tapping; [SPINDLE_0] AT_SPEED_TIMEOUT)",
+                           clamped(e.limit));
+    case Code::sync_not_at_rest:
+      return std::snprintf(out, size,
+                           "spindle 0 did not come to rest within %.3g s to start a rigid tap "
+                           "([SPINDLE_0] AT_SPEED_TIMEOUT): it turns at %.4g rpm",
+                           clamped(e.limit), clamped(e.error));
   }
   return std::snprintf(out, size, "servo event %d", static_cast<int>(e.code));
 }

@@ -18,6 +18,7 @@ void ServoLoop::publish() noexcept {
   status_.spindle = io_.spindle();
   status_.io = io_.io();
   status_.wait = io_.wait();
+  status_.sync = io_.sync();
   status_.input_result = io_.input_result();
   status_.input_waits = io_.input_waits();
   std::array<bool, kAxes> seen{};

@@ -11,7 +11,9 @@
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/rt.hpp"
 #include "cncd/motion/rt_event.hpp"
+#include "cncd/motion/segment.hpp"
 #include "cncd/motion/status.hpp"
+#include "cncd/motion/sync_follower.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
@@ -25,6 +27,13 @@ class ActionGate {
   CNCD_RT virtual bool run(const IoAction& action, bool first) noexcept = 0;
   // RT: a segment with outputs to set starts this period.
   CNCD_RT virtual void started(const SyncOutputs& sync) noexcept = 0;
+  // RT: one period of `dt` s along a segment in step with the spindle (`first`: its first
+  // period); `s` (in: where the path stood) and `v` are where the path is and its speed.
+  // `stop` (an abort) brings it to rest. True once it is over.
+  CNCD_RT virtual bool follow(const Segment& segment, bool first, double feed_override, bool stop,
+                              double dt, double& s, double& v) noexcept = 0;
+  // RT: the segment in step with the spindle is over or dropped.
+  CNCD_RT virtual void sync_ended() noexcept = 0;
 };
 
 class MachineIo final : public ActionGate {
@@ -33,6 +42,14 @@ class MachineIo final : public ActionGate {
 
   CNCD_RT bool run(const IoAction& action, bool first) noexcept override;
   CNCD_RT void started(const SyncOutputs& sync) noexcept override;
+  CNCD_RT bool follow(const Segment& segment, bool first, double feed_override, bool stop,
+                      double dt, double& s, double& v) noexcept override;
+  CNCD_RT void sync_ended() noexcept override;
+  CNCD_RT SyncStatus sync() const noexcept {
+    SyncStatus out = sync_.status();
+    out.done = syncs_done_;
+    return out;
+  }
 
   // The drivers' feedback of this period.
   CNCD_RT void feedback(const drivers::IoFeedback& in) noexcept;
@@ -71,6 +88,10 @@ class MachineIo final : public ActionGate {
   // The spindle has not reached its speed within AT_SPEED_TIMEOUT: the error take_error() gives.
   CNCD_RT void not_at_speed() noexcept;
   CNCD_RT bool wait_input(const IoAction& action, bool first) noexcept;
+  // The spindle as the synchronized-motion follower sees it this period.
+  CNCD_RT SyncFollower::Spindle sync_spindle() const noexcept;
+  // A tap drives the spindle: its command replaces the program's.
+  CNCD_RT void apply_tap() noexcept;
   CNCD_RT double input_value(const IoAction& action) const noexcept;
 
   const config::SpindleConfig& config_;
@@ -92,6 +113,16 @@ class MachineIo final : public ActionGate {
   RtEvent error_{};
   bool resuming_ = false;  // STOP_ON_PAUSE: restarted, waiting for at-speed before going on
   std::uint64_t resume_waited_ = 0;
+  // Synchronized motion: the follower, whether it drives the spindle (a tap), and the
+  // spindle's position last period (its signed speed) or, for the ideal spindle, where its
+  // command has taken it.
+  SyncFollower sync_;
+  bool tapping_ = false;
+  double tap_rps_ = 0;  // what the tap drives the spindle at, signed
+  bool has_last_revolutions_ = false;
+  double last_revolutions_ = 0;
+  double spindle_rps_ = 0;  // measured, signed
+  std::uint64_t syncs_done_ = 0;
 };
 
 }  // namespace cncd::motion

@@ -59,6 +59,11 @@ class PathExecutor {
   // A segment is being executed: the path is not at rest between two periods.
   CNCD_RT bool active() const noexcept { return has_active_; }
   // The probing mode of the segment being executed (none when none is).
+  // A move in step with the spindle is under way.
+  CNCD_RT bool syncing() const noexcept {
+    return has_active_ &&
+           window_[static_cast<std::size_t>(head_seq_ % kWindow)].spindle_sync != SpindleSync::none;
+  }
   CNCD_RT ProbeMode active_probe() const noexcept {
     return has_active_ ? window_[static_cast<std::size_t>(head_seq_ % kWindow)].probe
                        : ProbeMode::none;

@@ -45,6 +45,9 @@ struct RtEvent {
     probe_untripped_at_start,  // G38.4/G38.5 with the probe out of contact
     probe_no_contact,          // G38.2 ended without contact
     probe_contact_kept,        // G38.4 ended without losing contact
+    sync_overrun,              // the spindle went `error` rev past a tap's end (`limit` allowed)
+    sync_stalled,              // the spindle did not turn in a synchronized move for `limit` s
+    sync_not_at_rest,          // the spindle did not come to rest for a tap within `limit` s
   };
   Code code = Code::none;
   EventLevel level = EventLevel::info;

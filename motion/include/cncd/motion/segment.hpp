@@ -56,6 +56,11 @@ struct Segment {
   SyncOutputs sync;
   // A probing line: the servo loop stops it where the probe trips (ServoLoop::watch_probe).
   ProbeMode probe = ProbeMode::none;
+  // In step with the spindle (Move::spindle_sync): the servo loop takes the path position from
+  // the spindle's (MachineIo::follow).
+  SpindleSync spindle_sync = SpindleSync::none;
+  double per_rev = 0;
+  double retract_scale = 1;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
   AxisPose start_direction{};

@@ -83,6 +83,24 @@ struct ProbeStatus {
   AxisPose position{};     // where it tripped (machine coordinates), else where it ended
 };
 
+// Motion in step with the spindle (G33, G33.1, rigid G84/G74): none while there is none.
+struct SyncStatus {
+  enum class Phase : std::uint8_t {
+    none,
+    spindle_stopping,  // tap: the spindle comes to rest before the tap starts
+    tapping_in,        // tap: the spindle and the axis go into the hole
+    tapping_out,       // tap: reversed, back out to where the tap started
+    index,             // thread: waiting for the spindle's next whole revolution
+    following,         // thread: the path follows the spindle
+    stopping,          // an abort: the spindle (tap) or the path (thread) comes to rest
+  };
+  SpindleSync mode = SpindleSync::none;
+  Phase phase = Phase::none;
+  double per_rev = 0;      // units per revolution
+  double progress = 0;     // revolutions from the start along the segment (into the hole)
+  std::uint64_t done = 0;  // synchronized segments ended since the start
+};
+
 // What the servo thread publishes every period.
 struct ServoStatus {
   std::uint64_t sequence = 0;  // servo cycle count at publication
@@ -117,6 +135,7 @@ struct ServoStatus {
   RtEvent path_error;
   std::uint64_t path_errors = 0;
   ProbeStatus probe;
+  SyncStatus sync;
   RtStats rt;
 };
 

@@ -64,6 +64,14 @@ struct SyncOutputs {
 // the "or_error" kinds make a move that ends without it an error.
 enum class ProbeMode : std::uint8_t { none, toward_or_error, toward, away_or_error, away };
 
+// Motion in step with the spindle's position: a feed line whose path position is `per_rev`
+// (units of path length) per spindle revolution. thread (G33): the spindle turns as programmed
+// and the path follows it from the next whole revolution. tap (G33.1, rigid G84/G74): the
+// spindle is brought to rest, then driven with the axis down the line, reversed at its end and
+// back to rest at its start, where its own direction and speed are restored; the path ends
+// where it started.
+enum class SpindleSync : std::uint8_t { none, thread, tap };
+
 struct Move {
   // An action is a dwell of no time that does `action` (IoAction) where the path rests.
   enum class Kind : std::uint8_t { traverse, feed, arc, dwell, action };
@@ -92,6 +100,11 @@ struct Move {
   IoAction action;                    // Kind::action
   SyncOutputs sync;                   // set as this move starts (traverse, feed, arc)
   ProbeMode probe = ProbeMode::none;  // a feed line that probes (exact stop at both ends)
+  // A feed line in step with the spindle (exact stop at both ends): units per revolution, and
+  // for a tap how much faster the spindle turns on the way out (G33.1 I, at least 1).
+  SpindleSync spindle_sync = SpindleSync::none;
+  double per_rev = 0;
+  double retract_scale = 1;
 };
 
 }  // namespace cncd::motion

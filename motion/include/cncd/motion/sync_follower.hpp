@@ -1,0 +1,80 @@
+// Motion in step with the spindle (G33, G33.1, rigid G84/G74): where along a synchronized
+// segment the path stands, taken each servo period from the spindle's measured position, and,
+// for a tap, the speed the spindle is driven at. Every method is RT (servo thread); it knows
+// nothing of drivers: MachineIo hands it the spindle as measured and applies its command.
+//
+// A tap (SpindleSync::tap) is rigid tapping as a rigid-tapping control does it: the spindle is
+// brought to rest above the hole and its position locked there; then the spindle is driven
+// down the hole along a speed ramp the axis can follow (the lower of the spindle's and the
+// line's acceleration), braked to rest at the bottom, reversed, and braked to rest again where
+// it was locked. The axis follows the spindle's position (one period ahead, by its speed), so
+// it stays on the helix through the ramps and the reversal. The feed override scales the
+// spindle's speed, and so the axis's, throughout.
+//
+// A thread (SpindleSync::thread, G33) takes the spindle as the program turns it: the path
+// starts at the next whole revolution (the index) and catches up with the helix within the
+// line's acceleration, follows it, and slows to rest at the line's end.
+#pragma once
+
+#include <cstdint>
+
+#include "cncd/drivers/rt.hpp"
+#include "cncd/motion/rt_event.hpp"
+#include "cncd/motion/segment.hpp"
+#include "cncd/motion/status.hpp"
+
+namespace cncd::motion {
+
+class SyncFollower {
+ public:
+  // The spindle this period.
+  struct Spindle {
+    double revolutions = 0;  // measured, signed (forward counts up)
+    double rps = 0;          // measured, signed, revolutions per second
+    int direction = 0;       // as programmed: 1 M3, -1 M4, 0 stopped
+    double programmed_rps = 0;
+    double max_rps = 1e300;       // the spindle's limit in the tap's direction
+    double acceleration = 1e300;  // rev/s^2 the spindle can follow (its ramp)
+    double stall_timeout_s = 0;   // a tap that makes no progress for this long fails
+  };
+  struct Step {
+    double s = 0;                 // path position along the segment
+    double v = 0;                 // path speed, >= 0
+    bool done = false;            // the segment is over (s is its final position)
+    bool drives_spindle = false;  // a tap: the spindle turns at `spindle_rps` this period
+    double spindle_rps = 0;       // signed (forward > 0)
+    RtEvent::Code error = RtEvent::Code::none;  // the move failed: the path stops
+    double error_value = 0;                     // RtEvent::error and limit of the failure
+    double error_limit = 0;
+  };
+
+  // RT: a synchronized segment starts, the spindle as measured.
+  CNCD_RT void start(const Segment& segment, const Spindle& spindle) noexcept;
+  // RT: one period of `dt` s. `feed_override` scales a tap's speed; `stop` (an abort) brings
+  // the spindle (tap) or the path (thread) to rest, after which the step is done.
+  CNCD_RT Step step(const Segment& segment, const Spindle& spindle, double feed_override, bool stop,
+                    double dt) noexcept;
+  // RT: the segment ended or was dropped.
+  CNCD_RT void end() noexcept { status_ = {}; }
+  CNCD_RT const SyncStatus& status() const noexcept { return status_; }
+
+ private:
+  CNCD_RT Step tap_step(const Segment& segment, const Spindle& spindle, double feed_override,
+                        bool stop, double dt) noexcept;
+  CNCD_RT Step thread_step(const Segment& segment, const Spindle& spindle, bool stop,
+                           double dt) noexcept;
+
+  SyncStatus status_{};
+  int direction_ = 1;         // the spindle's direction into the hole / along the thread
+  double origin_ = 0;         // spindle revolutions at the path's start (s = 0)
+  double command_ = 0;        // tap: spindle speed commanded, rev/s, > 0 into the hole
+  double accel_ = 0;          // tap: the ramp, rev/s^2
+  double path_v_ = 0;         // thread: path speed
+  double path_s_ = 0;         // thread: path position
+  bool locked_ = false;       // tap: the spindle's position is locked to the path's
+  double stalled_s_ = 0;      // time without progress while driven
+  double stopping_s_ = 0;     // tap: time spent bringing the spindle to rest
+  double last_progress_ = 0;  // tap: revolutions into the hole in the previous period
+};
+
+}  // namespace cncd::motion
