@@ -9,8 +9,10 @@ namespace {
 // Revolutions from the end of a tap's way down (or back) at which the spindle is told to stop:
 // the braking curve reaches it at a crawl, so it comes to rest within a fraction of this.
 constexpr double kEndRev = 2e-4;
-// A spindle slower than this (rev/s) is at rest.
+// A spindle slower than this (rev/s) for kRestPeriods periods in a row is at rest: an encoder
+// that does not count for that long, a simulated spindle that has stopped.
 constexpr double kRestRps = 0.02;
+constexpr int kRestPeriods = 5;
 // How far past either end of a tap the spindle may turn before the tap is stopped (rev).
 constexpr double kOverrunRev = 0.25;
 // The tap brakes on this share of its ramp: the spindle, which follows the command within
@@ -43,6 +45,7 @@ void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcep
   status_.per_rev = segment.per_rev;
   stalled_s_ = 0;
   stopping_s_ = 0;
+  rest_periods_ = 0;
   locked_ = false;
   path_v_ = 0;
   path_s_ = 0;
@@ -79,7 +82,8 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
   // Where the spindle is now, and (below) where it will be at the end of this period: the
   // axis is told to be there then.
   const double now = direction_ * (spindle.revolutions - origin_);
-  const bool at_rest = std::abs(spindle.rps) <= kRestRps;
+  rest_periods_ = std::abs(spindle.rps) <= kRestRps ? rest_periods_ + 1 : 0;
+  const bool at_rest = rest_periods_ >= kRestPeriods;
   if (stop && status_.phase != Phase::stopping) status_.phase = Phase::stopping;
 
   double target = 0;  // spindle speed wanted, rev/s, > 0 into the hole
@@ -90,7 +94,8 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
     case Phase::spindle_stopping:
       target = 0;
       stopping_s_ += dt;
-      if (spindle.stall_timeout_s > 0 && stopping_s_ >= spindle.stall_timeout_s && !at_rest) {
+      if (spindle.stall_timeout_s > 0 && stopping_s_ >= spindle.stall_timeout_s &&
+          std::abs(spindle.rps) > kRestRps) {
         out.error = RtEvent::Code::sync_not_at_rest;
         out.error_value = std::abs(spindle.rps) * 60.0;
         out.error_limit = spindle.stall_timeout_s;

@@ -74,6 +74,7 @@ class SyncFollower {
   bool locked_ = false;       // tap: the spindle's position is locked to the path's
   double stalled_s_ = 0;      // time without progress while driven
   double stopping_s_ = 0;     // tap: time spent bringing the spindle to rest
+  int rest_periods_ = 0;      // tap: periods in a row the spindle has stood still
   double last_progress_ = 0;  // tap: revolutions into the hole in the previous period
 };
 
