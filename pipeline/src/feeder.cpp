@@ -14,6 +14,7 @@ void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   probe_seen = false;
   unsupported.reset();
   if (!mdi) per_revolution_ = false;
+  per_rev_ = 0;
   holds.clear();
   sync_ = {};
   need_at_speed_ = false;
@@ -137,7 +138,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     return false;
   };
   auto moving = [&](motion::Move& next) {
-    if (next.kind != motion::Move::Kind::traverse && need_at_speed_) {
+    // A tap brings the spindle to rest before it starts: no need to wait for its speed.
+    if (next.kind != motion::Move::Kind::traverse &&
+        next.spindle_sync != motion::SpindleSync::tap && need_at_speed_) {
       Action a;
       a.kind = Action::Kind::wait_at_speed;
       add_action(a, m.line);
@@ -162,8 +165,32 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           [&](const in::StraightFeed& c) {
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
-            move.feed = feed_per_second();
+            if (per_rev_ > 0) {
+              // G33: the path rests before the thread, which runs alone.
+              add_stop_point();
+              move.spindle_sync = motion::SpindleSync::thread;
+              move.per_rev = per_rev_;
+              move.feed = per_rev_ * spindle_speed / 60.0;
+            } else {
+              move.feed = feed_per_second();
+            }
             moving(move);
+            return true;
+          },
+          [&](const in::RigidTap& c) {
+            add_stop_point();
+            move.kind = motion::Move::Kind::feed;
+            std::copy(c.end.begin(), c.end.end(), move.end.begin());
+            move.spindle_sync = motion::SpindleSync::tap;
+            move.per_rev = per_rev_;
+            move.retract_scale = c.scale;
+            move.feed = per_rev_ * spindle_speed / 60.0;
+            const motion::AxisPose start = end_;
+            moving(move);
+            // The tap ends where it started, the spindle turning as before: a feed move after
+            // it waits until it is back at speed.
+            end_ = start;
+            need_at_speed_ = spindle_direction != 0;
             return true;
           },
           [&](const in::ArcFeed& c) {
@@ -215,13 +242,16 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             }
             return false;
           },
-          [&](const in::StartSpeedFeedSynch&) {
-            if (!unsupported) {
-              unsupported =
-                  Unsupported{m.line,
-                              "spindle-synchronized motion (G33, G33.1, rigid tapping) is not "
-                              "available: cncd cannot move an axis in step with the spindle yet"};
+          [&](const in::StartSpeedFeedSynch& c) {
+            per_rev_ = c.feed_per_rev;
+            if (!unsupported && machine_ != nullptr) {
+              if (auto why = spindle_position_missing(*machine_))
+                unsupported = Unsupported{m.line, *why};
             }
+            return false;
+          },
+          [&](const in::StopSpeedFeedSynch&) {
+            per_rev_ = 0;
             return false;
           },
           [&](const in::Dwell& c) {
@@ -329,12 +359,36 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       },
       m.op);
   if (!queued) return;
-  // A probing move stops where the probe trips: nothing may blend into or out of it.
-  move.path_mode =
-      move.probe != motion::ProbeMode::none ? motion::Move::PathMode::exact_stop : path_mode_;
+  // A probing move stops where the probe trips, and a move in step with the spindle starts and
+  // ends at rest: nothing may blend into or out of them.
+  const bool alone =
+      move.probe != motion::ProbeMode::none || move.spindle_sync != motion::SpindleSync::none;
+  move.path_mode = alone ? motion::Move::PathMode::exact_stop : path_mode_;
   move.tolerance = tolerance_;
-  move.merge_tolerance = path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
+  move.merge_tolerance =
+      !alone && path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
   pending.push_back(move);
+}
+
+std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine) {
+  const config::SpindleConfig& sp = machine.spindle;
+  // Without [SPINDLE_0] the spindle is ideal: its position is where its command took it.
+  if (!sp.present) return std::nullopt;
+  switch (sp.driver) {
+    case config::SpindleDriver::sim:
+      return std::nullopt;
+    case config::SpindleDriver::gpio:
+      if (sp.encoder_ppr > 0) return std::nullopt;
+      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
+             "position: [SPINDLE_0] has no encoder (ENCODER_A, ENCODER_B, ENCODER_PPR)";
+    case config::SpindleDriver::modbus:
+      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
+             "position, and a Modbus VFD ([SPINDLE_0] DRIVER = modbus) reports only its speed";
+    case config::SpindleDriver::none:
+      break;
+  }
+  return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs a spindle: [SPINDLE_0] "
+         "DRIVER = none";
 }
 
 double ProgramFeeder::feed_per_second() const {

@@ -77,9 +77,18 @@ class Simulation final : MoveTarget {
            ++i)
         result_.move_start_s[i] = begin_s;
       const double t = static_cast<double>(cycle) * result_.period_s;
-      if (options_.on_sample) options_.on_sample(t, s.commanded);
+      if (options_.on_sample) {
+        // The spindle where it stands at the end of the period is what the next one reads.
+        if (sample_pending_) options_.on_sample(sample_t_, sample_pose_, s.spindle.revolutions);
+        sample_pending_ = true;
+        sample_t_ = t;
+        sample_pose_ = s.commanded;
+        sample_revolutions_ = s.spindle.revolutions;
+      }
       if (options_.measure) measure(s, done);
     }
+    // The last period's spindle reading stands for its end: the program ends at rest.
+    if (sample_pending_) options_.on_sample(sample_t_, sample_pose_, sample_revolutions_);
     result_.cycles = cycle;
     result_.cycle_time_s = static_cast<double>(cycle) * result_.period_s;
   }
@@ -223,17 +232,20 @@ class Simulation final : MoveTarget {
     std::string error;
     const auto segment = planner_.plan(move, programmed_end_, false, error);
     if (!segment) return;  // push() reports it
-    programmed_end_ = segment->end;
+    // A tap goes down its line and back to where it started.
+    const bool tap = segment->spindle_sync == motion::SpindleSync::tap;
+    programmed_end_ = tap ? segment->start : segment->end;
     if (options_.on_move) options_.on_move(*segment);
     if (segment->kind == motion::Segment::Kind::dwell) {
       result_.feed_bound_s += segment->dwell_s;
       result_.exact_stop_bound_s += segment->dwell_s;
     } else {
       const MoveLimits limits = move_limits(machine_, *segment);
+      const double ways = tap ? 2.0 : 1.0;
       if (segment->length > 0 && limits.velocity < 1e300)
-        result_.feed_bound_s += segment->length / limits.velocity;
+        result_.feed_bound_s += ways * segment->length / limits.velocity;
       result_.exact_stop_bound_s +=
-          rest_to_rest_s(segment->length, limits.velocity, limits.acceleration);
+          ways * rest_to_rest_s(segment->length, limits.velocity, limits.acceleration);
     }
   }
 
@@ -303,6 +315,11 @@ class Simulation final : MoveTarget {
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};
   std::deque<motion::Segment> window_;  // queued segments from index window_first_ on
+  // The sample of the last period, handed on with the spindle's next reading.
+  bool sample_pending_ = false;
+  double sample_t_ = 0;
+  motion::AxisPose sample_pose_{};
+  double sample_revolutions_ = 0;
   std::uint64_t window_first_ = 0;
 };
 

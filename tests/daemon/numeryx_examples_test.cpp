@@ -45,7 +45,7 @@ class NumeryxExamples : public ::testing::Test {
     options.interp = pipeline::interpreter_options(*loaded_.config);
     options.measure = false;
     std::vector<Sample> samples;
-    options.on_sample = [&](double t, const motion::AxisPose& p) {
+    options.on_sample = [&](double t, const motion::AxisPose& p, double) {
       samples.push_back({t, p[0], p[1], p[2]});
     };
     const auto r = pipeline::simulate_plan(*loaded_.config, kNumeryx + program, options);

@@ -77,7 +77,7 @@ TEST_F(PlanSimTest, RapidsRunAtTheFastestSpeedTheAxesAllowAlongThem) {
 
 TEST_F(PlanSimTest, ArcsAndDwellsAreFollowedAndEachMoveGetsItsStartTime) {
   std::vector<double> times;
-  options_.on_sample = [&times](double t, const motion::AxisPose&) { times.push_back(t); };
+  options_.on_sample = [&times](double t, const motion::AxisPose&, double) { times.push_back(t); };
   // G61: the traverse stops where the circle starts (under G64 a fillet would round it).
   const auto r =
       simulate("G21 G90 G61\nG0 X20 Y0\nG2 X20 Y0 I-10 J0 F1200\nG4 P0.25\nG1 X30\nM2\n");
@@ -154,7 +154,7 @@ TEST_F(PlanSimTest, FilletsWhereArcsMeetLinesAreMeasuredAgainstTheProgrammedCurv
 
 TEST_F(PlanSimTest, ASpiralFromRoundedCentreWordsIsFollowedOnItsPathToItsEnd) {
   motion::AxisPose last{};
-  options_.on_sample = [&last](double, const motion::AxisPose& p) { last = p; };
+  options_.on_sample = [&last](double, const motion::AxisPose& p, double) { last = p; };
   // I5.005: radius 5.005 at the start, 4.995 at the end; half a turn at 10 mm/s.
   const auto r = simulate("G21 G90 G61\nG0 X0 Y0\nG2 X10 Y0 I5.005 J0 F600\nM2\n");
   ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : "");
@@ -233,9 +233,9 @@ TEST_F(PlanSimTest, CncdCheckPlanPrintsFiguresJsonAndTheTrajectory) {
   EXPECT_LE(report["axes"]["x"]["acceleration_ratio"].get<double>(), 1.001);
   const auto rows = lines_of(csv);
   ASSERT_EQ(rows.size(), report["cycles"].get<std::size_t>() + 1);
-  EXPECT_EQ(rows.front(), "t,x,y,z");
+  EXPECT_EQ(rows.front(), "t,x,y,z,spindle");
   char last[80];
-  std::snprintf(last, sizeof last, "%.6f,15.000000,5.000000,0.000000",
+  std::snprintf(last, sizeof last, "%.6f,15.000000,5.000000,0.000000,0.000000",
                 report["cycle_time_s"].get<double>());
   EXPECT_EQ(rows.back(), last);
   EXPECT_FALSE(std::filesystem::exists(csv.string() + ".tmp"));

@@ -78,14 +78,12 @@ TEST_F(ProbeDaemon, AProbeTouchingAtTheStartIsRefused) {
 }
 
 // What the machine cannot do yet is refused when the program is opened, at its line, never run
-// as something else (a G33 as a plain feed, a G96 surface speed as rpm).
-TEST_F(ProbeDaemon, SynchronizedMotionAndSurfaceSpeedAreRefusedAtOpen) {
+// as something else (a G96 surface speed as rpm).
+TEST_F(ProbeDaemon, SurfaceSpeedIsRefusedAtOpen) {
   const struct {
     const char* program;
     const char* message;
   } cases[] = {
-      {"G21\nS600 M3\nG33 Z-5 K1.25\nM2\n", ":3: spindle-synchronized motion (G33, G33.1, rigid"},
-      {"G21\nS600 M3\nG33.1 Z-5 K1.25\nM2\n", ":3: spindle-synchronized motion"},
       {"G21\nG96 D2000 S100 M3\nG1 X1 F100\nM2\n",
        ":2: constant surface speed (G96) is not available"},
   };

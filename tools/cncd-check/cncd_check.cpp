@@ -61,7 +61,8 @@ int usage(const std::string& why) {
          "               feed-limited and exact-stop bounds, peak axis velocity and\n"
          "               acceleration, largest deviation from the programmed path\n"
          "  --json       with --plan: print one JSON object instead\n"
-         "  --trajectory FILE.csv  with --plan: write t and every axis per servo period\n"
+         "  --trajectory FILE.csv  with --plan: write t, every axis and the spindle's\n"
+         "               position (revolutions) per servo period\n"
          "exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI\n";
   return kExitUsage;
 }
@@ -78,10 +79,10 @@ class TrajectoryFile {
       axes_.push_back(i);
       out_ << ',' << static_cast<char>(cncd::config::kAxisLetters[i] - 'A' + 'a');
     }
-    out_ << '\n';
+    out_ << ",spindle\n";
   }
   bool opened() const { return static_cast<bool>(out_); }
-  void add(double t, const cncd::motion::AxisPose& pose) {
+  void add(double t, const cncd::motion::AxisPose& pose, double spindle) {
     char text[40];
     std::snprintf(text, sizeof text, "%.6f", t);
     out_ << text;
@@ -89,7 +90,8 @@ class TrajectoryFile {
       std::snprintf(text, sizeof text, ",%.6f", pose[i]);
       out_ << text;
     }
-    out_ << '\n';
+    std::snprintf(text, sizeof text, ",%.6f", spindle);
+    out_ << text << '\n';
   }
   // "" or what went wrong; the temporary file is removed on failure.
   std::string finish() {
@@ -130,7 +132,9 @@ int check_plan(const cncd::config::MachineConfig& machine, const std::string& pr
                 << '\n';
       return kExitProblems;
     }
-    options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose) { csv->add(t, pose); };
+    options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose, double spindle) {
+      csv->add(t, pose, spindle);
+    };
   }
   const auto result = cncd::pipeline::simulate_plan(machine, program, options);
   // A program that stopped before it moved has no figures worth a report (JSON always has one).

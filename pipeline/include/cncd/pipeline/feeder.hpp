@@ -44,6 +44,9 @@ struct HoldInfo {
   interp::UserMCode user;  // user_m: what to run
 };
 
+// Why `machine` cannot move in step with its spindle (no position to follow), or nothing.
+std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine);
+
 class ProgramFeeder final : public interp::CanonSink {
  public:
   // Operator messages (MSG) in the program, with their line; none = dropped.
@@ -122,6 +125,8 @@ class ProgramFeeder final : public interp::CanonSink {
   // times the programmed spindle speed.
   double feed_per_second() const;
   bool per_revolution_ = false;  // G95
+  // Between START_SPEED_FEED_SYNCH and its stop: machine units per revolution (0: none).
+  double per_rev_ = 0;
   // M62/M63/M67 waiting for the next move.
   motion::SyncOutputs sync_{};
   // M3/M4 or S changed the spindle: the next feed move waits until it is at speed.

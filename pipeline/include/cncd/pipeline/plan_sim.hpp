@@ -35,9 +35,10 @@ struct PlanSimOptions {
   std::size_t max_moves = 0;
   // Measure peaks and path deviation (a little slower); the daemon's estimate does without.
   bool measure = true;
-  // Called once per servo period with the time (s, from the program's start) and the
-  // commanded axis positions (machine coordinates) at the end of that period.
-  std::function<void(double, const motion::AxisPose&)> on_sample;
+  // Called once per servo period with the time (s, from the program's start), the commanded
+  // axis positions (machine coordinates) at the end of that period and the spindle's position
+  // then (revolutions, signed: forward counts up), as the next period reads it.
+  std::function<void(double, const motion::AxisPose&, double)> on_sample;
   // Called with every programmed move, in order, as the planner plans it alone: the geometry
   // the bounds use, before a blend or a merge shortens it.
   std::function<void(const motion::Segment&)> on_move;
