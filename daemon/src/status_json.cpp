@@ -167,6 +167,11 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
         {"last_result", s.probe.last_tripped ? json(*s.probe.last_tripped ? 1 : 0) : json(nullptr)},
         {"last_position",
          s.probe.last_tripped ? axes_object(config, s.probe.last_position) : json(nullptr)}}},
+      {"sync", s.sync.mode.empty() ? json(nullptr)
+                                   : json{{"mode", s.sync.mode},
+                                          {"phase", s.sync.phase},
+                                          {"per_rev", s.sync.per_rev},
+                                          {"progress", s.sync.progress}}},
       {"tool",
        {{"number", s.tool.number},
         {"prepared", s.tool.prepared},

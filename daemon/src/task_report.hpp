@@ -98,6 +98,14 @@ struct ProbeReport {
   motion::AxisPose last_position{};
 };
 
+// Motion in step with the spindle (G33, G33.1, rigid G84/G74) under way, if any.
+struct SyncReport {
+  std::string mode;     // "thread" | "tap" | "" (none)
+  std::string phase;    // SyncStatus::Phase in words
+  double per_rev = 0;   // units per revolution (machine units)
+  double progress = 0;  // revolutions from the move's start
+};
+
 struct ToolReport {
   int number = 0;     // in the spindle, 0 = none
   int prepared = -1;  // -1 = none
@@ -137,6 +145,7 @@ struct TaskStatus {
   IoReport io;
   WaitReport wait;
   ProbeReport probe;
+  SyncReport sync;
   ToolReport tool;
   ActiveOffsets offsets;
   std::vector<std::string> gcodes;  // active, in modal-group order: "G1", "G17" ...

@@ -10,6 +10,38 @@
 namespace cncd::daemon {
 
 namespace {
+
+SyncReport sync_report(const motion::SyncStatus& sync) {
+  using Phase = motion::SyncStatus::Phase;
+  SyncReport out;
+  if (sync.mode == motion::SpindleSync::none) return out;
+  out.mode = sync.mode == motion::SpindleSync::tap ? "tap" : "thread";
+  switch (sync.phase) {
+    case Phase::spindle_stopping:
+      out.phase = "spindle_stopping";
+      break;
+    case Phase::tapping_in:
+      out.phase = "tapping_in";
+      break;
+    case Phase::tapping_out:
+      out.phase = "tapping_out";
+      break;
+    case Phase::index:
+      out.phase = "index";
+      break;
+    case Phase::following:
+      out.phase = "following";
+      break;
+    case Phase::stopping:
+      out.phase = "stopping";
+      break;
+    case Phase::none:
+      break;
+  }
+  out.per_rev = sync.per_rev;
+  out.progress = sync.progress;
+  return out;
+}
 // Machine coordinates -> work coordinates, all in machine units: the inverse of LinuxCNC's
 // machine = rotate_xy(work + g92, rotation) + g5x + tool.
 motion::AxisPose work_pose(const motion::AxisPose& machine, const interp::InterpState& st) {
@@ -212,6 +244,7 @@ TaskStatus Task::status() const {
   out.spindle.actual_rpm = sp.actual_rpm;
   out.spindle.at_speed = sp.at_speed;
   if (sp.has_position) out.spindle.position = sp.revolutions;
+  out.sync = sync_report(s.sync);
   out.mist = s.io.mist;
   out.flood = s.io.flood;
   out.io.douts = s.io.douts;

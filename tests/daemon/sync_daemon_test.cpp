@@ -1,0 +1,86 @@
+// G33.1 and G33 through the real daemon on the example sim machine: status shows the tap's
+// phases while it runs, the tap ends where it started with the spindle turning forward again,
+// a feed hold lets the tap come out before the machine holds, and the next feed waits until
+// the spindle is back at speed.
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+class SyncDaemon : public MachineTest {
+ protected:
+  static double z(const nlohmann::json& s) { return s["position"]["commanded"]["z"].get<double>(); }
+};
+
+TEST_F(SyncDaemon, RigidTapRunsShowsItsPhasesAndRestoresTheSpindle) {
+  ready_machine();
+  start_program("tap.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33.1 Z-10 K1.25\nG1 X20 F600\nM2\n");
+  std::set<std::string> phases;
+  double deepest = 1e9;
+  bool forward_again = false;
+  const auto s = wait_until([&](const nlohmann::json& st) {
+    if (!st["sync"].is_null()) {
+      EXPECT_EQ(st["sync"]["mode"], "tap");
+      EXPECT_EQ(st["sync"]["per_rev"], 1.25);
+      phases.insert(st["sync"]["phase"].get<std::string>());
+    }
+    deepest = std::min(deepest, z(st));
+    // The feed to X20 runs with the spindle forward at speed again.
+    const double x = st["position"]["commanded"]["x"].get<double>();
+    if (x > 10.001 && x < 19.999) {
+      forward_again = st["spindle"]["direction"] == 1 && st["spindle"]["at_speed"] == true;
+    }
+    return st["exec"] == "idle" && st["program"]["result"] != "";
+  });
+  ASSERT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_TRUE(phases.count("tapping_in")) << ::testing::PrintToString(phases);
+  EXPECT_TRUE(phases.count("tapping_out")) << ::testing::PrintToString(phases);
+  EXPECT_LT(deepest, -5);  // sampled on the way down
+  EXPECT_GE(deepest, -10.002);
+  EXPECT_NEAR(z(s), 5, 1e-9);
+  EXPECT_TRUE(forward_again);
+  EXPECT_TRUE(s["sync"].is_null());
+}
+
+TEST_F(SyncDaemon, FeedHoldDuringATapHoldsOnlyOnceTheTapIsOut) {
+  ready_machine();
+  start_program("tap.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33.1 Z-20 K1.25\nG0 X30\nM2\n");
+  wait_until([](const nlohmann::json& st) {
+    return !st["sync"].is_null() && st["sync"]["phase"] == "tapping_in" &&
+           st["position"]["commanded"]["z"].get<double>() < 0;
+  });
+  result_of(call("program.pause"));
+  const auto held = wait_until([](const nlohmann::json& st) { return st["motion"] == "paused"; });
+  EXPECT_NEAR(z(held), 5, 1e-9);  // out of the hole
+  EXPECT_NEAR(held["position"]["commanded"]["x"].get<double>(), 10, 1e-9);
+  result_of(call("program.resume"));
+  const auto s = wait_until([](const nlohmann::json& st) {
+    return st["exec"] == "idle" && st["program"]["result"] != "";
+  });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 30, 1e-9);
+}
+
+TEST_F(SyncDaemon, ThreadRunsToItsEnd) {
+  ready_machine();
+  start_program("thread.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33 Z-10 K1.5\nG0 Z20\nM2\n");
+  bool following = false;
+  const auto s = wait_until([&](const nlohmann::json& st) {
+    if (!st["sync"].is_null() && st["sync"]["phase"] == "following") {
+      following = true;
+      EXPECT_EQ(st["sync"]["mode"], "thread");
+    }
+    return st["exec"] == "idle" && st["program"]["result"] != "";
+  });
+  ASSERT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_TRUE(following);
+  EXPECT_NEAR(z(s), 20, 1e-9);
+}
+
+}  // namespace
+}  // namespace cncd::test
