@@ -11,9 +11,22 @@ MachineIo::MachineIo(const config::MachineConfig& config, double period_s)
   spindle_.at_speed = true;
 }
 
+void MachineIo::track_x(double x) noexcept {
+  if (x == x_) return;
+  x_ = x;
+  if (spindle_.css_numerator > 0) update_command();
+}
+
 void MachineIo::update_command() noexcept {
   const bool on = spindle_.direction != 0 && !spindle_.paused_off;
   double rpm = spindle_.programmed_rpm;
+  if (spindle_.css_numerator > 0) {
+    // G96: the surface speed at the tool's radius, X from the spindle's axis.
+    const double radius = std::abs(x_ - spindle_.css_x_origin);
+    const double cap = spindle_.css_max_rpm > 0 ? spindle_.css_max_rpm : 1e300;
+    rpm = radius > 1e-9 ? std::min(cap, spindle_.css_numerator / radius) : cap;
+    if (!std::isfinite(rpm)) rpm = 0;
+  }
   if (spindle_.override_enabled) rpm *= spindle_.override_ratio;
   if (!std::isfinite(rpm) || rpm < 0) rpm = 0;
   if (rpm == 0) {
@@ -152,6 +165,12 @@ bool MachineIo::run(const IoAction& action, bool first) noexcept {
       }
       spindle_.direction = action.direction;
       if (std::isfinite(action.rpm) && action.rpm >= 0) spindle_.programmed_rpm = action.rpm;
+      if (std::isfinite(action.css_numerator) && std::isfinite(action.css_max_rpm) &&
+          std::isfinite(action.css_x_origin)) {
+        spindle_.css_numerator = std::max(0.0, action.css_numerator);
+        spindle_.css_max_rpm = std::max(0.0, action.css_max_rpm);
+        spindle_.css_x_origin = action.css_x_origin;
+      }
       update_command();
       return true;
     case Kind::spindle_override_enable:

@@ -32,6 +32,7 @@ void PathExecutor::flush() noexcept {
     moves_done_ += window_at(head_seq_).moves;
     if (window_at(head_seq_).action.kind != IoAction::Kind::none) ++actions_done_;
   }
+  per_rev_in_window_ = 0;
   window_length_ = 0;
   stop_length_ = 0;
   floor_first_ = floor_end_ = 0;
@@ -93,6 +94,11 @@ double PathExecutor::speed_limit(const Segment& segment) const noexcept {
   // Overrides only ever lower the speed below what the axes allow (a feed override above 1
   // raises the feed, never the axis limit); the profile decelerates within the segment's
   // acceleration when the limit drops under the current speed.
+  if (segment.feed_per_rev > 0 && gate_ != nullptr) {
+    // G95: per revolution of the spindle as it turns.
+    return std::min(segment.axis_velocity,
+                    segment.feed_per_rev * gate_->spindle_rps() * feed_override_);
+  }
   if (segment.feed > 0) return std::min(segment.axis_velocity, segment.feed * feed_override_);
   return segment.axis_velocity * rapid_override_;
 }
@@ -159,6 +165,7 @@ void PathExecutor::fill_window() noexcept {
       if (!segments_.pop(seg)) break;
       --pass_budget_;
       --pulls_left_;
+      if (seg.feed_per_rev > 0) ++per_rev_in_window_;
       exit_hard_[static_cast<std::size_t>(seq % kWindow)] = 0;
       exit_soft_[static_cast<std::size_t>(seq % kWindow)] = 0;
       ++window_count_;
@@ -202,6 +209,7 @@ void PathExecutor::finish_front() noexcept {
   ++segments_done_;
   moves_done_ += done.moves;
   if (done.action.kind != IoAction::Kind::none) ++actions_done_;
+  if (done.feed_per_rev > 0) --per_rev_in_window_;
   window_length_ = std::max(0.0, window_length_ - done.length);
   if (floor_end_ > floor_first_ && floor_seq_[floor_first_ % kWindow] == head_seq_) ++floor_first_;
   ++head_seq_;
@@ -216,6 +224,15 @@ double PathExecutor::window_floor_accel() noexcept {
 
 PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joints_apart) noexcept {
   fault_ = Fault::none;
+  // G95 feeds follow the spindle: the look-ahead's speeds are brought up to date when its
+  // speed has changed by more than 1 %.
+  if (gate_ != nullptr && per_rev_in_window_ > 0) {
+    const double rps = gate_->spindle_rps();
+    if (std::abs(rps - spindle_rps_seen_) > 0.01 * std::max(rps, spindle_rps_seen_)) {
+      spindle_rps_seen_ = rps;
+      soft_limits_changed();
+    }
+  }
   // Joints and axes agree at the start of a period (not between two moves inside one).
   bool resting = !has_active_;
   bool moved = has_active_;

@@ -332,6 +332,10 @@ std::optional<Segment> Planner::plan(const Move& move, const AxisPose& start, bo
   }
 
   seg.feed = move.kind == Move::Kind::traverse ? 0.0 : move.feed;
+  seg.feed_per_rev =
+      move.kind != Move::Kind::traverse && std::isfinite(move.feed_per_rev) && move.feed_per_rev > 0
+          ? move.feed_per_rev
+          : 0.0;
   set_limits(seg);
   return seg;
 }

@@ -360,6 +360,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
       watch_probe();
       advance_path();
       follow_probe();
+      io_.track_x(axis_pose_[0]);
       advance_io();
     }
   } else {

@@ -1,6 +1,7 @@
 #include "cncd/pipeline/feeder.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <variant>
 
@@ -13,7 +14,10 @@ void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   input_wait_seen = false;
   probe_seen = false;
   unsupported.reset();
-  if (!mdi) per_revolution_ = false;
+  if (!mdi) {
+    per_revolution_ = false;
+    css_max_rpm_ = 0;
+  }
   per_rev_ = 0;
   holds.clear();
   sync_ = {};
@@ -26,11 +30,21 @@ motion::IoAction ProgramFeeder::spindle_action() const {
   a.kind = motion::IoAction::Kind::spindle;
   a.direction = static_cast<std::int8_t>(spindle_direction);
   a.rpm = spindle_speed;
+  if (css_max_rpm_ > 0) {
+    // G96: S is metres (G21) or feet (G20) per minute at the tool, X0 the spindle's axis.
+    constexpr double kTwoPi = 6.283185307179586;
+    const double per_s = tracker_.program_units() == interp::Units::inches ? 12.0 : 1000.0;
+    a.css_numerator = spindle_speed * per_s * tracker_.length_factor() / kTwoPi;
+    a.css_max_rpm = css_max_rpm_;
+    a.css_x_origin = tracker_.machine_pose(interp::Pose{})[0];
+  }
   return a;
 }
 
 void ProgramFeeder::check_speed(int line) {
-  if (machine_ == nullptr || !on_warning_ || spindle_direction == 0 || spindle_speed <= 0) return;
+  if (machine_ == nullptr || !on_warning_ || spindle_direction == 0 || spindle_speed <= 0 ||
+      css_max_rpm_ > 0)
+    return;
   const config::SpindleConfig& sp = machine_->spindle;
   if (!sp.present || sp.driver == config::SpindleDriver::none) return;
   const bool reverse = spindle_direction < 0;
@@ -170,9 +184,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               add_stop_point();
               move.spindle_sync = motion::SpindleSync::thread;
               move.per_rev = per_rev_;
-              move.feed = per_rev_ * spindle_speed / 60.0;
+              move.feed = per_rev_ * nominal_rpm() / 60.0;
             } else {
               move.feed = feed_per_second();
+              if (per_revolution_) move.feed_per_rev = tracker_.feed_per_minute();
             }
             moving(move);
             return true;
@@ -184,7 +199,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             move.spindle_sync = motion::SpindleSync::tap;
             move.per_rev = per_rev_;
             move.retract_scale = c.scale;
-            move.feed = per_rev_ * spindle_speed / 60.0;
+            move.feed = per_rev_ * nominal_rpm() / 60.0;
             const motion::AxisPose start = end_;
             moving(move);
             // The tap ends where it started, the spindle turning as before: a feed move after
@@ -198,6 +213,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             const in::Pose end = c.end();
             std::copy(end.begin(), end.end(), move.end.begin());
             move.feed = feed_per_second();
+            if (per_revolution_) move.feed_per_rev = tracker_.feed_per_minute();
             move.plane_axes = plane_axes(c.plane);
             move.center_first = c.first_axis;
             move.center_second = c.second_axis;
@@ -234,12 +250,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return false;
           },
           [&](const in::SetSpindleMode& c) {
-            if (c.css_max_rpm > 0 && !unsupported) {
-              unsupported =
-                  Unsupported{m.line,
-                              "constant surface speed (G96) is not available: the spindle turns at "
-                              "the rpm S gives (G97)"};
-            }
+            // G96 D (1e30 without D) or G97: the spindle takes the mode at once, S with it.
+            css_max_rpm_ = std::isfinite(c.css_max_rpm) && c.css_max_rpm > 0 ? c.css_max_rpm : 0.0;
+            add_action(spindle_action(), m.line);
+            need_at_speed_ = spindle_direction != 0;
             return false;
           },
           [&](const in::StartSpeedFeedSynch& c) {
@@ -391,10 +405,20 @@ std::optional<std::string> spindle_position_missing(const config::MachineConfig&
          "DRIVER = none";
 }
 
+double ProgramFeeder::nominal_rpm() const {
+  if (css_max_rpm_ <= 0) return spindle_speed;
+  const motion::IoAction a = spindle_action();
+  const double radius = std::abs(end_[0] - a.css_x_origin);
+  double rpm = radius > 1e-9 ? std::min(a.css_max_rpm, a.css_numerator / radius) : a.css_max_rpm;
+  if (machine_ != nullptr && machine_->spindle.present)
+    rpm = std::min(rpm, machine_->spindle.max_forward_velocity);
+  return rpm;
+}
+
 double ProgramFeeder::feed_per_second() const {
   const double f = tracker_.feed_per_minute();
   // G95: F per revolution at the programmed speed (the interpreter refuses it at S 0).
-  return (per_revolution_ ? f * spindle_speed : f) / 60.0;
+  return (per_revolution_ ? f * nominal_rpm() : f) / 60.0;
 }
 
 Drained ProgramFeeder::drain(MoveTarget& target) {

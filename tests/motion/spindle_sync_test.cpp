@@ -382,5 +382,53 @@ TEST_F(SpindleSyncTest, ASpindleThatDoesNotTurnEndsTheMove) {
   EXPECT_EQ(s.commanded[2], 0);
 }
 
+// G95: the feed follows the spindle as it turns, not as programmed: a spindle override of
+// 50 % halves it.
+TEST_F(SpindleSyncTest, FeedPerRevolutionFollowsTheSpindlesActualSpeed) {
+  start(mill_with_sim_spindle(3000));
+  Move cut = line_to(Move::Kind::feed, 50, 0, 0, 0.1 * 600 / 60.0);
+  cut.feed_per_rev = 0.1;  // 1 mm/s at 600 rpm
+  machine_->queue(cut);
+  run(1000);
+  const double x0 = machine_->status().commanded[0];
+  run(100);
+  EXPECT_NEAR((machine_->status().commanded[0] - x0) / 0.1, 1.0, 1e-6);
+  send({Command::Kind::spindle_override, 0, 0, 0.5});
+  run(400);  // the spindle ramps down to 300 rpm in 0.1 s
+  EXPECT_NEAR(machine_->status().spindle.actual_rpm, 300, 1e-6);
+  const double x1 = machine_->status().commanded[0];
+  run(100);
+  EXPECT_NEAR((machine_->status().commanded[0] - x1) / 0.1, 0.5, 1e-6);
+}
+
+// G96: the spindle turns at the surface speed over the tool's distance from X0, within D.
+TEST_F(SpindleSyncTest, ConstantSurfaceSpeedFollowsX) {
+  machine_ = std::make_unique<VirtualMachine>(mill_with_sim_spindle(60000));
+  machine_->ready();
+  machine_->queue(line_to(Move::Kind::traverse, 50, 0, 0));
+  IoAction css;
+  css.kind = IoAction::Kind::spindle;
+  css.direction = 1;
+  css.rpm = 100;                                            // m/min
+  css.css_numerator = 100 * 1000 / (2 * 3.14159265358979);  // mm/min over 2 pi
+  css.css_max_rpm = 2000;
+  css.css_x_origin = 0;
+  machine_->queue(action(css));
+  machine_->queue(line_to(Move::Kind::feed, 1, 0, 0, 5));
+  for (int i = 0; i < 5000 && machine_->status().spindle.direction == 0; ++i)
+    run(1);
+  ASSERT_EQ(machine_->status().commanded[0], 50);
+  // At X50: 100 m/min / (2 pi 50 mm) = 318.3 rpm.
+  EXPECT_NEAR(machine_->status().spindle.commanded_rpm, 318.31, 0.01);
+  // Half way in, twice as fast.
+  for (int i = 0; i < 20000 && machine_->status().commanded[0] > 25; ++i)
+    run(1);
+  EXPECT_NEAR(machine_->status().spindle.commanded_rpm, 100e3 / (2 * 3.14159265358979 * 25), 0.2);
+  run(20000, true);
+  EXPECT_NEAR(machine_->status().commanded[0], 1, 1e-9);
+  // At X1 it would be 15,915 rpm: D caps it.
+  EXPECT_NEAR(machine_->status().spindle.commanded_rpm, 2000, 1e-9);
+}
+
 }  // namespace
 }  // namespace cncd::test

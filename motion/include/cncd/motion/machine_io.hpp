@@ -34,6 +34,8 @@ class ActionGate {
                               double dt, double& s, double& v) noexcept = 0;
   // RT: the segment in step with the spindle is over or dropped.
   CNCD_RT virtual void sync_ended() noexcept = 0;
+  // RT: how fast the spindle turns (rev/s, >= 0) for G95 feeds, as measured this period.
+  CNCD_RT virtual double spindle_rps() const noexcept = 0;
 };
 
 class MachineIo final : public ActionGate {
@@ -45,6 +47,10 @@ class MachineIo final : public ActionGate {
   CNCD_RT bool follow(const Segment& segment, bool first, double feed_override, bool stop,
                       double dt, double& s, double& v) noexcept override;
   CNCD_RT void sync_ended() noexcept override;
+  CNCD_RT double spindle_rps() const noexcept override { return spindle_.actual_rpm / 60.0; }
+  // The X axis's position (machine coordinates) this period: constant surface speed (G96)
+  // sets the spindle's speed from it.
+  CNCD_RT void track_x(double x) noexcept;
   CNCD_RT SyncStatus sync() const noexcept {
     SyncStatus out = sync_.status();
     out.done = syncs_done_;
@@ -117,6 +123,7 @@ class MachineIo final : public ActionGate {
   // spindle's position last period (its signed speed) or, for the ideal spindle, where its
   // command has taken it.
   SyncFollower sync_;
+  double x_ = 0;  // the X axis, for G96
   bool tapping_ = false;
   double tap_rps_ = 0;  // what the tap drives the spindle at, signed
   bool has_last_revolutions_ = false;

@@ -123,6 +123,8 @@ class PathExecutor {
   double period_s_;
   SegmentRing segments_;
   double feed_override_ = 1.0;
+  double spindle_rps_seen_ = 0;  // the spindle speed the look-ahead's G95 speeds were set at
+  int per_rev_in_window_ = 0;    // G95 segments in the look-ahead window
   double rapid_override_ = 1.0;
   // Look-ahead window: the segments taken from the ring, oldest first; the first is being
   // executed once has_active_. Segment sequence number n lives in window_[n % kWindow];

@@ -22,6 +22,7 @@ struct Segment {
   double max_velocity = 0;      // path speed limit, units/s (feed, axis and arc limits)
   double axis_velocity = 0;     // path speed limit of the axes and the arc alone, units/s
   double feed = 0;              // programmed feed, units/s; 0 = traverse (rapid override)
+  double feed_per_rev = 0;      // G95: units per spindle revolution (feed follows the spindle)
   double max_acceleration = 0;  // path acceleration limit, units/s^2
   double dwell_s = 0;
   // Arc: centre in the plane, radius at the start, start angle and signed sweep (rad), plane

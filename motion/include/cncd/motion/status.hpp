@@ -52,6 +52,10 @@ struct SpindleStatus {
   bool has_position = false;     // revolutions comes from an encoder (or the sim spindle)
   double revolutions = 0;
   bool paused_off = false;  // stopped by a pause ([SPINDLE_0] STOP_ON_PAUSE), restarts on resume
+  // G96 (IoAction::css_*): programmed_rpm is then the surface speed; 0 = G97.
+  double css_numerator = 0;
+  double css_max_rpm = 0;
+  double css_x_origin = 0;
 };
 
 // The machine's outputs and inputs.

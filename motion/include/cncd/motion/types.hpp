@@ -47,6 +47,13 @@ struct IoAction {
   double rpm = 0;
   double value = 0;
   double timeout_s = 0;
+  // spindle: constant surface speed (G96) when css_numerator > 0: the spindle turns at
+  // css_numerator / |X - css_x_origin| rpm (X machine coordinates; css_numerator = the surface
+  // speed in machine units per minute over 2 pi), at most css_max_rpm; `rpm` is then the
+  // programmed surface speed.
+  double css_numerator = 0;
+  double css_max_rpm = 0;
+  double css_x_origin = 0;
 };
 
 // Outputs set as a move starts (M62/M63, M67), exact to the servo period.
@@ -78,6 +85,9 @@ struct Move {
   Kind kind = Kind::traverse;
   AxisPose end{};   // end point (traverse, feed, arc)
   double feed = 0;  // units/s along the path (feed, arc); traverse uses the limits
+  // G95: units per spindle revolution; the feed then follows the spindle's actual speed
+  // (`feed` is its value at the programmed speed, for planning).
+  double feed_per_rev = 0;
   // Arc: centre in the plane's two axes, the plane's normal axis, turns (>0 ccw, <0 cw,
   // LinuxCNC's "rotation": 1 = one ccw arc, -1 = one cw arc, 2 = one full extra ccw turn ...).
   std::array<int, 3> plane_axes{0, 1, 2};  // first, second, normal axis index (XY: 0,1,2)

@@ -124,9 +124,14 @@ class ProgramFeeder final : public interp::CanonSink {
   // The feed of the next feed move, machine units per second: F, or under G95 F per revolution
   // times the programmed spindle speed.
   double feed_per_second() const;
+  // The spindle's speed as programmed (rpm): S, or under G96 the speed at the X the last move
+  // ends at, within D.
+  double nominal_rpm() const;
   bool per_revolution_ = false;  // G95
   // Between START_SPEED_FEED_SYNCH and its stop: machine units per revolution (0: none).
   double per_rev_ = 0;
+  // G96's D (maximum rpm; 1e30 when D is not given), 0 in G97.
+  double css_max_rpm_ = 0;
   // M62/M63/M67 waiting for the next move.
   motion::SyncOutputs sync_{};
   // M3/M4 or S changed the spindle: the next feed move waits until it is at speed.
