@@ -68,6 +68,7 @@ json spindle_object(const SpindleReport& sp) {
            {"actual_rpm", sp.actual_rpm},
            {"at_speed", sp.at_speed}};
   if (sp.position) out["position"] = *sp.position;
+  out["css"] = sp.css_max_rpm ? json{{"max_rpm", *sp.css_max_rpm}} : json(nullptr);
   return out;
 }
 

@@ -70,6 +70,9 @@ struct SpindleReport {
   double actual_rpm = 0;
   bool at_speed = true;
   std::optional<double> position;  // revolutions, with an encoder (or the sim spindle)
+  // G96: the spindle's speed follows X; programmed_speed is then the surface speed (m/min in
+  // G21, ft/min in G20) and css_max_rpm its D. Unset in G97.
+  std::optional<double> css_max_rpm;
 };
 
 // The machine's outputs and inputs.

@@ -238,12 +238,15 @@ TaskStatus Task::status() const {
   out.spindle.programmed_speed = sp.programmed_rpm;
   out.spindle.override_ratio = sp.override_ratio;
   out.spindle.override_enabled = sp.override_enabled;
-  out.spindle.speed = sp.programmed_rpm * (sp.override_enabled ? sp.override_ratio : 1.0);
+  out.spindle.speed = sp.css_numerator > 0
+                          ? sp.commanded_rpm
+                          : sp.programmed_rpm * (sp.override_enabled ? sp.override_ratio : 1.0);
   out.spindle.enabled = sp.enabled;
   out.spindle.commanded_rpm = sp.commanded_rpm;
   out.spindle.actual_rpm = sp.actual_rpm;
   out.spindle.at_speed = sp.at_speed;
   if (sp.has_position) out.spindle.position = sp.revolutions;
+  if (sp.css_numerator > 0) out.spindle.css_max_rpm = sp.css_max_rpm;
   out.sync = sync_report(s.sync);
   out.mist = s.io.mist;
   out.flood = s.io.flood;

@@ -77,24 +77,5 @@ TEST_F(ProbeDaemon, AProbeTouchingAtTheStartIsRefused) {
       << s.dump();
 }
 
-// What the machine cannot do yet is refused when the program is opened, at its line, never run
-// as something else (a G96 surface speed as rpm).
-TEST_F(ProbeDaemon, SurfaceSpeedIsRefusedAtOpen) {
-  const struct {
-    const char* program;
-    const char* message;
-  } cases[] = {
-      {"G21\nG96 D2000 S100 M3\nG1 X1 F100\nM2\n",
-       ":2: constant surface speed (G96) is not available"},
-  };
-  for (const auto& c : cases) {
-    SCOPED_TRACE(c.program);
-    const auto program = dir_.write("refused.ngc", c.program);
-    const auto r = call("program.open", {{"path", program.string()}});
-    EXPECT_EQ(error_code(r), 1003);
-    EXPECT_NE(r["error"].value("message", "").find(c.message), std::string::npos) << r.dump();
-  }
-}
-
 }  // namespace
 }  // namespace cncd::test

@@ -82,5 +82,27 @@ TEST_F(SyncDaemon, ThreadRunsToItsEnd) {
   EXPECT_NEAR(z(s), 20, 1e-9);
 }
 
+// G96: the spindle's speed follows X (program X0 the spindle's axis) within D; G97 turns at S.
+TEST_F(SyncDaemon, ConstantSurfaceSpeedFollowsX) {
+  ready_machine();
+  mdi("G21 G90 G0 X40 Y10 Z5");
+  mdi("G96 D1000 S100 M3");
+  auto s = wait_until([](const nlohmann::json& st) { return st["spindle"]["at_speed"] == true; });
+  // 100 m/min at 40 mm from the axis: 100000 / (2 pi 40) = 397.9 rpm.
+  EXPECT_NEAR(s["spindle"]["commanded_rpm"].get<double>(), 397.887, 0.01) << s["spindle"].dump();
+  EXPECT_EQ(s["spindle"]["css"]["max_rpm"], 1000.0);
+  EXPECT_EQ(s["spindle"]["programmed_speed"], 100.0);
+  mdi("G1 X20 F600");
+  s = wait_until([](const nlohmann::json& st) { return st["motion"] == "idle"; });
+  EXPECT_NEAR(s["spindle"]["commanded_rpm"].get<double>(), 795.775, 0.01);
+  mdi("G0 X5");
+  s = wait_until([](const nlohmann::json& st) { return st["motion"] == "idle"; });
+  EXPECT_NEAR(s["spindle"]["commanded_rpm"].get<double>(), 1000, 1e-9);  // D
+  mdi("G97 S500");
+  s = status();
+  EXPECT_NEAR(s["spindle"]["commanded_rpm"].get<double>(), 500, 1e-9);
+  EXPECT_TRUE(s["spindle"]["css"].is_null());
+}
+
 }  // namespace
 }  // namespace cncd::test
