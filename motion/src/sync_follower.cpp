@@ -65,6 +65,19 @@ void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcep
   }
 }
 
+void SyncFollower::watch_stall(bool stalled, const Spindle& spindle, double dt,
+                               Step& out) noexcept {
+  if (!stalled) {
+    stalled_s_ = 0;
+    return;
+  }
+  stalled_s_ += dt;
+  if (spindle.stall_timeout_s > 0 && stalled_s_ >= spindle.stall_timeout_s) {
+    out.error = RtEvent::Code::sync_stalled;
+    out.error_limit = spindle.stall_timeout_s;
+  }
+}
+
 SyncFollower::Step SyncFollower::step(const Segment& segment, const Spindle& spindle,
                                       double feed_override, bool stop, double dt) noexcept {
   return segment.spindle_sync == SpindleSync::tap
@@ -160,15 +173,8 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
     return out;
   }
   // A spindle that is driven and does not turn.
-  if (std::abs(command_) > 10.0 * kRestRps && std::abs(progress - last_progress_) < 1e-6) {
-    stalled_s_ += dt;
-    if (spindle.stall_timeout_s > 0 && stalled_s_ >= spindle.stall_timeout_s) {
-      out.error = RtEvent::Code::sync_stalled;
-      out.error_limit = spindle.stall_timeout_s;
-    }
-  } else {
-    stalled_s_ = 0;
-  }
+  watch_stall(std::abs(command_) > 10.0 * kRestRps && std::abs(progress - last_progress_) < 1e-6,
+              spindle, dt, out);
   last_progress_ = progress;
   return out;
 }
@@ -219,15 +225,7 @@ SyncFollower::Step SyncFollower::thread_step(const Segment& segment, const Spind
     out.done = true;
   }
   // Waiting for a spindle that does not turn.
-  if (status_.phase == Phase::index && std::abs(spindle.rps) <= kRestRps) {
-    stalled_s_ += dt;
-    if (spindle.stall_timeout_s > 0 && stalled_s_ >= spindle.stall_timeout_s) {
-      out.error = RtEvent::Code::sync_stalled;
-      out.error_limit = spindle.stall_timeout_s;
-    }
-  } else {
-    stalled_s_ = 0;
-  }
+  watch_stall(status_.phase == Phase::index && std::abs(spindle.rps) <= kRestRps, spindle, dt, out);
   return out;
 }
 

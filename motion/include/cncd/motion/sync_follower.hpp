@@ -61,6 +61,8 @@ class SyncFollower {
  private:
   CNCD_RT Step tap_step(const Segment& segment, const Spindle& spindle, double feed_override,
                         bool stop, double dt) noexcept;
+  // Counts the time the spindle has been `stalled` in a row; past its timeout, the step fails.
+  CNCD_RT void watch_stall(bool stalled, const Spindle& spindle, double dt, Step& out) noexcept;
   CNCD_RT Step thread_step(const Segment& segment, const Spindle& spindle, bool stop,
                            double dt) noexcept;
 
