@@ -120,6 +120,11 @@ int format(const RtEvent& e, char* out, std::size_t size) {
                            "spindle 0 did not turn for %.3g s during a move in step with it "
                            "(G33, G33.1, rigid tapping; [SPINDLE_0] AT_SPEED_TIMEOUT)",
                            clamped(e.limit));
+    case Code::sync_jump:
+      return std::snprintf(out, size,
+                           "spindle 0's position jumped %.3g revolutions in one servo period "
+                           "during a rigid tap (at most %.3g): the tap was stopped there",
+                           clamped(e.error), clamped(e.limit));
     case Code::sync_not_at_rest:
       return std::snprintf(out, size,
                            "spindle 0 did not come to rest within %.3g s to start a rigid tap "

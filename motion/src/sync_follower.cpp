@@ -23,6 +23,11 @@ constexpr double kBrakeShare = 0.8;
 // ramp's where the ramp begins or ends.
 constexpr double kRampShare = 0.9;
 constexpr double kAxisShare = 0.5;
+// A tap's axis may move at most this share of the line's speed limit in a period, plus this
+// many revolutions (an encoder's counts, rounding): a larger step is a spindle position that
+// jumped.
+constexpr double kJumpShare = 1.25;
+constexpr double kJumpSlackRev = 0.002;
 // A thread settles on its helix with this time constant, in servo periods.
 constexpr double kSettlePeriods = 8;
 
@@ -47,6 +52,7 @@ void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcep
   stopping_s_ = 0;
   rest_periods_ = 0;
   locked_ = false;
+  last_s_ = 0;
   path_v_ = 0;
   path_s_ = 0;
   direction_ = spindle.direction != 0 ? spindle.direction : (spindle.rps < 0 ? -1 : 1);
@@ -165,6 +171,18 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
     out.v = 0;
   }
 
+  // A position that jumps (an encoder that slipped or was reset, a wild reading) would throw
+  // the axis: the axis stays where it was and the move stops.
+  const double step_limit = kJumpShare * segment.axis_velocity * dt + kJumpSlackRev * per_rev;
+  if (locked && std::abs(out.s - last_s_) > step_limit) {
+    out.error = RtEvent::Code::sync_jump;
+    out.error_value = std::abs(progress - last_progress_);
+    out.error_limit = step_limit / per_rev;
+    out.s = last_s_;
+    out.v = 0;
+    return out;
+  }
+  last_s_ = out.s;
   // A spindle that runs on past either end would drag the tap off its thread: stopped.
   if (locked && (progress > bottom + kOverrunRev || progress < -kOverrunRev)) {
     out.error = RtEvent::Code::sync_overrun;

@@ -367,6 +367,51 @@ TEST_F(SpindleSyncTest, ASpindleThatRunsOnPastTheBottomStopsTheTap) {
   EXPECT_EQ(s.spindle.direction, 0);
 }
 
+// A spindle drive with an encoder that does as told at once, until its reading jumps 3
+// revolutions as it passes `jump_at` (3.01 in that period at 600 rpm).
+class JumpingSpindle final : public FakeDriver {
+ public:
+  explicit JumpingSpindle(double jump_at) : FakeDriver("jumping"), jump_at_(jump_at) {}
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    const auto& sp = command.spindle;
+    rps_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;
+  }
+  void read_io(drivers::IoFeedback& feedback) noexcept override {
+    const double before = revolutions_;
+    revolutions_ += rps_ * 0.001;
+    if (before < jump_at_ && revolutions_ >= jump_at_) revolutions_ += 3;
+    feedback.spindle.present = true;
+    feedback.spindle.has_position = true;
+    feedback.spindle.rpm = std::abs(rps_) * 60;
+    feedback.spindle.revolutions = revolutions_;
+  }
+
+ private:
+  double jump_at_;
+  double rps_ = 0;
+  double revolutions_ = 0;
+};
+
+TEST_F(SpindleSyncTest, APositionThatJumpsStopsTheTapWhereItWas) {
+  JumpingSpindle spindle(5);
+  VirtualMachine m(mill_with_driven_spindle(), drivers::kCapHomeSwitch, nullptr, &spindle);
+  m.ready();
+  m.queue(spindle_on(600));
+  m.queue(synced(SpindleSync::tap, -20));
+  m.run_until_idle(20000);
+  const motion::Status s = m.status();
+  EXPECT_EQ(s.path_error.code, motion::RtEvent::Code::sync_jump);
+  EXPECT_NE(motion::format_event(s.path_error).find("jumped 3.01 revolutions in one servo period"),
+            std::string::npos)
+      << motion::format_event(s.path_error);
+  // The axis never took the jump: never faster than its limit, and it stopped in the hole (at
+  // once: the spindle's position can no longer be followed).
+  EXPECT_LE(peaks(m, {0, 0, 0}).velocity, 1.001);
+  EXPECT_LT(s.commanded[2], -1);
+  EXPECT_GT(s.commanded[2], -20);
+  EXPECT_EQ(s.spindle.direction, 0);
+}
+
 TEST_F(SpindleSyncTest, ASpindleThatDoesNotTurnEndsTheMove) {
   LateSpindle spindle(0, true);
   VirtualMachine m(mill_with_driven_spindle(), drivers::kCapHomeSwitch, nullptr, &spindle);

@@ -47,7 +47,8 @@ struct RtEvent {
     probe_contact_kept,        // G38.4 ended without losing contact
     sync_overrun,              // the spindle went `error` rev past a tap's end (`limit` allowed)
     sync_stalled,              // the spindle did not turn in a synchronized move for `limit` s
-    sync_not_at_rest,          // the spindle did not come to rest for a tap within `limit` s
+    sync_jump,         // the spindle's position jumped `error` rev in a period (`limit` allowed)
+    sync_not_at_rest,  // the spindle did not come to rest for a tap within `limit` s
   };
   Code code = Code::none;
   EventLevel level = EventLevel::info;
