@@ -49,6 +49,8 @@ void MachineIo::update_command() noexcept {
     spindle_.at_speed = true;
   }
   if (tapping_) apply_tap();
+  // The new command against this period's speed: a spindle just started is not at speed yet.
+  spindle_.at_speed = at_speed();
 }
 
 void MachineIo::apply_tap() noexcept {

@@ -135,6 +135,22 @@ TEST(MachineIo, FeedWaitsForTheSpindleToReachSpeed) {
   EXPECT_EQ(s.wait.kind, WaitStatus::Kind::none);
 }
 
+// The status of the period the spindle is told to turn is whole: turning at 0 rpm, not yet at
+// speed (a client that reads it then must not see a spindle at speed at 0 rpm).
+TEST(MachineIo, TheSpindleIsNotAtSpeedInThePeriodItIsStarted) {
+  Rig rig(mill_with_spindle(3000));
+  auto& m = rig.m;
+  ASSERT_TRUE(m.status().spindle.at_speed);  // stopped, and so at its speed
+  m.queue(action(spindle(1, 3000)));
+  m.flush();
+  for (int i = 0; i < 100 && !m.status().spindle.enabled; ++i)
+    m.cycles(1);
+  const auto s = m.status();
+  ASSERT_TRUE(s.spindle.enabled);
+  EXPECT_EQ(s.spindle.actual_rpm, 0);
+  EXPECT_FALSE(s.spindle.at_speed);
+}
+
 TEST(MachineIo, ATraverseDoesNotWaitForTheSpindle) {
   Rig rig(mill_with_spindle(100));  // 30 s to 3000 rpm
   auto& m = rig.m;
