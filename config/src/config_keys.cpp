@@ -260,6 +260,19 @@ constexpr std::array kKeys{
                 "modbus: status bit set at the commanded speed; -1 = none"),
     integer_key("SPINDLE_0", "FAULT_BIT", "2", -1, 15, "",
                 "modbus: status bit set when the VFD has tripped; -1 = none"),
+    integer_key("SPINDLE_0", "POSITION_REGISTER", "-1", -1, 65535, "",
+                "modbus: first register of the shaft's position counter, in POSITION_TABLE, for "
+                "spindle-synchronized motion (G33, G33.1, rigid tapping); -1 = none"),
+    choice_key("SPINDLE_0", "POSITION_TABLE", "ir", "ir|hr",
+               "modbus: the position is in input (ir) or holding (hr) registers"),
+    choice_key("SPINDLE_0", "POSITION_WIDTH", "32", "16|32",
+               "modbus: the position counter is 16 bits (one register) or 32 (two); it may wrap",
+               "bits"),
+    choice_key("SPINDLE_0", "WORD_ORDER", "HIGH_FIRST", "HIGH_FIRST|LOW_FIRST",
+               "modbus: which register of a 32-bit position comes first"),
+    real_key("SPINDLE_0", "POSITION_SCALE", "", -kInf, kInf, "counts/rev",
+             "modbus: position counts a revolution; negative when the count goes down turning "
+             "forward (M3)"),
 
     position_key("AXIS_L", "MIN_LIMIT", "-1e99",
                  "Lowest position programs and jogs may reach (soft limit)"),

@@ -69,6 +69,11 @@ void load_spindle_modbus(TypedReader& r, SpindleConfig& s) {
   integer("RUNNING_BIT", s.running_bit);
   integer("AT_SPEED_BIT", s.at_speed_bit);
   integer("FAULT_BIT", s.fault_bit);
+  integer("POSITION_REGISTER", s.position_register);
+  if (const auto v = r.choice(kSpindle, "POSITION_TABLE")) s.position_table = register_table(*v);
+  if (const auto v = r.choice(kSpindle, "POSITION_WIDTH")) s.position_width = *v == "16" ? 16 : 32;
+  if (const auto v = r.choice(kSpindle, "WORD_ORDER")) s.position_high_first = *v != "LOW_FIRST";
+  if (const auto v = r.real(kSpindle, "POSITION_SCALE")) s.position_scale = *v;
 }
 
 // Keys of one driver given with another: read by nobody, which the machinist should know.
@@ -96,7 +101,9 @@ constexpr std::initializer_list<const char*> kModbusKeys = {
     "STATUS_TABLE",    "COMMAND_STOP",
     "COMMAND_FORWARD", "COMMAND_REVERSE",
     "RUNNING_BIT",     "AT_SPEED_BIT",
-    "FAULT_BIT"};
+    "FAULT_BIT",       "POSITION_REGISTER",
+    "POSITION_TABLE",  "POSITION_WIDTH",
+    "WORD_ORDER",      "POSITION_SCALE"};
 
 // DIGITAL_OUTPUT_n and its kin: every key of the pattern in [CNCD], n below N.
 template <std::size_t N>

@@ -1,6 +1,7 @@
 // Cross-checks of the spindle, the [CNCD] signals and the tool change: what a driver needs,
 // which way each address can carry a signal, the buses and lines they name, and no output
 // driven from two places.
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -153,6 +154,36 @@ void check_gpio_spindle(TypedReader& r, const MachineConfig& c) {
   }
 }
 
+// The position counter of a servo spindle or VFD: it is unwrapped between readings, so a
+// revolution must be well under half its range.
+void check_spindle_position(TypedReader& r, const SpindleConfig& s) {
+  if (s.position_register < 0) {
+    for (const char* key : {"POSITION_TABLE", "POSITION_WIDTH", "WORD_ORDER", "POSITION_SCALE"}) {
+      if (r.given(kSpindle, key) && !r.failed(kSpindle, "POSITION_REGISTER")) {
+        r.warning(kSpindle, key, "ignored: no POSITION_REGISTER");
+      }
+    }
+    return;
+  }
+  if (s.position_width == 32 && s.position_register > 65534) {
+    r.problem(kSpindle, "POSITION_REGISTER",
+              "a 32-bit position takes two registers: at most 65534");
+  }
+  if (r.failed(kSpindle, "POSITION_SCALE")) return;
+  if (!r.given(kSpindle, "POSITION_SCALE")) {
+    r.problem(kSpindle, "POSITION_REGISTER",
+              "POSITION_REGISTER needs POSITION_SCALE, the position counts a revolution");
+  } else if (s.position_scale == 0) {
+    r.problem(kSpindle, "POSITION_SCALE", "must not be 0 (counts a revolution)");
+  } else if (std::fabs(s.position_scale) > std::ldexp(1.0, s.position_width - 2)) {
+    r.problem(kSpindle, "POSITION_SCALE",
+              "a " + std::to_string(s.position_width) + "-bit counter wraps every " +
+                  std::to_string(1LL << s.position_width) +
+                  " counts: a revolution must be at most a quarter of that (" +
+                  std::to_string(1LL << (s.position_width - 2)) + ")");
+  }
+}
+
 void check_modbus_spindle(TypedReader& r, const SpindleConfig& s) {
   if (!r.given(kSpindle, "MODBUS")) {
     r.problem(kSpindle, "DRIVER", "DRIVER = modbus needs MODBUS = n naming a [MODBUS_n] section");
@@ -166,6 +197,7 @@ void check_modbus_spindle(TypedReader& r, const SpindleConfig& s) {
               "COMMAND_REGISTER and SPEED_REGISTER are both holding register " +
                   std::to_string(s.speed_register));
   }
+  check_spindle_position(r, s);
 }
 
 // A line of the joints and [GPIO] ("[JOINT_0] STEP_LINE") and whether cncd drives it.

@@ -72,7 +72,18 @@ ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives, IoSetti
       readbacks_(std::make_unique<Seqlock<Readback>[]>(drives_.size())),
       state_(drives_.size()),
       io_(std::move(io)),
-      point_written_(io_.points.size(), std::numeric_limits<double>::quiet_NaN()) {}
+      point_written_(io_.points.size(), std::numeric_limits<double>::quiet_NaN()) {
+  const VfdSettings& v = io_.vfd;
+  // Readings further apart than a few updates and a slow reply: the bus was down.
+  const std::int64_t gap_ns = (4LL * bus_.update_period_ms + bus_.timeout_ms) * 1'000'000;
+  vfd_position_.configure(v.position_width, v.position_scale, v.max_acceleration, gap_ns);
+  if (bus_.rtu && bus_.baud > 0) {
+    // A read request is 8 bytes on the line, each a start bit, its data, parity and stop bits:
+    // the drive reads its counter once the last of them has arrived.
+    const int bits = 1 + bus_.data_bits + (bus_.parity == 'N' ? 0 : 1) + bus_.stop_bits;
+    request_ns_ = 8LL * bits * 1'000'000'000 / bus_.baud;
+  }
+}
 
 ModbusBus::~ModbusBus() {
   stop();
@@ -350,16 +361,31 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
       run == v.command_stop ? write_command() && write_speed() : write_speed() && write_command();
   if (!wrote) return errno != 0 && is_exception(errno);
 
-  // Both read-only registers in one request when they are close together in one table.
   std::uint16_t regs[8] = {};
-  std::uint16_t raw_speed = 0;
-  std::uint16_t status = 0;
   const auto read = [&](bool input, int first, int count) {
     const int n = input ? modbus_read_input_registers(ctx, first, count, regs)
                         : modbus_read_registers(ctx, first, count, regs);
     if (n == -1) failed(input ? "reading input" : "reading holding", first);
     return n != -1;
   };
+  // The position first, stamped with the moment the request reached the drive.
+  const bool has_position = v.position_register >= 0;
+  if (has_position) {
+    const std::int64_t sent = monotonic_ns();
+    if (!read(v.position_input, v.position_register, v.position_width / 16)) {
+      return is_exception(errno);
+    }
+    std::uint32_t raw = regs[0];
+    if (v.position_width == 32) {
+      raw = v.position_high_first ? (std::uint32_t{regs[0]} << 16) | regs[1]
+                                  : (std::uint32_t{regs[1]} << 16) | regs[0];
+    }
+    io_last_.vfd_position = vfd_position_.add(raw, sent + request_ns_);
+  }
+
+  // Both read-only registers in one request when they are close together in one table.
+  std::uint16_t raw_speed = 0;
+  std::uint16_t status = 0;
   const bool has_speed = v.actual_speed_register >= 0;
   const bool has_status = v.status_register >= 0;
   bool ok = true;
@@ -386,6 +412,7 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
   io_last_.vfd_time_ns = now;
   io_last_.vfd_status = status;
   io_last_.vfd_rpm = has_speed               ? raw_speed / v.speed_scale
+                     : has_position          ? std::abs(io_last_.vfd_position.rps) * 60.0
                      : sp.enable && !refused ? std::abs(sp.rpm)
                                              : 0.0;
   const auto bit = [&](int n) { return n >= 0 && has_status && ((status >> n) & 1u) != 0; };

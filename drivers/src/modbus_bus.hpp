@@ -14,6 +14,7 @@
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/fault_reason.hpp"
 #include "cncd/drivers/seqlock.hpp"
+#include "cncd/drivers/spindle_position.hpp"
 
 namespace cncd::drivers {
 
@@ -78,6 +79,13 @@ struct VfdSettings {
   int running_bit = 0;  // -1 = none
   int at_speed_bit = 1;
   int fault_bit = 2;
+  // The shaft's position counter (config::SpindleConfig::position_register ...); -1 = none.
+  int position_register = -1;
+  bool position_input = true;
+  int position_width = 32;
+  bool position_high_first = true;
+  double position_scale = 1;       // counts a revolution
+  double max_acceleration = 0;     // rev/s^2, 0 = unknown
 };
 
 struct IoSettings {
@@ -101,6 +109,7 @@ struct IoReadback {
   std::int64_t vfd_time_ns = 0;  // CLOCK_MONOTONIC of the VFD's last full answer; 0 = never
   std::uint16_t vfd_status = 0;
   bool vfd_fault = false;  // the fault bit, a refused reverse, or not running when told to
+  SpindlePositionFit vfd_position;  // the shaft's motion at its last reading (valid: read)
 };
 
 // Servo thread -> I/O thread.
@@ -210,6 +219,8 @@ class ModbusBus {
   std::int64_t vfd_healthy_since_ns_ = 0;
   std::uint32_t vfd_starts_seen_ = 0;
   FaultReason vfd_reason_;
+  SpindlePositionTracker vfd_position_;
+  std::int64_t request_ns_ = 0;  // the time a request takes to reach the drive (RTU: its bytes)
   std::uint32_t reason_reset_ = 0;  // the reset request that last cleared reason_
   void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
   bool link_failed_ = false;

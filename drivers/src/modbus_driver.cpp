@@ -122,6 +122,17 @@ std::string collect_io(const config::MachineConfig& machine, std::map<int, IoSet
   v.running_bit = sp.running_bit;
   v.at_speed_bit = sp.at_speed_bit;
   v.fault_bit = sp.fault_bit;
+  if (sp.position_register >= 0) {
+    if (sp.position_scale == 0 && problem.empty()) {
+      problem = section + "POSITION_REGISTER needs POSITION_SCALE (counts a revolution)";
+    }
+    v.position_register = sp.position_register;
+    v.position_input = sp.position_table != config::SignalAddress::Table::holding;
+    v.position_width = sp.position_width;
+    v.position_high_first = sp.position_high_first;
+    v.position_scale = sp.position_scale;
+    v.max_acceleration = sp.acceleration / 60.0;
+  }
   return problem;
 }
 
@@ -324,6 +335,11 @@ void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
                   ((rb.vfd_status >> at_speed_bit_) & 1u) != 0;
     fb.fault = rb.vfd_fault;
     fb.stale = rb.vfd_time_ns == 0 || now - rb.vfd_time_ns > slot.stale_ns;
+    if (rb.vfd_position.valid) {
+      // Where the shaft is now, not where it was when the bus last read it.
+      fb.has_position = true;
+      fb.revolutions = rb.vfd_position.at(now, slot.stale_ns);
+    }
   }
 }
 

@@ -193,6 +193,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return true;
           },
           [&](const in::RigidTap& c) {
+            if (!unsupported && machine_ != nullptr) {
+              if (auto why = spindle_cannot_reverse(*machine_))
+                unsupported = Unsupported{m.line, *why};
+            }
             add_stop_point();
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
@@ -396,13 +400,29 @@ std::optional<std::string> spindle_position_missing(const config::MachineConfig&
       return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
              "position: [SPINDLE_0] has no encoder (ENCODER_A, ENCODER_B, ENCODER_PPR)";
     case config::SpindleDriver::modbus:
+      if (sp.position_register >= 0) return std::nullopt;
       return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
-             "position, and a Modbus VFD ([SPINDLE_0] DRIVER = modbus) reports only its speed";
+             "position: the Modbus spindle ([SPINDLE_0] DRIVER = modbus) has no "
+             "POSITION_REGISTER";
     case config::SpindleDriver::none:
       break;
   }
   return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs a spindle: [SPINDLE_0] "
          "DRIVER = none";
+}
+
+std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine) {
+  const config::SpindleConfig& sp = machine.spindle;
+  if (!sp.present || sp.driver == config::SpindleDriver::none) return std::nullopt;
+  if (sp.max_reverse_velocity == 0) {
+    return "rigid tapping turns the spindle back out of the hole, and [SPINDLE_0] "
+           "MAX_REVERSE_VELOCITY = 0 forbids reverse";
+  }
+  if (sp.driver == config::SpindleDriver::modbus && sp.command_reverse == sp.command_stop) {
+    return "rigid tapping turns the spindle back out of the hole, and the Modbus spindle cannot "
+           "reverse ([SPINDLE_0] COMMAND_REVERSE = COMMAND_STOP)";
+  }
+  return std::nullopt;
 }
 
 double ProgramFeeder::nominal_rpm() const {

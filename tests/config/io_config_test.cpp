@@ -254,6 +254,67 @@ TEST_F(IoConfigTest, ModbusSpindleKeys) {
   EXPECT_NE(describe(c).find("  MODBUS_1 slave 7, command hr 8192"), std::string::npos);
 }
 
+TEST_F(IoConfigTest, ModbusSpindlePositionKeys) {
+  const std::string head = minimal_ini() +
+                           "[MODBUS_1]\nHOST = 127.0.0.1\n"
+                           "[SPINDLE_0]\nDRIVER = modbus\nMODBUS = 1\n";
+  EXPECT_EQ(loaded(head).spindle.position_register, -1);
+  const MachineConfig c =
+      loaded(head +
+             "POSITION_REGISTER = 100\nPOSITION_TABLE = hr\nPOSITION_WIDTH = 16\n"
+             "POSITION_SCALE = -4096\n");
+  const SpindleConfig& s = c.spindle;
+  EXPECT_EQ(s.position_register, 100);
+  EXPECT_EQ(s.position_table, Table::holding);
+  EXPECT_EQ(s.position_width, 16);
+  EXPECT_EQ(s.position_scale, -4096);
+  EXPECT_NE(describe(c).find("  position holding register 100, 16 bits, -4096 counts/rev"),
+            std::string::npos)
+      << describe(c);
+  const MachineConfig wide =
+      loaded(head + "POSITION_REGISTER = 7\nWORD_ORDER = LOW_FIRST\nPOSITION_SCALE = 10000\n");
+  EXPECT_EQ(wide.spindle.position_width, 32);
+  EXPECT_FALSE(wide.spindle.position_high_first);
+  EXPECT_EQ(wide.spindle.position_table, Table::input);
+  EXPECT_NE(describe(wide).find("  position input register 7, 32 bits, low word first, 10000 "
+                                "counts/rev"),
+            std::string::npos);
+  // Without a register the other keys do nothing, and say so.
+  EXPECT_EQ(warnings_of(head + "POSITION_SCALE = 4096\n"),
+            (std::vector<std::string>{
+                at(47) + ": [SPINDLE_0] POSITION_SCALE: ignored: no POSITION_REGISTER"}));
+}
+
+TEST_F(IoConfigTest, BadSpindlePositionKeysAreRefusedAtTheirLines) {
+  const std::string head = minimal_ini() +
+                           "[MODBUS_1]\nHOST = 127.0.0.1\n"
+                           "[SPINDLE_0]\nDRIVER = modbus\nMODBUS = 1\n";
+  const int first = 47;  // the first line after `head`
+  EXPECT_EQ(problems_of(head + "POSITION_REGISTER = 3\n"),
+            (std::vector<std::string>{at(first) +
+                                      ": [SPINDLE_0] POSITION_REGISTER: POSITION_REGISTER needs "
+                                      "POSITION_SCALE, the position counts a revolution"}));
+  EXPECT_EQ(problems_of(head + "POSITION_REGISTER = 3\nPOSITION_SCALE = 0\n"),
+            (std::vector<std::string>{at(first + 1) +
+                                      ": [SPINDLE_0] POSITION_SCALE: must not be 0 (counts a "
+                                      "revolution)"}));
+  EXPECT_EQ(problems_of(head + "POSITION_REGISTER = 3\nPOSITION_WIDTH = 16\n"
+                               "POSITION_SCALE = 20000\n"),
+            (std::vector<std::string>{at(first + 2) +
+                                      ": [SPINDLE_0] POSITION_SCALE: a 16-bit counter wraps "
+                                      "every 65536 counts: a revolution must be at most a "
+                                      "quarter of that (16384)"}));
+  EXPECT_EQ(problems_of(head + "POSITION_REGISTER = 65535\nPOSITION_SCALE = 4096\n"),
+            (std::vector<std::string>{at(first) +
+                                      ": [SPINDLE_0] POSITION_REGISTER: a 32-bit position takes "
+                                      "two registers: at most 65534"}));
+  EXPECT_EQ(problems_of(head + "POSITION_REGISTER = 3\nPOSITION_SCALE = 4096\n"
+                               "POSITION_WIDTH = 24\n"),
+            (std::vector<std::string>{at(first + 2) +
+                                      ": [SPINDLE_0] POSITION_WIDTH: unknown value '24'; expected "
+                                      "one of 16, 32"}));
+}
+
 TEST_F(IoConfigTest, BadSpindleValuesAreRefusedAtTheirLines) {
   const int at_spindle = 43;  // [SPINDLE_0] comes right after minimal_ini()
   EXPECT_EQ(

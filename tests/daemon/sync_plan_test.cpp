@@ -213,10 +213,43 @@ TEST_F(SyncPlan, AMachineWithoutTheSpindlesPositionRefusesSynchronizedMotion) {
        std::string(CNCD_SOURCE_DIR) + "/config/examples/modbus_delta_vfd_e.ini", program.string()});
   EXPECT_EQ(r.exit_status, 1);
   EXPECT_NE(r.err.find("tap.ngc:4: spindle-synchronized motion (G33, G33.1, rigid tapping) needs "
-                       "the spindle's position, and a Modbus VFD ([SPINDLE_0] DRIVER = modbus) "
-                       "reports only its speed"),
+                       "the spindle's position: the Modbus spindle ([SPINDLE_0] DRIVER = modbus) "
+                       "has no POSITION_REGISTER"),
             std::string::npos)
       << r.err;
+}
+
+TEST_F(SyncPlan, ASpindleThatCannotReverseRefusesRigidTappingButThreads) {
+  std::string ini;
+  {
+    std::ifstream in(ini_);
+    std::stringstream text;
+    text << in.rdbuf();
+    ini = text.str();
+  }
+  const auto section = ini.find("[SPINDLE_0]\n");
+  ASSERT_NE(section, std::string::npos);
+  ini.insert(section + 12, "MAX_REVERSE_VELOCITY = 0\n");
+  std::ofstream(ini_) << ini;
+  const auto check = [&](const std::string& name, const std::string& program) {
+    return run_command(
+        {CNCD_CHECK_BINARY, "--ini", ini_.string(), dir_.write(name, program).string()});
+  };
+  const auto tap = check("tap.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33.1 Z-2 K1.25\nM2\n");
+  EXPECT_EQ(tap.exit_status, 1);
+  EXPECT_NE(tap.err.find("tap.ngc:4: rigid tapping turns the spindle back out of the hole, and "
+                         "[SPINDLE_0] MAX_REVERSE_VELOCITY = 0 forbids reverse"),
+            std::string::npos)
+      << tap.err;
+  // RIGID_TAPPING = 1 makes G84 such a tap too.
+  const auto g84 =
+      check("g84.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG95 G84 Z-2 R2 F1.25\nG80\nM2\n");
+  EXPECT_EQ(g84.exit_status, 1);
+  EXPECT_NE(g84.err.find("g84.ngc:4: rigid tapping turns the spindle back"), std::string::npos)
+      << g84.err;
+  // A thread turns one way only.
+  const auto thread = check("thread.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33 Z-2 K1.25\nM2\n");
+  EXPECT_EQ(thread.exit_status, 0) << thread.err;
 }
 
 }  // namespace

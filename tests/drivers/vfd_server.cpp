@@ -8,8 +8,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
+#include <ctime>
 
 namespace cncd::test {
 namespace {
@@ -83,17 +86,66 @@ void VfdServer::set_fault(bool fault) {
   update_model();
 }
 
+double VfdServer::revolutions(std::int64_t now_ns) {
+  std::lock_guard lock(mutex_);
+  advance(now_ns);
+  return revolutions_;
+}
+
+double VfdServer::rpm(std::int64_t now_ns) {
+  std::lock_guard lock(mutex_);
+  advance(now_ns);
+  return rpm_;
+}
+
+void VfdServer::advance(std::int64_t now) {
+  if (map_.position_register < 0) return;
+  if (model_ns_ == 0 || now <= model_ns_) {
+    if (model_ns_ == 0) model_ns_ = now;
+  } else {
+    // In steps of at most 100 us, the speed ramping toward its target.
+    const double accel = map_.acceleration_rpm_s;
+    while (model_ns_ < now) {
+      const std::int64_t step = std::min<std::int64_t>(now - model_ns_, 100'000);
+      const double dt = static_cast<double>(step) / 1e9;
+      const double before = rpm_;
+      rpm_ = accel <= 0           ? target_rpm_
+             : rpm_ < target_rpm_ ? std::min(target_rpm_, rpm_ + accel * dt)
+                                  : std::max(target_rpm_, rpm_ - accel * dt);
+      revolutions_ += 0.5 * (before + rpm_) / 60.0 * dt;
+      model_ns_ += step;
+    }
+  }
+  modbus_mapping_t* m = as_mapping(mapping_);
+  const auto counts = static_cast<std::int64_t>(std::floor(revolutions_ * map_.counts_per_rev));
+  const auto word = static_cast<std::uint64_t>(counts);
+  std::uint16_t* table = map_.position_holding ? m->tab_registers : m->tab_input_registers;
+  if (map_.position_width == 16) {
+    table[map_.position_register] = static_cast<std::uint16_t>(word & 0xFFFFu);
+  } else {
+    table[map_.position_register] = static_cast<std::uint16_t>((word >> 16) & 0xFFFFu);
+    table[map_.position_register + 1] = static_cast<std::uint16_t>(word & 0xFFFFu);
+  }
+}
+
 void VfdServer::update_model() {
   modbus_mapping_t* m = as_mapping(mapping_);
   const int command = m->tab_registers[map_.command_register];
   const bool forward = command == map_.command_forward;
   const bool reverse = command == map_.command_reverse && !forward;
   const bool running = (forward || reverse) && !fault_;
-  // The motor reaches the commanded speed at once: this drive ramps in no time.
-  const std::uint16_t speed = running ? m->tab_registers[map_.speed_register] : 0;
+  const std::uint16_t commanded = running ? m->tab_registers[map_.speed_register] : 0;
+  // Without a shaft, the motor reaches the commanded speed at once; with one, it ramps.
+  std::uint16_t speed = commanded;
+  bool at_speed = running && speed > 0;
+  if (map_.position_register >= 0) {
+    target_rpm_ = (reverse ? -1.0 : 1.0) * commanded / map_.units_per_rpm;
+    speed = static_cast<std::uint16_t>(std::lround(std::abs(rpm_) * map_.units_per_rpm));
+    at_speed = running && commanded > 0 && rpm_ == target_rpm_;
+  }
   std::uint16_t status = 0;
   if (running) status |= map_.running_bits;
-  if (running && speed > 0) status |= map_.at_speed_bits;
+  if (at_speed) status |= map_.at_speed_bits;
   if (running && reverse) status |= map_.reverse_bits;
   if (fault_) status |= map_.fault_bits;
   (map_.actual_speed_holding ? m->tab_registers
@@ -129,6 +181,11 @@ void VfdServer::serve() {
     const int function = query[header];
     const int address = (query[header + 1] << 8) | query[header + 2];
     std::lock_guard lock(mutex_);
+    // The drive answers with its shaft where it is as the request arrives.
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    advance(ts.tv_sec * 1'000'000'000LL + ts.tv_nsec);
+    update_model();
     if (function == 0x05 || function == 0x06 || function == 0x0F || function == 0x10) {
       ++writes_[address];
     }

@@ -29,6 +29,16 @@ struct VfdMap {
   std::uint16_t at_speed_bits = 1u << 1;  // 0: the drive has no at-speed bit
   std::uint16_t fault_bits = 1u << 2;
   std::uint16_t reverse_bits = 0;  // set while turning in reverse
+  // A servo spindle's shaft: a counter of position_width bits (two registers for 32, high word
+  // first) in input registers (holding with position_holding), counts_per_rev a revolution;
+  // -1 = none. The motor then turns in real time at up to acceleration_rpm_s (0: at once), the
+  // speed register in units_per_rpm.
+  int position_register = -1;
+  bool position_holding = false;
+  int position_width = 32;
+  double counts_per_rev = 4096;
+  double units_per_rpm = 1;
+  double acceleration_rpm_s = 0;
 };
 
 class VfdServer {
@@ -54,10 +64,15 @@ class VfdServer {
   void set_silent(bool silent) { silent_.store(silent); }
   // Requests answered so far.
   int answered() const { return answered_.load(); }
+  // The shaft's true position (revolutions, signed) and speed (rpm, signed) at `now_ns`
+  // (CLOCK_MONOTONIC, not before the last request), of a map with a position register.
+  double revolutions(std::int64_t now_ns);
+  double rpm(std::int64_t now_ns);
 
  private:
   void serve();
-  void update_model();  // with mutex_ held
+  void update_model();             // with mutex_ held
+  void advance(std::int64_t now);  // the shaft, up to `now`; with mutex_ held
 
   VfdMap map_;
   int slave_;
@@ -68,6 +83,11 @@ class VfdServer {
   std::mutex mutex_;
   std::map<int, int> writes_;
   bool fault_ = false;
+  // The shaft (position maps).
+  double target_rpm_ = 0;  // signed
+  double rpm_ = 0;
+  double revolutions_ = 0;
+  std::int64_t model_ns_ = 0;  // 0: not yet started
   std::atomic<bool> silent_{false};
   std::atomic<int> answered_{0};
   std::atomic<bool> running_{false};

@@ -169,6 +169,14 @@ struct SpindleConfig {
   int running_bit = 0;  // of the status register; -1 = none
   int at_speed_bit = 1;
   int fault_bit = 2;
+  // The shaft's position, for spindle-synchronized motion: a counter of POSITION_WIDTH bits
+  // (two registers for 32, WORD_ORDER), in POSITION_TABLE, POSITION_SCALE counts a revolution
+  // (negative: it counts down turning forward). -1 = the drive reports no position.
+  int position_register = -1;
+  SignalAddress::Table position_table = SignalAddress::Table::input;
+  int position_width = 32;
+  bool position_high_first = true;
+  double position_scale = 0;
   SourceRef source;  // the [SPINDLE_0] header
 };
 

@@ -46,6 +46,8 @@ struct HoldInfo {
 
 // Why `machine` cannot move in step with its spindle (no position to follow), or nothing.
 std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine);
+// Why `machine` cannot tap rigidly (its spindle cannot reverse), or nothing.
+std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine);
 
 class ProgramFeeder final : public interp::CanonSink {
  public:
