@@ -109,6 +109,7 @@ void GpioDriver::read_io(IoFeedback& feedback) noexcept {
   fb.stale = stale_;
   fb.has_position = encoder_ != nullptr;
   fb.revolutions = encoder_ ? spindle_feedback_.revolutions : 0;
+  fb.time_ns = encoder_ ? spindle_feedback_.time_ns : 0;
 }
 
 void GpioDriver::set_output(const OutputLine& line, bool on) noexcept {
@@ -154,6 +155,7 @@ void GpioDriver::run_io(double dt, std::int64_t time_ns) noexcept {
     encoder_->sample(level(encoder_a_), level(encoder_b_), level(encoder_index_), time_ns);
     state.rpm = encoder_->rpm();
     state.revolutions = encoder_->revolutions();
+    state.time_ns = time_ns;
   } else {
     state.rpm = std::abs(ramp_rpm_);
   }

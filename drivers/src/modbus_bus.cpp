@@ -82,6 +82,8 @@ ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives, IoSetti
     // the drive reads its counter once the last of them has arrived.
     const int bits = 1 + bus_.data_bits + (bus_.parity == 'N' ? 0 : 1) + bus_.stop_bits;
     request_ns_ = 8LL * bits * 1'000'000'000 / bus_.baud;
+    // The answer: address, function, byte count, the registers and the CRC.
+    response_ns_ = (5LL + 2LL * v.position_width / 16) * bits * 1'000'000'000 / bus_.baud;
   }
 }
 
@@ -368,19 +370,23 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
     if (n == -1) failed(input ? "reading input" : "reading holding", first);
     return n != -1;
   };
-  // The position first, stamped with the moment the request reached the drive.
+  // The position first. The drive read it between the moment the request reached it and the
+  // moment its answer set off: a window of a fraction of a millisecond, unless the answer was
+  // slow.
   const bool has_position = v.position_register >= 0;
   if (has_position) {
     const std::int64_t sent = monotonic_ns();
     if (!read(v.position_input, v.position_register, v.position_width / 16)) {
       return is_exception(errno);
     }
+    const std::int64_t earliest = sent + request_ns_;
+    const std::int64_t latest = std::max(earliest, monotonic_ns() - response_ns_);
     std::uint32_t raw = regs[0];
     if (v.position_width == 32) {
       raw = v.position_high_first ? (std::uint32_t{regs[0]} << 16) | regs[1]
                                   : (std::uint32_t{regs[1]} << 16) | regs[0];
     }
-    io_last_.vfd_position = vfd_position_.add(raw, sent + request_ns_);
+    io_last_.vfd_position = vfd_position_.add(raw, earliest, latest);
   }
 
   // Both read-only registers in one request when they are close together in one table.

@@ -84,8 +84,8 @@ struct VfdSettings {
   bool position_input = true;
   int position_width = 32;
   bool position_high_first = true;
-  double position_scale = 1;       // counts a revolution
-  double max_acceleration = 0;     // rev/s^2, 0 = unknown
+  double position_scale = 1;    // counts a revolution
+  double max_acceleration = 0;  // rev/s^2, 0 = unknown
 };
 
 struct IoSettings {
@@ -108,7 +108,7 @@ struct IoReadback {
   double vfd_rpm = 0;            // actual speed, >= 0
   std::int64_t vfd_time_ns = 0;  // CLOCK_MONOTONIC of the VFD's last full answer; 0 = never
   std::uint16_t vfd_status = 0;
-  bool vfd_fault = false;  // the fault bit, a refused reverse, or not running when told to
+  bool vfd_fault = false;           // the fault bit, a refused reverse, or not running when told to
   SpindlePositionFit vfd_position;  // the shaft's motion at its last reading (valid: read)
 };
 
@@ -220,7 +220,10 @@ class ModbusBus {
   std::uint32_t vfd_starts_seen_ = 0;
   FaultReason vfd_reason_;
   SpindlePositionTracker vfd_position_;
-  std::int64_t request_ns_ = 0;  // the time a request takes to reach the drive (RTU: its bytes)
+  // The time a position request takes to reach the drive and its answer to come back (RTU:
+  // their bytes on the line; TCP: 0).
+  std::int64_t request_ns_ = 0;
+  std::int64_t response_ns_ = 0;
   std::uint32_t reason_reset_ = 0;  // the reset request that last cleared reason_
   void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
   bool link_failed_ = false;

@@ -339,6 +339,7 @@ void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
       // Where the shaft is now, not where it was when the bus last read it.
       fb.has_position = true;
       fb.revolutions = rb.vfd_position.at(now, slot.stale_ns);
+      fb.time_ns = now;
     }
   }
 }

@@ -65,6 +65,7 @@ void MachineIo::apply_tap() noexcept {
 
 void MachineIo::feedback(const drivers::IoFeedback& in) noexcept {
   in_ = in;
+  elapsed_s_ = period_s_;
   io_.dins = in.digital;
   io_.ains = in.analog;
   const double commanded_rps =
@@ -74,13 +75,23 @@ void MachineIo::feedback(const drivers::IoFeedback& in) noexcept {
     spindle_.has_position = in.spindle.has_position;
     spindle_.revolutions = std::isfinite(in.spindle.revolutions) ? in.spindle.revolutions : 0.0;
     if (spindle_.has_position && has_last_revolutions_) {
-      spindle_rps_ = (spindle_.revolutions - last_revolutions_) / period_s_;
+      // A spindle that turns by the clock (its driver says when it stood where) moved over the
+      // time between its two positions: further over a servo period that came late, hardly at
+      // all over one run straight after it. Too short a time tells no speed: the last stands.
+      const std::int64_t at = in.spindle.time_ns;
+      if (at != 0 && last_position_ns_ != 0) {
+        elapsed_s_ = static_cast<double>(std::max<std::int64_t>(0, at - last_position_ns_)) * 1e-9;
+      }
+      if (elapsed_s_ >= 0.25 * period_s_) {
+        spindle_rps_ = (spindle_.revolutions - last_revolutions_) / elapsed_s_;
+      }
     } else {
       // No position: the speed it reports, in the direction it was told.
       spindle_rps_ = std::copysign(spindle_.actual_rpm / 60.0, commanded_rps);
     }
     has_last_revolutions_ = spindle_.has_position;
     last_revolutions_ = spindle_.revolutions;
+    last_position_ns_ = in.spindle.time_ns;
   } else {
     spindle_.actual_rpm = spindle_.commanded_rpm;
     // The ideal spindle is where its command has taken it.
@@ -102,6 +113,7 @@ SyncFollower::Spindle MachineIo::sync_spindle() const noexcept {
   if (!(s.max_rps > 0)) s.max_rps = 1e300;
   s.acceleration = !ideal_ && config_.acceleration > 0 ? config_.acceleration / 60.0 : 1e300;
   s.stall_timeout_s = config_.at_speed_timeout_s;
+  s.elapsed_s = elapsed_s_;
   return s;
 }
 

@@ -173,7 +173,10 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
 
   // A position that jumps (an encoder that slipped or was reset, a wild reading) would throw
   // the axis: the axis stays where it was and the move stops.
-  const double step_limit = kJumpShare * segment.axis_velocity * dt + kJumpSlackRev * per_rev;
+  // A spindle that turns by the clock goes further over a servo period that came late.
+  const double step_time = std::max(dt, spindle.elapsed_s);
+  const double step_limit =
+      kJumpShare * segment.axis_velocity * step_time + kJumpSlackRev * per_rev;
   if (locked && std::abs(out.s - last_s_) > step_limit) {
     out.error = RtEvent::Code::sync_jump;
     out.error_value = std::abs(progress - last_progress_);

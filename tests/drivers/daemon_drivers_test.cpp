@@ -7,6 +7,7 @@
 #include <chrono>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -16,6 +17,7 @@
 #include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "test_util.hpp"
+#include "vfd_server.hpp"
 
 namespace cncd::test {
 namespace {
@@ -393,6 +395,64 @@ TEST(DriversEndToEnd, ASimulatedMotorThatLagsTripsTheFollowingError) {
   EXPECT_EQ(end["state"], "off");
   EXPECT_EQ(end["joint_fault"][0], true);
   EXPECT_LT(end["position"]["commanded"]["x"].get<double>(), 50.0);
+}
+
+TEST(DriversEndToEnd, ARigidTapRunsOnAModbusServoSpindle) {
+  // The sim mill with its spindle on Modbus TCP: a servo spindle with a 32-bit position
+  // counter, read every 5 ms, ramping at 3000 rpm/s.
+  VfdMap map;
+  map.position_register = 10;
+  map.counts_per_rev = 4096;
+  map.units_per_rpm = 0.1;
+  map.acceleration_rpm_s = 3000;
+  VfdServer server(map, 3);
+  ASSERT_EQ(server.start(), "");
+  TempDir dir;
+  const std::string ini = adapt(
+      dir, "sim_mm.ini",
+      {{"[SPINDLE_0]\nDRIVER = sim\n",
+        "[MODBUS_1]\nTRANSPORT = tcp\nHOST = 127.0.0.1\nPORT = " + std::to_string(server.port()) +
+            "\nTIMEOUT_MS = 40\nUPDATE_PERIOD_MS = 5\n\n"
+            "[SPINDLE_0]\nDRIVER = modbus\nMODBUS = 1\nSLAVE = 3\nSPEED_SCALE = 0.1\n"
+            "POSITION_REGISTER = 10\nPOSITION_SCALE = 4096\n"},
+       {"ACCELERATION = 6000", "ACCELERATION = 3000"}});
+  const std::string program = dir.write("tap.ngc",
+                                        "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33.1 Z-5 K1.25\n"
+                                        "G1 X20 F600\nM5\nM2\n")
+                                  .string();
+  DaemonProcess daemon;
+  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
+  daemon::Client client;
+  ASSERT_EQ(client.connect(daemon.socket()), "");
+  result(client.call("machine.reset"));
+  result(client.call("machine.on"));
+  result(client.call("machine.home"));
+  wait_for(client, daemon, 60, [](const json& s) {
+    for (const auto& h : s["homed"])
+      if (!h.get<bool>()) return false;
+    return s["motion"] == "idle";
+  });
+  result(client.call("program.open", {{"path", program}}));
+  result(client.call("program.run"));
+  std::set<std::string> phases;
+  double deepest = 1e9;
+  const json end = wait_for(client, daemon, 60, [&](const json& s) {
+    if (!s["sync"].is_null()) phases.insert(s["sync"]["phase"].get<std::string>());
+    deepest = std::min(deepest, s["position"]["commanded"]["z"].get<double>());
+    return s["exec"] == "idle" && s["program"]["result"] != "";
+  });
+  EXPECT_EQ(end["program"]["result"], "done") << end.dump() << daemon.log();
+  EXPECT_EQ(end["fault"], "") << end.dump();
+  EXPECT_TRUE(phases.count("tapping_in")) << ::testing::PrintToString(phases);
+  EXPECT_TRUE(phases.count("tapping_out")) << ::testing::PrintToString(phases);
+  EXPECT_LT(deepest, -2);
+  EXPECT_GE(deepest, -5.002);
+  EXPECT_NEAR(end["position"]["commanded"]["z"].get<double>(), 5, 1e-9);
+  EXPECT_NEAR(end["position"]["commanded"]["x"].get<double>(), 20, 1e-9);
+  // The drive was told forward, reverse in the hole, forward again and stop.
+  EXPECT_GE(server.writes(0), 5);
+  EXPECT_EQ(server.holding(0), 0);
+  EXPECT_EQ(daemon.stop(), 0) << daemon.log();
 }
 
 TEST(DriveSimCommand, RealTimePriorityOutsideItsRangeIsRefused) {

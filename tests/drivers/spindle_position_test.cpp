@@ -69,8 +69,8 @@ TEST(SpindlePosition, ANegativeScaleCountsDownTurningForward) {
     const double rev = 0.1 * k;  // 10 rev/s, every 10 ms
     tracker.add(reading(-rev, 1000, 32), 1000 * kMs + k * 10 * kMs);
   }
-  EXPECT_NEAR(tracker.fit().revolutions, 10, 1e-9);
-  EXPECT_NEAR(tracker.fit().rps, 10, 1e-6);
+  EXPECT_NEAR(tracker.fit().revolutions, 10, 1e-3);
+  EXPECT_NEAR(tracker.fit().rps, 10, 0.05);
 }
 
 TEST(SpindlePosition, TheFirstReadingIsTakenAsASignedCount) {
@@ -83,25 +83,62 @@ TEST(SpindlePosition, TheFirstReadingIsTakenAsASignedCount) {
 }
 
 TEST(SpindlePosition, BetweenReadingsThePositionIsPredicted) {
-  // A spindle ramping at 50 rev/s^2 (3000 rpm/s), read every 10 ms with 4096 counts a
-  // revolution. Between readings the prediction stays within a few counts of the truth; the
-  // last reading itself falls up to a tenth of a revolution behind.
+  // A spindle ramping from rest at 50 rev/s^2 (3000 rpm/s), read every 10 ms with 4096 counts
+  // a revolution. The last reading itself falls up to 0.2 revolutions behind; the prediction
+  // stays within a hundredth of a revolution while the filter learns the ramp, and within a
+  // few counts once it has.
   SpindlePositionTracker tracker;
   tracker.configure(32, 4096, 50, 50 * kMs);
   const auto truth = [](double t) { return 25 * t * t; };  // from rest at t = 0
-  double worst_predicted = 0;
+  double worst_learning = 0;
+  double worst_settled = 0;
   double worst_reading = 0;
   for (std::int64_t t = 0; t <= 400 * kMs; t += kMs) {
     const double now = static_cast<double>(t) / 1e9;
     if (t % (10 * kMs) == 0) tracker.add(reading(truth(now), 4096, 32), t);
-    if (t < 30 * kMs) continue;  // three readings make the fit
-    worst_predicted =
-        std::max(worst_predicted, std::abs(tracker.fit().at(t, kHorizon) - truth(now)));
+    const double error = std::abs(tracker.fit().at(t, kHorizon) - truth(now));
+    double& worst = t < 200 * kMs ? worst_learning : worst_settled;
+    worst = std::max(worst, error);
     worst_reading = std::max(worst_reading, std::abs(tracker.fit().revolutions - truth(now)));
-    EXPECT_NEAR(tracker.fit().rps_at(t, kHorizon), 50 * now, 0.5) << t / kMs << " ms";
+    if (t >= 200 * kMs) {
+      EXPECT_NEAR(tracker.fit().rps_at(t, kHorizon), 50 * now, 0.05);
+    }
   }
-  EXPECT_LE(worst_predicted, 3.0 / 4096);
+  EXPECT_LE(worst_learning, 0.01);
+  EXPECT_LE(worst_settled, 3.0 / 4096);
   EXPECT_GE(worst_reading, 0.15);  // 20 rev/s x 9 ms, near the end
+}
+
+TEST(SpindlePosition, JitterInWhenTheDriveReadsIsSmoothedAndNeverJumps) {
+  // 10 rev/s, read every 5 ms, each reading taken up to 0.5 ms before or after its stamp:
+  // 0.005 revolutions either way, and the newest reading up to 0.05 behind. The estimate keeps
+  // within about twice the jitter, and each servo period (1 ms) it moves with the spindle (0.01
+  // revolutions) give or take less than the jitter: the fit through the three latest readings
+  // it replaced let it step 0.017.
+  SpindlePositionTracker tracker;
+  tracker.configure(32, 4096, 50, 50 * kMs);
+  std::uint32_t seed = 12345;
+  const auto jitter_ns = [&] {  // a fixed pseudo-random sequence, -0.5 .. 0.5 ms
+    seed = seed * 1103515245u + 12345u;
+    return static_cast<std::int64_t>((seed >> 16) % 1001) * 1000 - 500'000;
+  };
+  double worst = 0;
+  double worst_step = 0;
+  double last = 0;
+  for (std::int64_t t = 0; t <= 1000 * kMs; t += kMs) {
+    if (t % (5 * kMs) == 0) {
+      const double taken = static_cast<double>(t + jitter_ns()) / 1e9;
+      tracker.add(reading(10 * taken, 4096, 32), t);
+    }
+    const double estimate = tracker.fit().at(t, kHorizon);
+    if (t >= 100 * kMs) {
+      worst = std::max(worst, std::abs(estimate - 10 * static_cast<double>(t) / 1e9));
+      worst_step = std::max(worst_step, std::abs(estimate - last - 0.01));
+    }
+    last = estimate;
+  }
+  EXPECT_LE(worst, 0.012);
+  EXPECT_LE(worst_step, 0.005);
 }
 
 TEST(SpindlePosition, ThePredictionStopsAtTheHorizon) {
@@ -125,10 +162,9 @@ TEST(SpindlePosition, AfterAGapTheCountCarriesOnFromTheSpeed) {
   const std::int64_t later = 400 * kMs;
   tracker.add(reading(truth(0.4), 16384, 16), later);
   EXPECT_EQ(tracker.counts(), 4 * 16384);
-  // The fit starts afresh from the one reading: no speed is claimed across the gap.
-  EXPECT_EQ(tracker.fit().rps, 0);
-  tracker.add(reading(truth(0.41), 16384, 16), later + 10 * kMs);
-  EXPECT_NEAR(tracker.fit().rps, 10, 0.1);
+  // The filter starts afresh at the mean speed across the gap.
+  EXPECT_NEAR(tracker.fit().rps, 10, 0.01);
+  EXPECT_NEAR(tracker.fit().at(later + 10 * kMs, kHorizon), 4.1, 0.001);
 }
 
 TEST(SpindlePosition, TheAccelerationIsHeldWithinTwiceTheSpindles) {

@@ -7,10 +7,13 @@
 // on its own, so the error is measured, not assumed.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "cncd/drivers/spindle_position.hpp"
 #include "machine_fixture.hpp"
 
 namespace cncd::test {
@@ -425,6 +428,174 @@ TEST_F(SpindleSyncTest, ASpindleThatDoesNotTurnEndsTheMove) {
       << motion::format_event(s.path_error);
   EXPECT_LT(cycles, 2000);
   EXPECT_EQ(s.commanded[2], 0);
+}
+
+// A servo spindle on a field bus, in virtual time: every `update_ms` the bus hands the drive
+// the latest command and reads the drive's position counter (4096 counts a revolution, 16
+// bits), the request arriving `latency_ms` later and the answer as much again. The shaft ramps
+// at `acceleration` rpm/s toward the speed last handed over. The position the servo loop gets
+// is the driver's: SpindlePositionTracker's prediction from the readings.
+class BusSpindle final : public FakeDriver {
+ public:
+  BusSpindle(int update_ms, int latency_ms, double acceleration)
+      : FakeDriver("bus"), update_ms_(update_ms), latency_ms_(latency_ms), accel_(acceleration) {
+    tracker_.configure(16, kCounts, acceleration / 60.0, 200 * kMs);
+  }
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    const auto& sp = command.spindle;
+    told_rpm_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm);
+  }
+  void read_io(drivers::IoFeedback& feedback) noexcept override {
+    // This period's moment, in 0.1 ms steps of the shaft.
+    for (int i = 0; i < 10; ++i) {
+      const std::int64_t t = now_ + i * kMs / 10;
+      const std::int64_t into = t % (update_ms_ * kMs);
+      if (into == 0) request_rpm_ = told_rpm_;  // the bus takes the command...
+      if (into == latency_ms_ * kMs) {
+        // ... it reaches the drive, which reads its counter as it takes it
+        target_rpm_ = request_rpm_;
+        sampled_ = Reading{counts(), t};
+      }
+      if (into == 2 * latency_ms_ * kMs) tracker_.add(sampled_.raw, sampled_.time_ns);
+      const double before = rpm_;
+      rpm_ = rpm_ < target_rpm_ ? std::min(target_rpm_, rpm_ + accel_ * 1e-4)
+                                : std::max(target_rpm_, rpm_ - accel_ * 1e-4);
+      revolutions_ += 0.5 * (before + rpm_) / 60.0 * 1e-4;
+    }
+    now_ += kMs;
+    truth_ = revolutions_;
+    feedback.spindle.present = true;
+    feedback.spindle.rpm = std::abs(rpm_);
+    feedback.spindle.has_position = tracker_.fit().valid;
+    feedback.spindle.revolutions = tracker_.fit().at(now_, 200 * kMs);
+  }
+  // The shaft's true position at the moment of the last read_io.
+  double truth() const { return truth_; }
+
+ private:
+  static constexpr std::int64_t kMs = 1'000'000;
+  static constexpr double kCounts = 4096;
+  struct Reading {
+    std::uint32_t raw = 0;
+    std::int64_t time_ns = 0;
+  };
+  std::uint32_t counts() const {
+    return static_cast<std::uint32_t>(
+        static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(revolutions_ * kCounts))) &
+        0xFFFFu);
+  }
+  int update_ms_;
+  int latency_ms_;
+  double accel_;
+  drivers::SpindlePositionTracker tracker_;
+  std::int64_t now_ = 0;
+  double told_rpm_ = 0;
+  double request_rpm_ = 0;
+  double target_rpm_ = 0;
+  double rpm_ = 0;
+  double revolutions_ = 0;
+  double truth_ = 0;
+  Reading sampled_;
+};
+
+TEST_F(SpindleSyncTest, RigidTapStaysOnTheHelixOfASpindleOnAFieldBus) {
+  // A Modbus servo spindle read every 10 ms with 1 ms each way: the last reading is up to
+  // 12 ms (0.12 revolutions at 600 rpm, 0.15 mm of a 1.25 pitch) old, and the drive takes a
+  // new speed as late. The tap stays on the helix of the shaft's true position.
+  BusSpindle spindle(10, 1, 3000);
+  config::MachineConfig c = mill_with_driven_spindle();
+  c.spindle.acceleration = 3000;
+  VirtualMachine m(c, drivers::kCapHomeSwitch, nullptr, &spindle);
+  m.ready();
+  m.queue(spindle_on(600));
+  m.queue(at_speed());
+  m.queue(synced(SpindleSync::tap, -10));
+  m.flush();
+  struct Period {
+    double z;
+    double truth;
+    SyncStatus::Phase phase;
+  };
+  std::vector<Period> periods;
+  for (int i = 0; i < 20000; ++i) {
+    m.cycles(1);
+    const motion::Status s = m.status();
+    periods.push_back({s.commanded[2], spindle.truth(), s.sync.phase});
+    if (s.motion == MotionState::idle && s.queued == 0) break;
+  }
+  const motion::Status s = m.status();
+  ASSERT_EQ(s.motion, MotionState::idle);
+  EXPECT_EQ(s.path_errors, 0u) << motion::format_event(s.path_error);
+  std::size_t in = 0;
+  while (in < periods.size() && periods[in].phase != SyncStatus::Phase::tapping_in)
+    ++in;
+  ASSERT_LT(in, periods.size());
+  // Each period's axis command against where the shaft truly is when the period ends.
+  const double locked = periods[in].truth;
+  double worst = 0;
+  double deepest = 0;
+  for (std::size_t k = in; k + 1 < periods.size(); ++k) {
+    if (periods[k].phase == SyncStatus::Phase::none) break;
+    const double ideal = -kPitch * (periods[k + 1].truth - locked);
+    worst = std::max(worst, std::abs(periods[k].z - ideal));
+    deepest = std::min(deepest, periods[k].z);
+  }
+  std::printf("bus spindle: largest helix error %.5f mm\n", worst);
+  EXPECT_LE(worst, kPitch * 0.02);
+  EXPECT_NEAR(deepest, -10, 0.01);
+  EXPECT_NEAR(s.commanded[2], 0, 1e-9);
+  EXPECT_EQ(s.spindle.direction, 1);
+}
+
+// A spindle that turns by the clock, with a servo loop that runs late now and then: every
+// 200th period starts 6 ms late and the next five catch up at once, as a servo thread does
+// after a stall. The driver says when the spindle stood where (SpindleFeedback::time_ns).
+class ClockSpindle final : public FakeDriver {
+ public:
+  explicit ClockSpindle(bool stamped) : FakeDriver("clock"), stamped_(stamped) {}
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    const auto& sp = command.spindle;
+    rps_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;
+  }
+  void read_io(drivers::IoFeedback& feedback) noexcept override {
+    ++period_;
+    const std::int64_t step = period_ % 200 == 0 ? 6'000'000 : period_ % 200 <= 5 ? 0 : 1'000'000;
+    now_ += step;
+    revolutions_ += rps_ * static_cast<double>(step) * 1e-9;
+    feedback.spindle.present = true;
+    feedback.spindle.has_position = true;
+    feedback.spindle.rpm = std::abs(rps_) * 60;
+    feedback.spindle.revolutions = revolutions_;
+    feedback.spindle.time_ns = stamped_ ? now_ : 0;
+  }
+
+ private:
+  bool stamped_;
+  std::int64_t period_ = 0;
+  std::int64_t now_ = 1'000'000'000;
+  double rps_ = 0;
+  double revolutions_ = 0;
+};
+
+TEST_F(SpindleSyncTest, ALateServoPeriodIsNoJumpOfASpindleThatTurnsByTheClock) {
+  for (const bool stamped : {true, false}) {
+    SCOPED_TRACE(stamped ? "stamped" : "not stamped");
+    ClockSpindle spindle(stamped);
+    VirtualMachine m(mill_with_driven_spindle(), drivers::kCapHomeSwitch, nullptr, &spindle);
+    m.ready();
+    m.queue(spindle_on(600));
+    m.queue(synced(SpindleSync::tap, -10));
+    m.run_until_idle(40000);
+    const motion::Status s = m.status();
+    if (stamped) {
+      // 0.06 revolutions in a period 6 ms long is the spindle's own speed.
+      EXPECT_EQ(s.path_errors, 0u) << motion::format_event(s.path_error);
+      EXPECT_NEAR(s.commanded[2], 0, 1e-9);
+    } else {
+      // Without the time, the same step is a position that jumped: the tap stops.
+      EXPECT_EQ(s.path_error.code, motion::RtEvent::Code::sync_jump);
+    }
+  }
 }
 
 // G95: the feed follows the spindle as it turns, not as programmed: a spindle override of

@@ -85,6 +85,10 @@ struct SpindleFeedback {
   bool stale = false;         // no fresh answer from the drive within its deadline
   bool has_position = false;  // an encoder: revolutions counts the spindle's position
   double revolutions = 0;
+  // When the spindle stood at `revolutions`, by the driver's clock (only differences count): a
+  // spindle that turns by the clock, not in servo periods, moves more over a period that came
+  // late. 0: the position moves in servo periods (the simulated spindle).
+  std::int64_t time_ns = 0;
 };
 
 // The machine's inputs as the drivers report them each period; a driver fills in the signals

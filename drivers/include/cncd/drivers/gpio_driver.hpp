@@ -96,6 +96,7 @@ class GpioDriver final : public Driver {
   struct SpindleState {
     double rpm = 0;  // >= 0
     double revolutions = 0;
+    std::int64_t time_ns = 0;  // the base period that counted it
   };
   struct OutputLine {
     int output = -1;  // index into output_levels_, -1 = none

@@ -128,6 +128,10 @@ class MachineIo final : public ActionGate {
   double tap_rps_ = 0;  // what the tap drives the spindle at, signed
   bool has_last_revolutions_ = false;
   double last_revolutions_ = 0;
+  std::int64_t last_position_ns_ = 0;  // when the spindle stood at last_revolutions_ (0: no time)
+  // The time between the spindle's last two positions (a late servo period, or one run straight
+  // after it, by the spindle driver's clock), or one period.
+  double elapsed_s_ = 0;
   double spindle_rps_ = 0;  // measured, signed
   std::uint64_t syncs_done_ = 0;
 };

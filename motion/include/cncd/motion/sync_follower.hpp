@@ -36,6 +36,7 @@ class SyncFollower {
     double max_rps = 1e300;       // the spindle's limit in the tap's direction
     double acceleration = 1e300;  // rev/s^2 the spindle can follow (its ramp)
     double stall_timeout_s = 0;   // a tap that makes no progress for this long fails
+    double elapsed_s = 0;  // since the previous position, by the spindle's clock; 0: one period
   };
   struct Step {
     double s = 0;                 // path position along the segment
