@@ -155,8 +155,9 @@ void Task::run_program(int from_line, bool step) {
   skip_moved_ = false;
   stepping_ = step;
   step_budget_ = step ? 1 : 0;
+  // Both clocks read now: `status` may be older (opening the program takes its time).
   started_at_ = Clock::now();
-  started_cycles_ = status.rt.cycles;
+  started_cycles_ = motion_.status().rt.cycles;
   elapsed_s_ = 0;
   motion_s_ = 0;
   last_result_.clear();
