@@ -114,6 +114,18 @@ json wait_for(daemon::Client& client, const DaemonProcess& daemon, int seconds, 
   return s;
 }
 
+// Machine reset, on and homed, and at rest.
+void make_ready(daemon::Client& client, const DaemonProcess& daemon) {
+  result(client.call("machine.reset"));
+  result(client.call("machine.on"));
+  result(client.call("machine.home"));
+  wait_for(client, daemon, 60, [](const json& s) {
+    for (const auto& h : s["homed"])
+      if (!h.get<bool>()) return false;
+    return s["motion"] == "idle";
+  });
+}
+
 // Runs the example program on `ini` (already adapted) and returns the final status.
 json run_example(const TempDir& dir, const std::string& ini,
                  const std::string& program = kProgram) {
@@ -124,14 +136,7 @@ json run_example(const TempDir& dir, const std::string& ini,
   daemon::Client client;
   EXPECT_EQ(client.connect(daemon.socket()), "");
   const auto wait_until = [&](auto done) { return wait_for(client, daemon, 60, done); };
-  result(client.call("machine.reset"));
-  result(client.call("machine.on"));
-  result(client.call("machine.home"));
-  wait_until([](const json& s) {
-    for (const auto& h : s["homed"])
-      if (!h.get<bool>()) return false;
-    return s["motion"] == "idle";
-  });
+  make_ready(client, daemon);
   result(client.call("program.open", {{"path", program}}));
   result(client.call("program.run"));
   wait_until([](const json& s) { return s["exec"] == "idle"; });
@@ -424,14 +429,7 @@ TEST(DriversEndToEnd, ARigidTapRunsOnAModbusServoSpindle) {
   ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
   daemon::Client client;
   ASSERT_EQ(client.connect(daemon.socket()), "");
-  result(client.call("machine.reset"));
-  result(client.call("machine.on"));
-  result(client.call("machine.home"));
-  wait_for(client, daemon, 60, [](const json& s) {
-    for (const auto& h : s["homed"])
-      if (!h.get<bool>()) return false;
-    return s["motion"] == "idle";
-  });
+  make_ready(client, daemon);
   result(client.call("program.open", {{"path", program}}));
   result(client.call("program.run"));
   std::set<std::string> phases;
