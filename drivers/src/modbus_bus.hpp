@@ -171,6 +171,11 @@ class ModbusBus {
   // Why the spindle VFD faulted or went quiet (see ModbusBus::exchange_vfd).
   const FaultReason& vfd_reason() const noexcept { return vfd_reason_; }
   const IoSettings& io() const { return io_; }
+  // How long a spindle command takes to reach the drive on average: half an update period in
+  // the mailbox, and the request's bytes on an RTU line.
+  std::int64_t command_delay_ns() const noexcept {
+    return std::int64_t{bus_.update_period_ms} * 500'000 + request_ns_;
+  }
   // Any thread: completed update cycles and their start time span, for rate figures.
   std::uint64_t cycles() const noexcept { return cycles_.load(std::memory_order_relaxed); }
 

@@ -340,6 +340,7 @@ void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
       fb.has_position = true;
       fb.revolutions = rb.vfd_position.at(now, slot.stale_ns);
       fb.time_ns = now;
+      fb.command_delay_ns = slot.bus->command_delay_ns();
     }
   }
 }

@@ -114,6 +114,10 @@ SyncFollower::Spindle MachineIo::sync_spindle() const noexcept {
   s.acceleration = !ideal_ && config_.acceleration > 0 ? config_.acceleration / 60.0 : 1e300;
   s.stall_timeout_s = config_.at_speed_timeout_s;
   s.elapsed_s = elapsed_s_;
+  if (!ideal_ && in_.spindle.command_delay_ns > 0) {
+    s.command_delay_periods = static_cast<int>(
+        std::lround(static_cast<double>(in_.spindle.command_delay_ns) * 1e-9 / period_s_));
+  }
   return s;
 }
 

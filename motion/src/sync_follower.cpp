@@ -46,6 +46,9 @@ double toward(double from, double to, double step) {
 
 void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcept {
   status_ = {};
+  std::fill(std::begin(sent_), std::end(sent_), 0.0);
+  sent_head_ = 0;
+  out_at_top_ = false;
   status_.mode = segment.spindle_sync;
   status_.per_rev = segment.per_rev;
   stalled_s_ = 0;
@@ -69,6 +72,14 @@ void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcep
     origin_ = direction_ > 0 ? std::ceil(spindle.revolutions) : std::floor(spindle.revolutions);
     status_.phase = SyncStatus::Phase::index;
   }
+}
+
+double SyncFollower::still_to_turn(int periods, double dt) const noexcept {
+  const int n = std::clamp(periods, 0, kMaxDelayPeriods);
+  double sum = 0;
+  for (int i = 1; i <= n; ++i)
+    sum += sent_[(sent_head_ - i + kMaxDelayPeriods) % kMaxDelayPeriods];
+  return sum * dt;
 }
 
 void SyncFollower::watch_stall(bool stalled, const Spindle& spindle, double dt,
@@ -101,6 +112,10 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
   // Where the spindle is now, and (below) where it will be at the end of this period: the
   // axis is told to be there then.
   const double now = direction_ * (spindle.revolutions - origin_);
+  // Where the spindle will be once the command of this period reaches it: a spindle whose
+  // commands come late (a field bus) still turns on those already sent. The tap brakes and
+  // turns on that position, so such a spindle still comes to rest at the ends.
+  const double coming = now + still_to_turn(spindle.command_delay_periods, dt);
   rest_periods_ = std::abs(spindle.rps) <= kRestRps ? rest_periods_ + 1 : 0;
   const bool at_rest = rest_periods_ >= kRestPeriods;
   if (stop && status_.phase != Phase::stopping) status_.phase = Phase::stopping;
@@ -125,10 +140,12 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
         status_.phase = Phase::tapping_in;
         last_progress_ = 0;
         locked_ = true;
+        // At rest, whatever was sent has been done.
+        std::fill(std::begin(sent_), std::end(sent_), 0.0);
       }
       break;
     case Phase::tapping_in: {
-      const double left = bottom - now;
+      const double left = bottom - coming;
       if (left <= kEndRev) {
         status_.phase = Phase::tapping_out;
         target = 0;
@@ -138,13 +155,16 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
       break;
     }
     case Phase::tapping_out: {
-      if (now <= kEndRev) {
+      // Once told to stop at the top, it stops: a position that settles a little short (a
+      // field bus's estimate) does not start the spindle again.
+      if (out_at_top_ || coming <= kEndRev) {
+        out_at_top_ = true;
         target = 0;
         if (command_ == 0 && at_rest) out.done = true;
       } else {
         const double scale = std::max(1.0, segment.retract_scale);
         target =
-            -std::min({spindle.programmed_rps * scale * fo, cap, braking_speed(now, brake, dt)});
+            -std::min({spindle.programmed_rps * scale * fo, cap, braking_speed(coming, brake, dt)});
       }
       break;
     }
@@ -157,6 +177,8 @@ SyncFollower::Step SyncFollower::tap_step(const Segment& segment, const Spindle&
   }
   command_ = toward(command_, target, accel_ * dt);
   out.spindle_rps = direction_ * command_;
+  sent_[sent_head_] = command_;
+  sent_head_ = (sent_head_ + 1) % kMaxDelayPeriods;
 
   // Measured from the origin as it stands now (the lock may have just set it).
   const double progress = direction_ * (spindle.revolutions - origin_);

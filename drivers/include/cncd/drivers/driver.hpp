@@ -89,6 +89,9 @@ struct SpindleFeedback {
   // spindle that turns by the clock, not in servo periods, moves more over a period that came
   // late. 0: the position moves in servo periods (the simulated spindle).
   std::int64_t time_ns = 0;
+  // How long a speed command takes to reach the spindle, on average (a field bus's update
+  // period): commands already sent still turn it that long. 0: at once.
+  std::int64_t command_delay_ns = 0;
 };
 
 // The machine's inputs as the drivers report them each period; a driver fills in the signals

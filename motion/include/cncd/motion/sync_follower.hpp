@@ -37,6 +37,7 @@ class SyncFollower {
     double acceleration = 1e300;  // rev/s^2 the spindle can follow (its ramp)
     double stall_timeout_s = 0;   // a tap that makes no progress for this long fails
     double elapsed_s = 0;  // since the previous position, by the spindle's clock; 0: one period
+    int command_delay_periods = 0;  // servo periods a speed command takes to reach the spindle
   };
   struct Step {
     double s = 0;                 // path position along the segment
@@ -75,12 +76,19 @@ class SyncFollower {
   double path_v_ = 0;   // thread: path speed
   double path_s_ = 0;   // thread: path position
   bool locked_ = false;
-  double last_s_ = 0;      // tap: the path position given last period       // tap: the spindle's
-                           // position is locked to the path's
-  double stalled_s_ = 0;   // time without progress while driven
-  double stopping_s_ = 0;  // tap: time spent bringing the spindle to rest
-  int rest_periods_ = 0;   // tap: periods in a row the spindle has stood still
+  bool out_at_top_ = false;  // tap: back at the top, told to stop
+  double last_s_ = 0;        // tap: the path position given last period       // tap: the spindle's
+                             // position is locked to the path's
+  double stalled_s_ = 0;     // time without progress while driven
+  double stopping_s_ = 0;    // tap: time spent bringing the spindle to rest
+  int rest_periods_ = 0;     // tap: periods in a row the spindle has stood still
   double last_progress_ = 0;  // tap: revolutions into the hole in the previous period
+  // tap: the latest speed commands (rev/s into the hole), newest at sent_[(sent_head_ - 1)]:
+  // those sent within the spindle's command delay still turn it.
+  static constexpr int kMaxDelayPeriods = 256;
+  double sent_[kMaxDelayPeriods] = {};
+  int sent_head_ = 0;
+  CNCD_RT double still_to_turn(int periods, double dt) const noexcept;
 };
 
 }  // namespace cncd::motion
