@@ -2,6 +2,7 @@
 // which way each address can carry a signal, the buses and lines they name, and no output
 // driven from two places.
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
@@ -164,6 +165,20 @@ void check_spindle_position(TypedReader& r, const SpindleConfig& s) {
       }
     }
     return;
+  }
+  // The position is estimated between readings, and the spindle's commands wait for the bus:
+  // a slow bus leaves a rigid tap off its helix (docs/motion.md).
+  if (s.modbus >= 0) {
+    const std::string bus = "MODBUS_" + std::to_string(s.modbus);
+    const auto period = r.ini().value(bus, "UPDATE_PERIOD_MS");
+    char* end = nullptr;
+    const long ms = period ? std::strtol(period->c_str(), &end, 10) : 10;
+    if (period && end != period->c_str() && *end == '\0' && ms > 10) {
+      r.warning(kSpindle, "POSITION_REGISTER",
+                "[" + bus + "] UPDATE_PERIOD_MS = " + std::to_string(ms) +
+                    ": a rigid tap on a spindle read that seldom may be off its helix by more "
+                    "than pitch x 0.02; keep it at 10 or less");
+    }
   }
   if (s.position_width == 32 && s.position_register > 65534) {
     r.problem(kSpindle, "POSITION_REGISTER",

@@ -279,6 +279,16 @@ TEST_F(IoConfigTest, ModbusSpindlePositionKeys) {
   EXPECT_NE(describe(wide).find("  position input register 7, 32 bits, low word first, 10000 "
                                 "counts/rev"),
             std::string::npos);
+  // A bus read that seldom is worth a word.
+  const std::string slow = minimal_ini() +
+                           "[MODBUS_1]\nHOST = 127.0.0.1\nUPDATE_PERIOD_MS = 20\n"
+                           "[SPINDLE_0]\nDRIVER = modbus\nMODBUS = 1\n";
+  EXPECT_EQ(warnings_of(slow + "POSITION_REGISTER = 7\nPOSITION_SCALE = 4096\n"),
+            (std::vector<std::string>{
+                at(48) + ": [SPINDLE_0] POSITION_REGISTER: [MODBUS_1] UPDATE_PERIOD_MS = 20: a "
+                         "rigid tap on a spindle read that seldom may be off its helix by more "
+                         "than pitch x 0.02; keep it at 10 or less"}));
+  EXPECT_TRUE(warnings_of(slow).empty());
   // Without a register the other keys do nothing, and say so.
   EXPECT_EQ(warnings_of(head + "POSITION_SCALE = 4096\n"),
             (std::vector<std::string>{
