@@ -69,19 +69,18 @@ class SyncFollower {
                            double dt) noexcept;
 
   SyncStatus status_{};
-  int direction_ = 1;   // the spindle's direction into the hole / along the thread
-  double origin_ = 0;   // spindle revolutions at the path's start (s = 0)
-  double command_ = 0;  // tap: spindle speed commanded, rev/s, > 0 into the hole
-  double accel_ = 0;    // tap: the ramp, rev/s^2
-  double path_v_ = 0;   // thread: path speed
-  double path_s_ = 0;   // thread: path position
-  bool locked_ = false;
-  bool out_at_top_ = false;  // tap: back at the top, told to stop
-  double last_s_ = 0;        // tap: the path position given last period       // tap: the spindle's
-                             // position is locked to the path's
-  double stalled_s_ = 0;     // time without progress while driven
-  double stopping_s_ = 0;    // tap: time spent bringing the spindle to rest
-  int rest_periods_ = 0;     // tap: periods in a row the spindle has stood still
+  int direction_ = 1;         // the spindle's direction into the hole / along the thread
+  double origin_ = 0;         // spindle revolutions at the path's start (s = 0)
+  double command_ = 0;        // tap: spindle speed commanded, rev/s, > 0 into the hole
+  double accel_ = 0;          // tap: the ramp, rev/s^2
+  double path_v_ = 0;         // thread: path speed
+  double path_s_ = 0;         // thread: path position
+  bool locked_ = false;       // tap: the spindle's position is locked to the path's
+  bool out_at_top_ = false;   // tap: back at the top, told to stop
+  double last_s_ = 0;         // tap: the path position given last period
+  double stalled_s_ = 0;      // time without progress while driven
+  double stopping_s_ = 0;     // tap: time spent bringing the spindle to rest
+  int rest_periods_ = 0;      // tap: periods in a row the spindle has stood still
   double last_progress_ = 0;  // tap: revolutions into the hole in the previous period
   // tap: the latest speed commands (rev/s into the hole), newest at sent_[(sent_head_ - 1)]:
   // those sent within the spindle's command delay still turn it.
