@@ -34,6 +34,10 @@ constexpr const char* kPart =
 // the first move reaching the servo thread, and between the last one ending and the daemon's
 // loop seeing the run end.
 constexpr double kLoopAllowance = 0.1;
+// The servo clock runs ahead of the wall clock only while a servo thread that stalled catches
+// up, at most 10 periods (MotionController skips the rest), over a stall that began before the
+// run did: 10 ms here, and 2 ms for the status the clocks are read from.
+constexpr double kCatchUp = 0.012;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -73,15 +77,16 @@ class EstimateTest : public MachineTest {
     ASSERT_EQ(done["program"]["result"], "done") << done.dump();
     EXPECT_EQ(done["program"]["remaining_s"], 0.0);
     // The run on the servo clock (servo periods x the period) is what the estimate predicts. Wall
-    // time is never shorter, and longer only by the periods a stalled servo thread skipped (a busy
-    // shared machine, sanitizer builds): printed, not held to the estimate.
+    // time is shorter only while a stalled servo thread catches up (kCatchUp), and longer by the
+    // periods one skipped (a busy shared machine, sanitizer builds): printed, not held to the
+    // estimate.
     const double motion = done["program"]["motion_s"].get<double>();
     const double elapsed = done["program"]["elapsed_s"].get<double>();
     // The daemon's loop notices the start and the end of the run at its own pace: a few ms
     // each, up to tens of ms on a loaded machine under the sanitizers (74 ms seen in all).
     EXPECT_NEAR(motion, estimated, 0.01 * estimated + kLoopAllowance) << done.dump();
-    EXPECT_GE(elapsed + 0.002, motion) << done.dump();
-    EXPECT_GE(measured + 0.002, motion);
+    EXPECT_GE(elapsed + kCatchUp, motion) << done.dump();
+    EXPECT_GE(measured + kCatchUp, motion);
     std::printf(
         "estimated %.3f s, run %.3f s on the servo clock, %.3f s (daemon, wall), %.3f s "
         "(program.run to idle), %s servo overruns\n",

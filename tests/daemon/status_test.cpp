@@ -97,7 +97,8 @@ TEST_F(MachineTest, ProgressAndElapsedTime) {
   // tens of ms on a loaded machine under the sanitizers.
   EXPECT_NEAR(s["program"]["estimated_s"].get<double>(), s["program"]["motion_s"].get<double>(),
               0.1);
-  EXPECT_GE(s["program"]["elapsed_s"].get<double>() + 0.002,
+  // Ahead of wall time only by a stalled servo thread catching up: at most 10 periods.
+  EXPECT_GE(s["program"]["elapsed_s"].get<double>() + 0.012,
             s["program"]["motion_s"].get<double>());
 }
 
