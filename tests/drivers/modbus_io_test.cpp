@@ -154,11 +154,10 @@ TEST_F(ModbusIo, AServoSpindlesPositionIsFollowedBetweenReadings) {
       driver_.write_io(command);
       feedback_ = IoFeedback{};
       driver_.read_io(feedback_);
-      const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                           std::chrono::steady_clock::now().time_since_epoch())
-                           .count();
       ASSERT_TRUE(feedback_.spindle.has_position);
-      const double truth = server_->revolutions(now);
+      // The shaft where it truly was at the moment the driver gave its position for.
+      ASSERT_NE(feedback_.spindle.time_ns, 0);
+      const double truth = server_->revolutions(feedback_.spindle.time_ns);
       errors.push_back(std::abs(feedback_.spindle.revolutions - truth));
       lowest = std::min(lowest, truth);
       highest = std::max(highest, truth);

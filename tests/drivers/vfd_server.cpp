@@ -88,8 +88,28 @@ void VfdServer::set_fault(bool fault) {
 
 double VfdServer::revolutions(std::int64_t now_ns) {
   std::lock_guard lock(mutex_);
-  advance(now_ns);
-  return revolutions_;
+  if (now_ns >= model_ns_ || history_size_ == 0) {
+    advance(now_ns);
+    return revolutions_;
+  }
+  // Between two remembered moments: as the shaft turned from one to the other.
+  const std::size_t n = history_.size();
+  const auto at = [&](std::size_t k) -> const Past& {  // k = 0: the oldest remembered
+    return history_[(history_head_ + n - history_size_ + k) % n];
+  };
+  if (now_ns <= at(0).time_ns) return at(0).revolutions;
+  std::size_t lo = 0;
+  std::size_t hi = history_size_ - 1;
+  while (hi - lo > 1) {
+    const std::size_t mid = (lo + hi) / 2;
+    (at(mid).time_ns <= now_ns ? lo : hi) = mid;
+  }
+  const Past& a = at(lo);
+  const Past& b = at(hi);
+  if (now_ns >= b.time_ns) return b.revolutions;
+  const double f =
+      static_cast<double>(now_ns - a.time_ns) / static_cast<double>(b.time_ns - a.time_ns);
+  return a.revolutions + f * (b.revolutions - a.revolutions);
 }
 
 double VfdServer::rpm(std::int64_t now_ns) {
@@ -114,6 +134,9 @@ void VfdServer::advance(std::int64_t now) {
                                   : std::max(target_rpm_, rpm_ - accel * dt);
       revolutions_ += 0.5 * (before + rpm_) / 60.0 * dt;
       model_ns_ += step;
+      history_[history_head_] = Past{model_ns_, revolutions_};
+      history_head_ = (history_head_ + 1) % history_.size();
+      history_size_ = std::min(history_size_ + 1, history_.size());
     }
   }
   modbus_mapping_t* m = as_mapping(mapping_);

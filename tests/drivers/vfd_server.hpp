@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 namespace cncd::test {
 
@@ -64,8 +65,9 @@ class VfdServer {
   void set_silent(bool silent) { silent_.store(silent); }
   // Requests answered so far.
   int answered() const { return answered_.load(); }
-  // The shaft's true position (revolutions, signed) and speed (rpm, signed) at `now_ns`
-  // (CLOCK_MONOTONIC, not before the last request), of a map with a position register.
+  // The shaft's true position (revolutions, signed) at `now_ns` (CLOCK_MONOTONIC; up to 2 s
+  // back), and its speed (rpm, signed) at `now_ns` (not before the last request), of a map with
+  // a position register.
   double revolutions(std::int64_t now_ns);
   double rpm(std::int64_t now_ns);
 
@@ -88,6 +90,14 @@ class VfdServer {
   double rpm_ = 0;
   double revolutions_ = 0;
   std::int64_t model_ns_ = 0;  // 0: not yet started
+  // Where the shaft was, every 100 us, for the last 2 s: a ring, newest at history_head_ - 1.
+  struct Past {
+    std::int64_t time_ns = 0;
+    double revolutions = 0;
+  };
+  std::vector<Past> history_ = std::vector<Past>(20000);
+  std::size_t history_head_ = 0;
+  std::size_t history_size_ = 0;
   std::atomic<bool> silent_{false};
   std::atomic<int> answered_{0};
   std::atomic<bool> running_{false};
