@@ -103,14 +103,14 @@ void describe_spindle(std::string& out, const SpindleConfig& s) {
                                                ", at speed bit " + std::to_string(s.at_speed_bit) +
                                                ", fault bit " + std::to_string(s.fault_bit) + ")"));
     if (s.position_register >= 0) {
-      line(out, "  position " + std::string(table_name(s.position_table)) + " register " +
-                    std::to_string(s.position_register) + ", " +
-                    std::to_string(s.position_width) + " bits" +
-                    (s.position_width == 32
-                         ? std::string(s.position_high_first ? ", high word first"
-                                                             : ", low word first")
-                         : std::string()) +
-                    ", " + num(s.position_scale) + " counts/rev");
+      line(out,
+           "  position " + std::string(table_name(s.position_table)) + " register " +
+               std::to_string(s.position_register) + ", " + std::to_string(s.position_width) +
+               " bits" +
+               (s.position_width == 32
+                    ? std::string(s.position_high_first ? ", high word first" : ", low word first")
+                    : std::string()) +
+               ", " + num(s.position_scale) + " counts/rev");
     }
   }
 }
