@@ -405,12 +405,7 @@ TEST(DriversEndToEnd, ASimulatedMotorThatLagsTripsTheFollowingError) {
 TEST(DriversEndToEnd, ARigidTapRunsOnAModbusServoSpindle) {
   // The sim mill with its spindle on Modbus TCP: a servo spindle with a 32-bit position
   // counter, read every 5 ms, ramping at 3000 rpm/s.
-  VfdMap map;
-  map.position_register = 10;
-  map.counts_per_rev = 4096;
-  map.units_per_rpm = 0.1;
-  map.acceleration_rpm_s = 3000;
-  VfdServer server(map, 3);
+  VfdServer server(servo_spindle_map(), 3);
   ASSERT_EQ(server.start(), "");
   TempDir dir;
   const std::string ini = adapt(

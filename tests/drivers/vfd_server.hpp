@@ -42,6 +42,17 @@ struct VfdMap {
   double acceleration_rpm_s = 0;
 };
 
+// A servo spindle: the generic profile with a 32-bit position counter at input register 10,
+// 4096 counts a revolution, the speed in tens of rpm, ramping at 3000 rpm/s.
+inline VfdMap servo_spindle_map() {
+  VfdMap map;
+  map.position_register = 10;
+  map.counts_per_rev = 4096;
+  map.units_per_rpm = 0.1;
+  map.acceleration_rpm_s = 3000;
+  return map;
+}
+
 class VfdServer {
  public:
   VfdServer(VfdMap map, int slave);
