@@ -315,14 +315,19 @@ TEST_F(SpindleSyncTest, ThreadStartsAtTheIndexAndFollowsTheHelix) {
   EXPECT_NEAR(machine_->status().spindle.actual_rpm, 600, 1e-9);
 }
 
+// The signed speed a spindle command asks for, rev/s (forward > 0).
+double told_rps(const drivers::IoCommand& command) {
+  const auto& sp = command.spindle;
+  return !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;
+}
+
 // A spindle drive with an encoder that turns as it was told `delay` periods ago (at once at
 // that speed), or, `dead`, not at all.
 class LateSpindle final : public FakeDriver {
  public:
   LateSpindle(std::size_t delay, bool dead) : FakeDriver("late"), delay_(delay), dead_(dead) {}
   void write_io(const drivers::IoCommand& command) noexcept override {
-    const auto& sp = command.spindle;
-    told_.push_back(!sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0);  // test code
+    told_.push_back(told_rps(command));  // test code
   }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
     const double rps = dead_ || told_.size() <= delay_ ? 0.0 : told_[told_.size() - 1 - delay_];
@@ -375,10 +380,7 @@ TEST_F(SpindleSyncTest, ASpindleThatRunsOnPastTheBottomStopsTheTap) {
 class JumpingSpindle final : public FakeDriver {
  public:
   explicit JumpingSpindle(double jump_at) : FakeDriver("jumping"), jump_at_(jump_at) {}
-  void write_io(const drivers::IoCommand& command) noexcept override {
-    const auto& sp = command.spindle;
-    rps_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;
-  }
+  void write_io(const drivers::IoCommand& command) noexcept override { rps_ = told_rps(command); }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
     const double before = revolutions_;
     revolutions_ += rps_ * 0.001;
@@ -442,8 +444,7 @@ class BusSpindle final : public FakeDriver {
     tracker_.configure(16, kCounts, acceleration / 60.0, 200 * kMs);
   }
   void write_io(const drivers::IoCommand& command) noexcept override {
-    const auto& sp = command.spindle;
-    told_rpm_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm);
+    told_rpm_ = told_rps(command) * 60.0;
   }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
     // This period's moment, in 0.1 ms steps of the shaft.
@@ -568,10 +569,7 @@ TEST_F(SpindleSyncTest, RigidTapStaysOnTheHelixOfASpindleOnAFieldBus) {
 class ClockSpindle final : public FakeDriver {
  public:
   explicit ClockSpindle(bool stamped) : FakeDriver("clock"), stamped_(stamped) {}
-  void write_io(const drivers::IoCommand& command) noexcept override {
-    const auto& sp = command.spindle;
-    rps_ = !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;
-  }
+  void write_io(const drivers::IoCommand& command) noexcept override { rps_ = told_rps(command); }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
     ++period_;
     const std::int64_t step = period_ % 200 == 0 ? 6'000'000 : period_ % 200 <= 5 ? 0 : 1'000'000;
