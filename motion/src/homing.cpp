@@ -296,7 +296,7 @@ Homing::Result Homing::update(JointIo& io) noexcept {
     if (advance_profile(m.s, m.v, m.length, m.v_max, m.a, dt)) {
       m.active = false;
       m.reached_end = true;
-    } else if (m.v_max == 0 && m.v == 0) {
+    } else if (m.v_max == 0 && at_rest(m.v)) {
       m.active = false;
     }
     io.command[static_cast<std::size_t>(j)] = m.origin + m.direction * m.s;

@@ -245,7 +245,7 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
   while (dt > 0) {
     if (!has_active_) {
       if (window_count_ == 0) fill_window();
-      if ((abort_requested_ && path_v_ <= 0) || window_count_ == 0) break;
+      if ((abort_requested_ && at_rest(path_v_)) || window_count_ == 0) break;
       has_active_ = true;
       // Path motion drives every joint of an axis to the axis position: a gantry joint homed
       // apart from its twin (or to another HOME) would jump.
@@ -312,7 +312,7 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
   distance_to_go_ = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell
                         ? window_at(head_seq_).length - path_s_
                         : 0.0;
-  if (abort_requested_ && path_v_ == 0) {
+  if (abort_requested_ && at_rest(path_v_)) {
     flush();
     motion_ = MotionState::idle;
     return {moved, fault_};
@@ -320,7 +320,7 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
   if (!pending()) {
     motion_ = MotionState::idle;
   } else if (pause_requested_) {
-    motion_ = path_v_ == 0 && !syncing() ? MotionState::paused : MotionState::pausing;
+    motion_ = at_rest(path_v_) && !syncing() ? MotionState::paused : MotionState::pausing;
   } else {
     motion_ = abort_requested_ ? MotionState::stopping : MotionState::moving;
   }

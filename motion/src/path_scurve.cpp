@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "cncd/motion/path_executor.hpp"
+#include "profile.hpp"
 #include "scurve.hpp"
 
 namespace cncd::motion {
@@ -241,7 +242,7 @@ void PathExecutor::scurve_step(double& dt, AxisPose& pose) noexcept {
     }
     break;
   }
-  if (step.velocity < 1e-12 && step.acceleration <= 0) step = {step.distance, 0.0, 0.0};
+  if (at_rest(step.velocity) && step.acceleration <= 0) step = {step.distance, 0.0, 0.0};
   path_v_ = step.velocity;
   path_a_ = step.acceleration;
 

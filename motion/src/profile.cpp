@@ -36,17 +36,21 @@ bool advance_profile(double& s, double& v, double length, double v_max, double a
     }
     double accel;
     double duration;
-    if (v > v_max + 1e-12) {
+    if (v > v_max + kSpeedResolution) {
       accel = -a;  // slow down to the (lowered) limit
       duration = (v - v_max) / a;
     } else {
+      // Within the resolution of the limit is on it: left there, a hold's 1e-15 would
+      // cruise for ever, neither moving nor at rest.
+      v = std::min(v, std::max(v_max, 0.0));
       const double peak = std::sqrt(0.5 * (stop_sq + v * v));
       // Below a fast v_end the end may come before the peak: accelerate up to it.
       const double target = std::min({v_max, peak, std::sqrt(v * v + 2.0 * a * d)});
-      if (target > v + 1e-12) {
+      if (target > v + kSpeedResolution) {
         accel = a;
         duration = (target - v) / a;
-      } else if (v <= 0) {
+      } else if (at_rest(v)) {
+        v = 0;
         return false;  // holding at rest
       } else {
         accel = 0;  // cruise until the braking curve (or the end, below v_end)
@@ -55,10 +59,10 @@ bool advance_profile(double& s, double& v, double length, double v_max, double a
     }
     const double step = std::min(std::max(duration, 0.0), dt);
     s += v * step + 0.5 * accel * step * step;
-    // Slowing down to a lowered limit lands on it exactly: v - a ((v - v_max) / a) can leave
-    // 1e-16 over, a speed at which a hold would never count as at rest.
-    const bool lowered = accel < 0 && step == duration;
-    v = lowered ? v_max : std::max(0.0, v + accel * step);
+    // Slowing down to a lowered limit lands on it exactly: v - a dt, with v / a a hair over
+    // dt, can leave 1e-15 over, a speed at which a hold would never count as at rest.
+    v = std::max(0.0, v + accel * step);
+    if (accel < 0 && (step == duration || v <= v_max + kSpeedResolution)) v = std::max(v_max, 0.0);
     dt -= step;
     if (s > length) s = length;
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "profile.hpp"
+
 namespace cncd::motion {
 namespace {
 
@@ -264,7 +266,7 @@ SyncFollower::Step SyncFollower::thread_step(const Segment& segment, const Spind
   if (path_s_ >= length - 1e-9) {
     out.s = length;
     out.done = true;
-  } else if (status_.phase == Phase::stopping && path_v_ == 0) {
+  } else if (status_.phase == Phase::stopping && at_rest(path_v_)) {
     out.done = true;
   }
   // Waiting for a spindle that does not turn.
