@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cncd/motion/homing.hpp"
 #include "machine_fixture.hpp"
 #include "profile.hpp"
 
@@ -98,6 +99,51 @@ TEST(HoldRest, AbortDuringTheRapidsAccelerationEndsIdleAndTakesMoves) {
     EXPECT_DOUBLE_EQ(m.status().commanded[0], 10);
     EXPECT_DOUBLE_EQ(m.status().commanded[1], 20);
   }
+}
+
+// X homing, searching at `search` mm/s with `a` mm/s² and its switch out of reach, aborted
+// `periods` periods into the search (still speeding up, or at speed).
+void abort_search(double a, double search, int periods) {
+  SCOPED_TRACE(testing::Message() << "search " << search << " mm/s at " << a << " mm/s², "
+                                  << periods << " periods");
+  auto config = small_mill();
+  config.joints[0].max_acceleration = a;
+  config.joints[0].home_search_vel = search;
+  config.joints[0].home_latch_vel = 1;
+  motion::Homing homing(config, 1e-3, 1u << 0);
+  motion::JointIo io;
+  ASSERT_TRUE(homing.start(1u << 0, io));
+  double before = io.command[0];
+  double speed = 0;
+  for (int k = 0; k < periods; ++k) {
+    io.feedback = io.command;
+    ASSERT_EQ(homing.update(io), motion::Homing::Result::running);
+    speed = std::abs(io.command[0] - before) / 1e-3;
+    before = io.command[0];
+  }
+  homing.abort();
+  const int bound = static_cast<int>(std::ceil(speed / a / 1e-3)) + 2;
+  motion::Homing::Result result = motion::Homing::Result::running;
+  for (int k = 0; k < bound && result == motion::Homing::Result::running; ++k) {
+    io.feedback = io.command;
+    result = homing.update(io);
+  }
+  EXPECT_EQ(result, motion::Homing::Result::aborted) << "from " << speed << " mm/s";
+}
+
+// Homing shares the profile: an abort during a switch search brakes the joint to rest and
+// ends the homing within v / a and a period.
+TEST(HoldRest, HomingAbortDuringTheSearchEnds) {
+  int cases = 0;
+  for (const double a : {2000.0, 2205.6, 987.65}) {
+    for (double search = 7.0; search < 200; search *= 1.07) {
+      for (int periods = 1; periods < 120; periods += 7) {
+        ASSERT_NO_FATAL_FAILURE(abort_search(a, search, periods));
+        ++cases;
+      }
+    }
+  }
+  EXPECT_GT(cases, 2000);
 }
 
 }  // namespace
