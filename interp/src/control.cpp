@@ -70,12 +70,12 @@ bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
   return false;
 }
 
+}  // namespace
+
 std::string o_label(const std::string& name) {
   return std::isdigit(static_cast<unsigned char>(name.empty() ? 'x' : name[0])) ? "o" + name
                                                                                 : "o<" + name + ">";
 }
-
-}  // namespace
 
 // Reads on until a line with this O-word name and one of `stops`; that line is then in
 // `line_` and is the current line.
@@ -149,6 +149,7 @@ void Interpreter::Impl::do_call() {
   frame.return_offset = return_offset;
   frame.return_line = return_line;
   frame.control_depth = control_.size();
+  frame.nx_loop_depth = nx_loops_.size();
   for (int i = 0; i < 30; ++i) {
     frame.saved_parameters[static_cast<std::size_t>(i)] = parameters_.get(i + 1);
     const auto arg = static_cast<std::size_t>(i);
@@ -166,6 +167,11 @@ void Interpreter::Impl::do_call() {
 void Interpreter::Impl::do_return(bool has_value, double value) {
   if (calls_.empty()) fail("Return or endsub outside a subroutine");
   const CallFrame frame = calls_.back();
+  if (nx_loops_.size() > frame.nx_loop_depth) {
+    const ForFrame& open = nx_loops_.back();
+    fail("for #" + std::to_string(open.var) + " of line " + std::to_string(open.for_line) +
+         " has no next before the end of subroutine " + o_label(frame.name));
+  }
   calls_.pop_back();
   control_.resize(frame.control_depth);
   parameters_.pop_scope();

@@ -132,6 +132,7 @@ struct CallFrame {
   std::int64_t return_offset = 0;
   int return_line = 0;
   std::size_t control_depth = 0;
+  std::size_t nx_loop_depth = 0;              // Numeryx for loops open in the caller
   std::array<double, 30> saved_parameters{};  // the caller's #1-#30
 };
 
@@ -143,6 +144,8 @@ inline constexpr int kG92Base = 5211;
 bool is_linear_axis(int axis);
 void rotate_xy(Pose& pose, double degrees);
 double unit_factor(Units from, Units to);
+// An O-word name as messages write it: "o100", "o<probe>".
+std::string o_label(const std::string& name);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {

@@ -30,6 +30,14 @@ double loop_slack(double end) {
   return 1e-9 * std::max(1.0, std::fabs(end));
 }
 
+std::string no_progress(int var, double step, double value, double end) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "Step %.17g does not change #%d (%.17g): the for loop would never reach %.17g",
+                step, var, value, end);
+  return text;
+}
+
 }  // namespace
 
 void Interpreter::Impl::execute_numeryx_block() {
@@ -298,6 +306,10 @@ bool Interpreter::Impl::handle_numeryx_loop() {
     const double slack = loop_slack(b.nx_loop_end);
     const bool runs = step > 0 ? b.nx_loop_start <= b.nx_loop_end + slack
                                : b.nx_loop_start >= b.nx_loop_end - slack;
+    // A step lost in the rounding of a large value leaves the variable where it is: the loop
+    // would run for ever.
+    if (runs && b.nx_loop_start + step == b.nx_loop_start)
+      fail(no_progress(b.nx_loop_var, step, b.nx_loop_start, b.nx_loop_end), column);
     nx_loops_.push_back(ForFrame{b.nx_loop_var, b.nx_loop_end, step, source().tell(),
                                  source().line_number(), current_line_, !runs});
     if (!runs) skip_numeryx_loop();
@@ -305,6 +317,13 @@ bool Interpreter::Impl::handle_numeryx_loop() {
   }
   if (nx_loops_.empty()) fail("next without a for loop", column);
   const ForFrame& top = nx_loops_.back();
+  // The caller's loop cannot be closed from a subroutine: its body is in the caller.
+  if (!calls_.empty() && nx_loops_.size() <= calls_.back().nx_loop_depth) {
+    fail("next without for in subroutine " + o_label(calls_.back().name) + ": the for #" +
+             std::to_string(top.var) + " of line " + std::to_string(top.for_line) +
+             " belongs to its caller",
+         column);
+  }
   if (b.nx_loop_var != 0 && b.nx_loop_var != top.var) {
     fail("next #" + std::to_string(b.nx_loop_var) + " does not close the loop of for #" +
              std::to_string(top.var) + " (line " + std::to_string(top.for_line) + ")",
@@ -314,6 +333,9 @@ bool Interpreter::Impl::handle_numeryx_loop() {
     const double value = parameters_.get(top.var) + top.step;
     const double slack = loop_slack(top.end);
     if (top.step > 0 ? value <= top.end + slack : value >= top.end - slack) {
+      // The body may have set the variable where the step no longer changes it.
+      if (value == parameters_.get(top.var))
+        fail(no_progress(top.var, top.step, value, top.end), column);
       parameters_.set(top.var, value, column);
       loop_back(top.offset, top.line_before);
       return true;
