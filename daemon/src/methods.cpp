@@ -145,7 +145,10 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
   add_command(dispatcher, task, "program.step", &Task::step);
   add_command(dispatcher, task, "program.pause", &Task::pause);
   add_command(dispatcher, task, "program.resume", &Task::resume);
-  add_command(dispatcher, task, "tool.change_done", &Task::tool_change_done);
+  dispatcher.add("tool.change_done", [&task](const json& params) {
+    task.tool_change_done(params["tool"].get<int>());
+    return ok();
+  });
   dispatcher.add("program.abort", [&task, &completions](const json&, Session& session) {
     if (session.in_batch) {
       task.abort();

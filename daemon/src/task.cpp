@@ -141,6 +141,7 @@ void Task::run_program(int from_line, bool step) {
   const auto status = ready_status("running a program");
   // Checked again: a directory on the way may have been replaced by a symlink leading out.
   const ProgramFile file = find_program(program_path_, config_.program_dirs);
+  tool_at_start_ = interp_->state().tool_in_spindle;
   if (!file.error.empty()) throw TaskError(TaskErrorKind::program, file.error);
   if (auto error = interp_->open(file.path)) {
     throw TaskError(TaskErrorKind::program, error->to_string());

@@ -86,9 +86,10 @@ class Task {
   void set_feed_override(double ratio);
   void set_rapid_override(double ratio);
   void set_spindle_override(double ratio);
-  // The operator has put in the tool a running program's M6 waits for: the program goes on.
-  // Throws TaskError (wrong_state) when no tool change is waited for.
-  void tool_change_done();
+  // The operator has put in `tool`, the one a running program's M6 waits for: the program goes
+  // on. Throws TaskError: wrong_state when no tool change is waited for, bad_value when the
+  // change waiting is for another tool.
+  void tool_change_done(int tool);
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 
@@ -220,6 +221,7 @@ class Task {
   PlanEstimator estimator_;  // the open program's running time, worked out in the background
   bool from_top_ = false;    // the run started at the program's first line
   int run_from_line_ = 0;    // run from line: the line it started at
+  int tool_at_start_ = 0;    // run from line: the tool in the spindle when it started
   // Run from line with a traverse to the line's start: the moving time when it ended.
   std::optional<double> approach_done_s_;
   std::chrono::steady_clock::time_point paused_since_{};

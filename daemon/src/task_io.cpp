@@ -62,13 +62,20 @@ WaitReport Task::wait_report(const motion::Status& s) const {
   return out;
 }
 
-void Task::tool_change_done() {
+void Task::tool_change_done(int tool) {
   const auto s = motion_.status();
   if (exec_ == ExecState::idle || s.wait.kind != motion::WaitStatus::Kind::tool_change)
-    throw TaskError(TaskErrorKind::wrong_state, "no tool change is waiting");
+    throw TaskError(TaskErrorKind::wrong_state,
+                    fmt::format("no tool change is waiting: T{} is not asked for", tool));
   const auto hold = feeder_->holds.find(s.wait.hold_id);
-  events_.add("info", "tool",
-              fmt::format("tool T{} put in", hold != feeder_->holds.end() ? hold->second.tool : 0));
+  const int wanted = hold != feeder_->holds.end() ? hold->second.tool : 0;
+  // An answer meant for another change (a second Enter, a confirmation sent before this
+  // prompt was seen) must not let this one go on.
+  if (tool != wanted) {
+    throw TaskError(TaskErrorKind::bad_value,
+                    fmt::format("the tool change waiting is for T{}, not T{}", wanted, tool));
+  }
+  events_.add("info", "tool", fmt::format("tool T{} put in", wanted));
   motion_.release_hold(s.wait.hold_id);
   if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
 }

@@ -31,6 +31,10 @@ bool Task::skip_before_start(bool program_ended) {
   }
   // The spindle and coolant as the skipped lines left them, before the machine moves there.
   feeder_->restore_io_state();
+  // A skipped M6 (or M61) left another tool in force than the one in the spindle: its length
+  // is already in the line's positions, so the operator puts it in before anything moves.
+  if (const int in_force = interp_->state().tool_in_spindle; in_force != tool_at_start_)
+    feeder_->change_tool_first(in_force, interp_->current_line(), motion_.status().commanded);
   skip_to_line_ = 0;
   return true;
 }

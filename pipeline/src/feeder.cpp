@@ -71,29 +71,6 @@ void ProgramFeeder::add_action(const motion::IoAction& action, int line) {
   pending.push_back(move);
 }
 
-void ProgramFeeder::restore_io_state() {
-  std::deque<motion::Move> front;
-  const auto push = [&](const motion::IoAction& a) {
-    motion::Move move;
-    move.kind = motion::Move::Kind::action;
-    move.action = a;
-    front.push_back(move);
-  };
-  push(spindle_action());
-  motion::IoAction coolant;
-  coolant.kind = motion::IoAction::Kind::coolant;
-  coolant.flood = flood;
-  coolant.mist = mist;
-  push(coolant);
-  if (spindle_direction != 0) {
-    motion::IoAction at_speed;
-    at_speed.kind = motion::IoAction::Kind::wait_at_speed;
-    push(at_speed);
-  }
-  need_at_speed_ = false;
-  pending.insert(pending.begin(), front.begin(), front.end());
-}
-
 void ProgramFeeder::emit(const interp::CanonCommand& command) {
   namespace in = interp;
   const in::CanonCommand m = tracker_.to_machine(command);
@@ -118,37 +95,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     add_action(a, m.line);
     return false;
   };
-  auto hold = [&](HoldInfo info) {
-    Action a;
-    a.kind = Action::Kind::hold;
-    a.hold = info.kind;
-    a.hold_id = next_hold_id_++;
-    info.line = m.line;
-    holds[a.hold_id] = std::move(info);
-    add_action(a, m.line);
-  };
+  auto hold = [&](HoldInfo info) { add_hold(std::move(info), m.line); };
   auto tool_change = [&](int number) {
-    tool = number;
-    const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
-    if (change != nullptr && change->has_position) {
-      // LinuxCNC's TOOL_CHANGE_POSITION: one traverse there, machine coordinates; the axes it
-      // does not name stay where they are.
-      motion::Move there;
-      there.kind = motion::Move::Kind::traverse;
-      there.line = m.line;
-      there.path_mode = motion::Move::PathMode::exact_stop;
-      there.end = end_;
-      for (int i = 0; i < motion::kAxes; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        if (change->position_given[k]) there.end[k] = change->position[k];
-      }
-      pending.push_back(there);
-      end_ = there.end;
-    }
-    HoldInfo info;
-    info.kind = Action::Hold::tool_change;
-    info.tool = number;
-    hold(std::move(info));
+    queue_tool_change(number, m.line);
     return false;
   };
   auto moving = [&](motion::Move& next) {

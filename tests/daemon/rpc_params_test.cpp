@@ -103,6 +103,7 @@ class RpcParamsTest : public MachineTest {
           {"back_angle", 0},
           {"orientation", 0},
           {"comment", "6 mm end mill"}}},
+        {"tool.change_done", {{"tool", 3}}},
         {"offsets.set", {{"system", "G54"}, {"origin", {{"x", 0}}}, {"rotation", 0}}},
     };
   }

@@ -1,5 +1,6 @@
 // cncctl: command-line client for cncd's control socket. Exit status: see cncctl.hpp.
 #include <poll.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -39,7 +40,7 @@ void usage(std::FILE* out) {
       "  open FILE           open FILE for run or step\n"
       "  step [FILE]         run one more line of the open program (or of FILE) and wait\n"
       "  pause | resume      feed hold and continue\n"
-      "  tool-done           the tool a program's M6 waits for is in: go on\n"
+      "  tool-done T<n>      tool n, the one a program's M6 waits for, is in: go on\n"
       "  abort               stop the running program; returns once the machine is at rest\n"
       "  mdi LINE            execute one block; returns when it has finished\n"
       "  jog AXIS +/-VELOCITY\n"
@@ -87,18 +88,30 @@ int wait_homed(cncd::daemon::Client& client, const std::vector<int>& joints) {
   return kFailed;
 }
 
-// A tool change the program waits for: prompts once and answers tool.change_done when a line
-// comes on standard input (another terminal may answer it with 'cncctl tool-done' meanwhile).
+// A tool change the program waits for: prompts once and answers tool.change_done for the tool
+// the prompt named when a line comes on standard input (another terminal may answer it with
+// 'cncctl tool-done T' meanwhile).
 class ToolPrompt {
  public:
   void update(cncd::daemon::Client& client, const json& wait, bool tty) {
-    const bool waiting = wait.is_object() && wait.value("kind", "") == "tool_change";
+    const bool waiting = wait.is_object() && wait.value("kind", "") == "tool_change" &&
+                         wait.contains("tool") && wait["tool"].is_number_integer();
     if (!waiting) {
       prompted_ = false;
       return;
     }
-    if (!prompted_) {
+    const int tool = wait["tool"].get<int>();
+    // A wait that started later than the one prompted for is another change, of the same tool
+    // maybe: two M6 in a row whose gap no status showed.
+    const double since = wait.value("since", 0.0);
+    const bool newer = since < since_;
+    since_ = since;
+    if (!prompted_ || tool != tool_ || newer) {
       prompted_ = true;
+      tool_ = tool;
+      // What was typed before this prompt (an Enter for the last change, a key hit by
+      // accident) must not answer it.
+      if (isatty(STDIN_FILENO) != 0) ::tcflush(STDIN_FILENO, TCIFLUSH);
       std::fprintf(stderr, "%s%s\n", tty ? "\r\033[K" : "", wait.value("message", "").c_str());
     }
     if (stdin_closed_) return;
@@ -111,13 +124,16 @@ class ToolPrompt {
       return;
     }
     if (std::memchr(buffer, '\n', static_cast<std::size_t>(n)) == nullptr) return;
-    // Answered meanwhile from elsewhere: the refusal says so, and is of no matter here.
-    const json reply = client.call("tool.change_done");
+    // Answered meanwhile from elsewhere, or the program has moved on to another change: the
+    // refusal says so, and the next status shows what is waiting now.
+    const json reply = client.call("tool.change_done", json{{"tool", tool_}});
     (void)reply;
   }
 
  private:
   bool prompted_ = false;
+  int tool_ = -1;
+  double since_ = 0;
   bool stdin_closed_ = false;
 };
 
@@ -227,9 +243,9 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     return kDone;
   };
   if (command == "status") return show(client, "status.get", json_output, print_status);
-  static const std::vector<std::string> kTakeArgs = {"home", "run",      "mdi",   "open",
-                                                     "step", "watch",    "tools", "offsets",
-                                                     "jog",  "override", "errors"};
+  static const std::vector<std::string> kTakeArgs = {"home", "run",      "mdi",    "open",
+                                                     "step", "watch",    "tools",  "offsets",
+                                                     "jog",  "override", "errors", "tool-done"};
   if (args.size() > 1 &&
       std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
@@ -242,7 +258,19 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "abort") return simple("program.abort");
   if (command == "pause") return simple("program.pause");
   if (command == "resume") return simple("program.resume");
-  if (command == "tool-done") return simple("tool.change_done");
+  if (command == "tool-done") {
+    // The tool is named: an answer meant for one change never lets another go on.
+    const std::string usage = "tool-done needs the tool the prompt names, e.g. 'tool-done T3'";
+    if (args.size() != 2) throw UsageError{usage};
+    std::string word = args[1];
+    if (!word.empty() && (word[0] == 'T' || word[0] == 't')) word.erase(0, 1);
+    char* end = nullptr;
+    const long tool = std::strtol(word.c_str(), &end, 10);
+    if (word.empty() || *end != '\0' || tool < 0 || tool > 99999) throw UsageError{usage};
+    const json result = result_of(client.call("tool.change_done", json{{"tool", tool}}));
+    if (json_output) std::printf("%s\n", result.dump().c_str());
+    return kDone;
+  }
   if (command == "mdi") {
     std::string line;
     for (std::size_t i = 1; i < args.size(); ++i)

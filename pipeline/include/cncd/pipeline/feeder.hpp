@@ -69,6 +69,11 @@ class ProgramFeeder final : public interp::CanonSink {
   // Puts the spindle and coolant as the program has left them in front of the pending moves
   // (run from line: the lines skipped set them).
   void restore_io_state();
+  // Run from line: the tool the skipped lines left in force is not the one in the spindle.
+  // Puts that tool change in front of the pending moves as an M6 makes it (the spindle
+  // stopped unless TOOL_CHANGE_WITH_SPINDLE_ON, the traverse to TOOL_CHANGE_POSITION, the
+  // hold for the operator); `at` is where the machine stands (machine coordinates).
+  void change_tool_first(int number, int line, const motion::AxisPose& at);
   // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
   // planner is flushed there.
   static bool stop_point(const motion::Move& move) {
@@ -116,6 +121,10 @@ class ProgramFeeder final : public interp::CanonSink {
   void add_stop_point();
   // Queues an action (a zero dwell that does `action` at rest).
   void add_action(const motion::IoAction& action, int line);
+  // Queues a hold the task answers, remembering what it waits for under its id.
+  void add_hold(HoldInfo info, int line);
+  // Queues M6's tool change to `number`: the traverse to the tool change position, the hold.
+  void queue_tool_change(int number, int line);
   // The spindle as the program sets it now.
   motion::IoAction spindle_action() const;
   const config::MachineConfig* machine_ = nullptr;

@@ -1,0 +1,81 @@
+// The feeder's holds (a tool change, a user M code) and what a run from a line puts in front of
+// its first move: the tool, spindle and coolant the skipped lines left in force.
+#include <utility>
+
+#include "cncd/pipeline/feeder.hpp"
+
+namespace cncd::pipeline {
+
+void ProgramFeeder::add_hold(HoldInfo info, int line) {
+  motion::IoAction a;
+  a.kind = motion::IoAction::Kind::hold;
+  a.hold = info.kind;
+  a.hold_id = next_hold_id_++;
+  info.line = line;
+  holds[a.hold_id] = std::move(info);
+  add_action(a, line);
+}
+
+void ProgramFeeder::queue_tool_change(int number, int line) {
+  tool = number;
+  const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
+  if (change != nullptr && change->has_position) {
+    // LinuxCNC's TOOL_CHANGE_POSITION: one traverse there, machine coordinates; the axes it
+    // does not name stay where they are.
+    motion::Move there;
+    there.kind = motion::Move::Kind::traverse;
+    there.line = line;
+    there.path_mode = motion::Move::PathMode::exact_stop;
+    there.end = end_;
+    for (int i = 0; i < motion::kAxes; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (change->position_given[k]) there.end[k] = change->position[k];
+    }
+    pending.push_back(there);
+    end_ = there.end;
+  }
+  HoldInfo info;
+  info.kind = motion::IoAction::Hold::tool_change;
+  info.tool = number;
+  add_hold(std::move(info), line);
+}
+
+void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPose& at) {
+  std::deque<motion::Move> rest;
+  rest.swap(pending);
+  const motion::AxisPose end = end_;
+  end_ = at;
+  if (machine_ == nullptr || !machine_->tool_change.with_spindle_on) {
+    motion::IoAction stop;
+    stop.kind = motion::IoAction::Kind::spindle;
+    add_action(stop, line);
+  }
+  queue_tool_change(number, line);
+  end_ = end;
+  pending.insert(pending.end(), rest.begin(), rest.end());
+}
+
+void ProgramFeeder::restore_io_state() {
+  std::deque<motion::Move> front;
+  const auto push = [&](const motion::IoAction& a) {
+    motion::Move move;
+    move.kind = motion::Move::Kind::action;
+    move.action = a;
+    front.push_back(move);
+  };
+  push(spindle_action());
+  motion::IoAction coolant;
+  coolant.kind = motion::IoAction::Kind::coolant;
+  coolant.flood = flood;
+  coolant.mist = mist;
+  push(coolant);
+  if (spindle_direction != 0) {
+    motion::IoAction at_speed;
+    at_speed.kind = motion::IoAction::Kind::wait_at_speed;
+    push(at_speed);
+  }
+  need_at_speed_ = false;
+  pending.insert(pending.begin(), front.begin(), front.end());
+}
+
+}  // namespace cncd::pipeline
