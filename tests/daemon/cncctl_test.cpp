@@ -157,5 +157,33 @@ TEST_F(CncctlTest, ExitCodesTellDoneRefusedFailedAndUnreachable) {
   EXPECT_EQ(r.exit_status, 69);
 }
 
+// Text from cncd goes to a terminal: a program's (MSG, ...) and a file name must not carry
+// escape sequences there (retitle the window, move the cursor, hide what follows).
+TEST_F(CncctlTest, ControlCharactersFromTheProgramAreEscaped) {
+  ready();
+  const std::string hostile =
+      "\x1b]0;owned\x07 \x1b[2J \xc2\x9b"
+      "31m \x7f \xff caf\xc3\xa9\tend";
+  const auto program = dir_.write("msg\x1b[1m.ngc", "(MSG, " + hostile + ")\nG0 X1\nM2\n");
+  auto r = cncctl({"run", program.string()});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  for (const auto* command : {"errors", "status"}) {
+    r = cncctl({command});
+    EXPECT_EQ(r.exit_status, 0) << r.err;
+    for (const char bad : {'\x1b', '\x07', '\x7f', '\t'})
+      EXPECT_EQ(r.out.find(bad), std::string::npos) << command << ": " << r.out;
+    EXPECT_EQ(r.out.find("\xc2\x9b"), std::string::npos) << command << ": " << r.out;
+    EXPECT_EQ(r.out.find('\xff'), std::string::npos) << command << ": " << r.out;
+    EXPECT_NE(r.out.find("msg\\x1b[1m.ngc"), std::string::npos) << command << ": " << r.out;
+  }
+  r = cncctl({"errors"});
+  // Printable UTF-8 stays as it is; what is not is written so that it can be read (cncd's JSON
+  // has made the stray byte U+FFFD).
+  EXPECT_NE(
+      r.out.find("\\x1b]0;owned\\x07 \\x1b[2J \\u009b31m \\x7f \xef\xbf\xbd caf\xc3\xa9\\tend"),
+      std::string::npos)
+      << r.out;
+}
+
 }  // namespace
 }  // namespace cncd::test

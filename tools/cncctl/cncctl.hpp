@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -31,6 +32,13 @@ struct UsageError {
 };
 
 using Args = std::vector<std::string>;
+
+// Text from cncd (a program's MSG, errors, events, file names) as it may go to a terminal:
+// printable UTF-8 as it is; tab, newline and return as \t \n \r; other C0 controls, DEL and
+// bytes that are not UTF-8 as \xNN; the C1 controls U+0080-U+009F as \u0080-\u009f.
+std::string printable(std::string_view text);
+// object[key] through printable(); "" when it is not a string.
+std::string text_field(const nlohmann::json& object, const char* key);
 
 // The response's result; throws Refused when it holds an error.
 nlohmann::json result_of(const nlohmann::json& response);

@@ -13,7 +13,8 @@ std::string join(const json& list) {
   std::string out;
   if (!list.is_array()) return out;
   for (const auto& item : list)
-    out += (out.empty() ? "" : " ") + (item.is_string() ? item.get<std::string>() : item.dump());
+    out += (out.empty() ? "" : " ") +
+           (item.is_string() ? printable(item.get<std::string>()) : item.dump());
   return out;
 }
 }  // namespace
@@ -26,12 +27,12 @@ int info(daemon::Client& client, const Args& args, bool json_output) {
     return kDone;
   }
   const json machine = result.value("machine", json::object());
-  std::printf("cncd      %s (protocol %s)\n", result.value("version", "").c_str(),
+  std::printf("cncd      %s (protocol %s)\n", text_field(result, "version").c_str(),
               result.value("protocol_version", json()).dump().c_str());
-  std::printf("machine   %s\n", machine.value("name", "").c_str());
-  std::printf("config    %s\n", machine.value("config", "").c_str());
+  std::printf("machine   %s\n", text_field(machine, "name").c_str());
+  std::printf("config    %s\n", text_field(machine, "config").c_str());
   std::printf("axes      %s (%s)\n", join(machine.value("axes", json())).c_str(),
-              machine.value("units", "").c_str());
+              text_field(machine, "units").c_str());
   std::printf("joints    %s: %s\n", machine.value("joints", json()).dump().c_str(),
               join(machine.value("drivers", json())).c_str());
   std::printf("servo     %s ns\n", machine.value("servo_period_ns", json()).dump().c_str());

@@ -25,7 +25,7 @@ int wait_jog_done(daemon::Client& client, bool json_output) {
     std::printf("%s\n", axes_text(s["position"]["commanded"]).c_str());
   }
   if (!s.value("fault", "").empty()) {
-    std::fprintf(stderr, "cncctl: jog failed: %s\n", s.value("fault", "").c_str());
+    std::fprintf(stderr, "cncctl: jog failed: %s\n", text_field(s, "fault").c_str());
     return kFailed;
   }
   return kDone;

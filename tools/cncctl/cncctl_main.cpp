@@ -71,7 +71,7 @@ int wait_homed(cncd::daemon::Client& client, const std::vector<int>& joints) {
   for (int tries = 0; tries < 6000; ++tries) {
     const json s = result_of(client.call("status.get"));
     if (!s.value("fault", "").empty()) {
-      std::fprintf(stderr, "cncctl: homing failed: %s\n", s.value("fault", "").c_str());
+      std::fprintf(stderr, "cncctl: homing failed: %s\n", text_field(s, "fault").c_str());
       return kFailed;
     }
     bool done = true;
@@ -112,7 +112,7 @@ class ToolPrompt {
       // What was typed before this prompt (an Enter for the last change, a key hit by
       // accident) must not answer it.
       if (isatty(STDIN_FILENO) != 0) ::tcflush(STDIN_FILENO, TCIFLUSH);
-      std::fprintf(stderr, "%s%s\n", tty ? "\r\033[K" : "", wait.value("message", "").c_str());
+      std::fprintf(stderr, "%s%s\n", tty ? "\r\033[K" : "", text_field(wait, "message").c_str());
     }
     if (stdin_closed_) return;
     pollfd fd{STDIN_FILENO, POLLIN, 0};
@@ -150,7 +150,7 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
     const std::string wait_kind = wait.is_object() ? wait.value("kind", "") : "";
     if (wait_kind != last_wait && !wait_kind.empty() && wait_kind != "tool_change" &&
         !json_output) {
-      std::printf("%s%s\n", tty ? "\r\033[K" : "", wait.value("message", "").c_str());
+      std::printf("%s%s\n", tty ? "\r\033[K" : "", text_field(wait, "message").c_str());
       std::fflush(stdout);
     }
     last_wait = wait_kind;
@@ -175,7 +175,7 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
     }
     if (exec == "idle") {
       if (tty) std::printf("\r\033[K");
-      const std::string result = p.value("result", "");
+      const std::string result = text_field(p, "result");
       if (json_output) {
         std::printf("%s\n", s.dump(2).c_str());
       } else {
@@ -184,7 +184,7 @@ int follow_program(cncd::daemon::Client& client, bool json_output) {
       }
       if (result != "done") {
         std::fprintf(stderr, "cncctl: program %s: %s\n", result.c_str(),
-                     p.value("error", "").c_str());
+                     text_field(p, "error").c_str());
         return kFailed;
       }
       return kDone;
@@ -213,12 +213,12 @@ int follow_step(cncd::daemon::Client& client, bool json_output) {
                     static_cast<unsigned long long>(p.value("total_lines", 0ULL)),
                     axes_text(s["work_position"]["commanded"]).c_str());
       } else {
-        std::printf("%s; position %s\n", p.value("result", "").c_str(),
+        std::printf("%s; position %s\n", text_field(p, "result").c_str(),
                     axes_text(s["work_position"]["commanded"]).c_str());
       }
       if (exec == "idle" && p.value("result", "") != "done") {
-        std::fprintf(stderr, "cncctl: program %s: %s\n", p.value("result", "").c_str(),
-                     p.value("error", "").c_str());
+        std::fprintf(stderr, "cncctl: program %s: %s\n", text_field(p, "result").c_str(),
+                     text_field(p, "error").c_str());
         return kFailed;
       }
       return kDone;
@@ -282,7 +282,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     const json response = client.call("mdi.execute", json{{"line", line}}, 24 * 3600 * 1000);
     if (response.contains("error") && response["error"].value("code", 0) == 1003) {
       std::fprintf(stderr, "cncctl: mdi failed: %s\n",
-                   response["error"].value("message", "").c_str());
+                   text_field(response["error"], "message").c_str());
       return kFailed;
     }
     result_of(response);
@@ -306,8 +306,8 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
       char stamp[32];
       std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M:%S", std::localtime(&when));
       std::printf("%6llu %s %-7s %-8s %s\n", static_cast<unsigned long long>(e.value("seq", 0ULL)),
-                  stamp, e.value("level", "").c_str(), e.value("kind", "").c_str(),
-                  e.value("message", "").c_str());
+                  stamp, text_field(e, "level").c_str(), text_field(e, "kind").c_str(),
+                  text_field(e, "message").c_str());
     }
     return kDone;
   }

@@ -34,15 +34,15 @@ void print_tools(const json& list) {
   for (const auto& t : list["tools"]) {
     std::printf("T%-5d P%-5d %-36s %-10.4f %s\n", t.value("number", 0), t.value("pocket", 0),
                 axes_text(t["offset"]).c_str(), t.value("diameter", 0.0),
-                t.value("comment", "").c_str());
+                text_field(t, "comment").c_str());
   }
-  std::printf("(%s, %s)\n", list.value("path", "").c_str(), list.value("units", "").c_str());
+  std::printf("(%s, %s)\n", text_field(list, "path").c_str(), text_field(list, "units").c_str());
 }
 
 void print_offsets(const json& offsets) {
-  const std::string active = offsets.value("active", "");
+  const std::string active = text_field(offsets, "active");
   for (const auto& system : offsets["systems"]) {
-    const std::string name = system.value("name", "");
+    const std::string name = text_field(system, "name");
     std::printf("%-6s%s %s", name.c_str(), name == active ? "*" : " ",
                 axes_text(system["origin"]).c_str());
     if (system.value("rotation", 0.0) != 0.0)
@@ -50,7 +50,7 @@ void print_offsets(const json& offsets) {
     std::printf("\n");
   }
   std::printf("%-7s %s\n", "G92", axes_text(offsets["g92"]).c_str());
-  std::printf("(* active; %s, machine coordinates)\n", offsets.value("units", "").c_str());
+  std::printf("(* active; %s, machine coordinates)\n", text_field(offsets, "units").c_str());
 }
 }  // namespace
 
@@ -121,7 +121,7 @@ int offsets(daemon::Client& client, const Args& args, bool json_output) {
   if (json_output) {
     std::printf("%s\n", result.dump().c_str());
   } else {
-    std::printf("%s set\n", result.value("system", "").c_str());
+    std::printf("%s set\n", text_field(result, "system").c_str());
   }
   return kDone;
 }

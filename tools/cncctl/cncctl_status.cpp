@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "cncctl.hpp"
@@ -13,7 +14,8 @@ using nlohmann::json;
 json result_of(const json& response) {
   if (response.contains("error")) {
     const auto& error = response["error"];
-    throw Refused{error.value("message", std::string("error")) + " (code " +
+    const std::string message = text_field(error, "message");
+    throw Refused{(message.empty() ? std::string("error") : message) + " (code " +
                       std::to_string(error.value("code", 0)) + ")",
                   error.value("code", 0)};
   }
@@ -35,7 +37,7 @@ std::string axes_text(const json& axes) {
   char buf[64];
   if (!axes.is_object()) return out;
   for (const auto& [name, value] : axes.items()) {
-    if (!value.is_number()) continue;
+    if (!value.is_number() || name.size() != 1 || name[0] < 'a' || name[0] > 'z') continue;
     std::snprintf(buf, sizeof buf, "%s%c %.4f", out.empty() ? "" : "  ", name[0] - 'a' + 'A',
                   value.get<double>());
     out += buf;
@@ -58,7 +60,7 @@ std::string join(const json& list) {
   if (!list.is_array()) return out;
   for (const auto& item : list) {
     if (!item.is_string()) continue;
-    out += (out.empty() ? "" : " ") + item.get<std::string>();
+    out += (out.empty() ? "" : " ") + printable(item.get<std::string>());
   }
   return out;
 }
@@ -70,6 +72,8 @@ T get(const json& object, const char* key, T fallback) {
   const auto it = object.find(key);
   if (it == object.end() || it->is_null()) return fallback;
   try {
+    // Text comes from cncd (file names, errors): never raw to the terminal.
+    if constexpr (std::is_same_v<T, std::string>) return printable(it->get<std::string>());
     return it->get<T>();
   } catch (const json::exception&) {
     return fallback;
