@@ -356,6 +356,7 @@ void Task::feed() {
 
 void Task::poll() {
   drain_servo_events();
+  user_m_.tick();
   if (opening_) {
     if (auto outcome = opener_.take()) finish_open(std::move(*outcome));
   }
