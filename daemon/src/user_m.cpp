@@ -42,7 +42,7 @@ UserMProcess::~UserMProcess() {
 
 std::string UserMProcess::start(const std::string& executable, double p, double q,
                                 double timeout_s) {
-  stop();
+  if (pid_ > 0) stop();
   if (kill_at_) kill_all();  // what the last one left must not share this one's run
   if (!g_started_any) {
     // Helpers that leave their parent (setsid and a double fork) come to cncd, not to init:

@@ -3,11 +3,11 @@
 // time, polled from the task's loop.
 //
 // What it starts stays with it even in a session of its own: cncd is a child subreaper, so
-// helpers whose parents end are handed to cncd rather than to init, and a timeout, an abort, an
-// estop or shutdown ends every process that descends from cncd (it starts no others), SIGTERM
-// first and SIGKILL kKillGrace later. The executable gets none of cncd's descriptors (standard
-// input is /dev/null, output and errors go where cncd's go) and only the environment
-// user_m_environment() gives.
+// helpers whose parents end are handed to cncd rather than to init, and a timeout or the end of
+// the run (done, abort, estop, shutdown: Task::finish_program) ends every process that descends
+// from cncd (it starts no others), SIGTERM first and SIGKILL kKillGrace later. The executable gets
+// none of cncd's descriptors (standard input is /dev/null, output and errors go where cncd's go)
+// and only the environment user_m_environment() gives.
 #pragma once
 
 #include <sys/types.h>
