@@ -34,6 +34,7 @@ std::vector<std::string> user_m_environment() {
 
 UserMProcess::~UserMProcess() {
   stop();
+  tick();
   // At shutdown the grace is waited out here: nothing of the M codes outlives cncd.
   while (kill_at_ && std::chrono::steady_clock::now() < *kill_at_ && !descendants().empty())
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -117,22 +118,28 @@ std::optional<std::string> UserMProcess::poll() {
 void UserMProcess::stop() {
   if (!g_started_any || !has_children()) return;
   if (pid_ > 0) ::kill(-pid_, SIGTERM);
-  const std::vector<pid_t> all = descendants();
-  for (const pid_t pid : all)
-    ::kill(pid, SIGTERM);
   // Its status is of no use now: the reaping in tick() takes it with the helpers'.
   pid_ = -1;
-  if (!all.empty() && !kill_at_) kill_at_ = std::chrono::steady_clock::now() + kKillGrace;
+  // The rest of the tree is looked for in /proc from the next tick(): an estop's answer does
+  // not wait for that.
+  term_pending_ = true;
+  if (!kill_at_) kill_at_ = std::chrono::steady_clock::now() + kKillGrace;
 }
 
 void UserMProcess::tick() {
   if (!g_started_any) return;
   reap_children(pid_);
+  if (term_pending_) {
+    term_pending_ = false;
+    for (const pid_t pid : descendants())
+      ::kill(pid, SIGTERM);
+  }
   if (kill_at_ && std::chrono::steady_clock::now() >= *kill_at_) kill_all();
 }
 
 void UserMProcess::kill_all() {
   kill_at_.reset();
+  term_pending_ = false;
   // A helper may fork while it is being killed: look again until nothing is left.
   for (int round = 0; round < 50; ++round) {
     const std::vector<pid_t> left = descendants();

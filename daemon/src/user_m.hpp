@@ -49,8 +49,9 @@ class UserMProcess {
   // happened ("exited with status 3", "was killed by signal 9", "did not finish within 60 s").
   // A process past its timeout is stopped first.
   std::optional<std::string> poll();
-  // Ends a running M code and all that user M codes started: SIGTERM now, SIGKILL after
-  // kKillGrace (tick()). Does not wait: an estop is not held up by a slow helper.
+  // Ends a running M code and all that user M codes started: SIGTERM to its process group
+  // now, to the rest of the tree at the next tick(), SIGKILL after kKillGrace. Does not wait
+  // nor read /proc: an estop is not held up by it.
   void stop();
   // Called every loop: reaps the helpers handed to cncd and, once the grace after stop() has
   // passed, kills what is left.
@@ -67,6 +68,7 @@ class UserMProcess {
   std::chrono::steady_clock::time_point deadline_{};
   double timeout_s_ = 0;
   std::optional<std::chrono::steady_clock::time_point> kill_at_;  // stop() was called
+  bool term_pending_ = false;  // stop() was called: SIGTERM to the tree at the next tick()
 };
 
 }  // namespace cncd::daemon
