@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "loader.hpp"
 #include "text.hpp"
@@ -238,6 +239,27 @@ void check_joint_section(TypedReader& r, const MachineConfig& c, int index, char
           (beyond.empty() ? "" : "; the file has" + beyond + " instead, which JOINTS leaves out"));
 }
 
+// Homing waits for joints that have no section after the last [JOINT_n] and drive no axis of
+// COORDINATES for ever: they are refused together, by number.
+void refuse_unconfigured_joints(TypedReader& r, const MachineConfig& c,
+                                const std::vector<int>& joints, int last_section) {
+  std::string list;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const char* separator = i == 0 ? "" : i + 1 == joints.size() ? " and " : ", ";
+    list += separator + std::to_string(joints[i]);
+  }
+  const std::string last =
+      last_section < 0
+          ? "the file has none): give each joint its section"
+          : "the last is [" + joint_section(last_section) +
+                "]): set JOINTS = " + std::to_string(last_section + 1 + c.extra_joints) +
+                ", or give each joint its section";
+  r.problem("KINS", "JOINTS",
+            "JOINTS = " + std::to_string(c.joint_count) + ", but joint" +
+                (joints.size() == 1 ? " " : "s ") + list + (joints.size() == 1 ? " has" : " have") +
+                " no [JOINT_n] section (" + last);
+}
+
 // Path limits not given in [TRAJ] follow the axes, as LinuxCNC lets the axis limits apply.
 void derive_traj_limits(TypedReader& r, MachineConfig& c) {
   double fastest = 0;
@@ -286,9 +308,21 @@ void load_motion(TypedReader& r, MachineConfig& c) {
     if (present || (driven && r.ini().has_section(axis_section(letter)))) load_axis(r, c, letter);
   }
   c.joints.clear();
+  int last_section = -1;
+  for (int n = 0; n < kMaxJoints; ++n) {
+    if (r.ini().has_section(joint_section(n))) last_section = n;
+  }
+  std::vector<int> unconfigured;
   for (int index = 0; index < c.joint_count; ++index) {
     const char letter =
         index < static_cast<int>(map.size()) ? map[static_cast<std::size_t>(index)] : '\0';
+    const bool drives_axis = letter != '\0' && c.coordinates.find(letter) != std::string::npos;
+    if (index > last_section && index < c.joint_count - c.extra_joints && !drives_axis) {
+      // No section here nor after it: JOINTS counts joints the machine does not have.
+      unconfigured.push_back(index);
+      c.joints.push_back(load_joint(r, c, index, letter));
+      continue;
+    }
     check_joint_section(r, c, index, letter);
     if (letter == '\0' && index < c.joint_count - c.extra_joints) {
       r.warning(joint_section(index), "", "joint is driven by no axis");
@@ -299,6 +333,7 @@ void load_motion(TypedReader& r, MachineConfig& c) {
     }
     c.joints.push_back(load_joint(r, c, index, letter));
   }
+  if (!unconfigured.empty()) refuse_unconfigured_joints(r, c, unconfigured, last_section);
   derive_traj_limits(r, c);
 }
 

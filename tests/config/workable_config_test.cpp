@@ -71,6 +71,24 @@ TEST_F(WorkableConfigTest, JointOfAnAxisWithoutItsSectionIsRefused) {
       << ::testing::PrintToString(strings(lathe.warnings));
 }
 
+TEST_F(WorkableConfigTest, JointsBeyondTheLastJointSectionAreRefused) {
+  // JOINTS = 9 on a three-joint mill: six joints run on made-up defaults and homing never
+  // completes. Whether the kinematics give them axes outside COORDINATES or none at all.
+  const std::string expected =
+      "[KINS] JOINTS: JOINTS = 9, but joints 3, 4, 5, 6, 7 and 8 have no [JOINT_n] section "
+      "(the last is [JOINT_2]): set JOINTS = 3, or give each joint its section";
+  EXPECT_EQ(problems_with(11, "JOINTS = 9"), problem_at(11, expected));
+  EXPECT_EQ(problems_of(replace_line(
+                replace_line(minimal_ini(), 10, "KINEMATICS = trivkins coordinates=XYZ"), 11,
+                "JOINTS = 9")),
+            problem_at(11, expected));
+  // One joint too many: named alone.
+  EXPECT_EQ(problems_with(11, "JOINTS = 4"),
+            problem_at(11,
+                       "[KINS] JOINTS: JOINTS = 4, but joint 3 has no [JOINT_n] section (the "
+                       "last is [JOINT_2]): set JOINTS = 3, or give each joint its section"));
+}
+
 TEST_F(WorkableConfigTest, DefaultVelocityAboveTheMaximumIsLowered) {
   const auto result = load(
       replace_line(minimal_ini(), 7,
