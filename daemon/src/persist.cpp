@@ -24,7 +24,7 @@ std::string os_error(const std::string& what, const std::filesystem::path& path)
 std::string atomic_write_file(const std::filesystem::path& path, const std::string& content) {
   const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   std::string temp = (dir / ("." + path.filename().string() + ".XXXXXX")).string();
-  const int fd = mkstemp(temp.data());
+  const int fd = ::mkostemp(temp.data(), O_CLOEXEC);
   if (fd < 0) return os_error("cannot create a temporary file next to", path);
   std::size_t written = 0;
   while (written < content.size()) {

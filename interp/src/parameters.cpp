@@ -1,6 +1,7 @@
 #include "parameters.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -198,7 +199,6 @@ std::optional<std::string> Parameters::load(const std::filesystem::path& path) {
 }
 
 std::optional<std::string> Parameters::save(const std::filesystem::path& path) const {
-  const std::filesystem::path temp = path.string() + ".tmp";
   // set() lets no such value in: this is the last line of defence for the file.
   for (int number = 1; number < kMaxParameter; ++number) {
     const double value = numbered_[static_cast<std::size_t>(number)];
@@ -207,6 +207,17 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
              out_of_range_message("parameter #" + std::to_string(number), value);
     }
   }
+  // A name of its own each time, created exclusively (mkstemp: O_CREAT | O_EXCL), so that a
+  // link planted where the temporary goes is never followed.
+  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::string temp_name = (dir / ("." + path.filename().string() + ".XXXXXX")).string();
+  errno = 0;
+  const int fd = ::mkostemp(temp_name.data(), O_CLOEXEC);
+  if (fd < 0) {
+    return "Unable to write parameter file " + path.string() +
+           ": cannot create a temporary file beside it: " + std::strerror(errno);
+  }
+  const std::filesystem::path temp = temp_name;
   // Whatever fails, the temporary file goes: a full disk must not be left fuller, nor a
   // truncated copy lie beside the file.
   const auto fail = [&](const std::string& what) {
@@ -215,9 +226,11 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
     std::filesystem::remove(temp, ignored);
     return what + ": " + reason;
   };
-  errno = 0;
-  std::FILE* out = std::fopen(temp.c_str(), "w");
-  if (out == nullptr) return fail("Unable to write parameter file " + temp.string());
+  std::FILE* out = ::fdopen(fd, "w");
+  if (out == nullptr) {
+    ::close(fd);
+    return fail("Unable to write parameter file " + temp.string());
+  }
   for (int number = 1; number < kMaxParameter; ++number) {
     if (!is_persistent_parameter(number)) continue;
     std::fprintf(out, "%d\t%f\n", number, numbered_[static_cast<std::size_t>(number)]);
@@ -226,7 +239,7 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
   int error = 0;
   if (std::fflush(out) != 0 || std::ferror(out) != 0) {
     error = errno != 0 ? errno : EIO;
-  } else if (::fsync(::fileno(out)) != 0) {
+  } else if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) {
     error = errno;
   }
   if (std::fclose(out) != 0 && error == 0) error = errno;
@@ -237,7 +250,6 @@ std::optional<std::string> Parameters::save(const std::filesystem::path& path) c
   if (::rename(temp.c_str(), path.c_str()) != 0) {
     return fail("Unable to replace parameter file " + path.string());
   }
-  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd >= 0) {
     ::fsync(dir_fd);

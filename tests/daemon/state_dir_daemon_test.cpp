@@ -125,5 +125,27 @@ TEST_F(StateDirDaemonTest, MissingStateFilesStartFromTheDefaultsAndAreCreated) {
   EXPECT_FALSE(fs::exists(dir_.path() / "fresh.var.tmp"));
 }
 
+// A link planted where a fixed temporary name would go is never followed: the file it points
+// to stays as it was, and the parameter file is written, a regular file, all the same.
+TEST_F(StateDirDaemonTest, TheParameterFileIsNeverWrittenThroughALinkBesideIt) {
+  const auto ini = copy_example_machine(dir_.path());
+  TempDir elsewhere;
+  const fs::path victim = elsewhere.write("victim", "precious\n");
+  fs::create_symlink(victim, dir_.path() / "sim_mm.var.tmp");
+  ASSERT_EQ(start(ini), "");
+  ready();
+  const json g10 = mdi("G10 L2 P1 X5");
+  ASSERT_TRUE(g10.contains("result")) << g10.dump();
+  EXPECT_EQ(daemon_.stop(), 0);
+  EXPECT_EQ(slurp(victim), "precious\n");
+  EXPECT_TRUE(fs::is_symlink(dir_.path() / "sim_mm.var.tmp"));
+  EXPECT_FALSE(fs::is_symlink(dir_.path() / "sim_mm.var"));
+  EXPECT_EQ(parameter(dir_.path() / "sim_mm.var", 5221), 5);
+  // Nor is a temporary file left behind.
+  for (const auto& entry : fs::directory_iterator(dir_.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".sim_mm.var."), std::string::npos)
+        << entry.path();
+}
+
 }  // namespace
 }  // namespace cncd::test
