@@ -237,6 +237,8 @@ int main(int argc, char** argv) {
   // A configuration that loads must also be able to run here: its start-up code and the
   // places of its state files.
   auto problems = cncd::daemon::check_state_directories(config);
+  for (auto& problem : cncd::daemon::check_state_files(config))
+    problems.push_back(std::move(problem));
   for (auto& problem : cncd::pipeline::check_startup_code(config))
     problems.push_back(std::move(problem));
   if (!problems.empty()) return refuse(problems, options.ini);

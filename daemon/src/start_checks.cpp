@@ -1,13 +1,19 @@
 #include "start_checks.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string>
 
+#include "cncd/config/machine_config.hpp"
+#include "cncd/interp/interpreter.hpp"
+#include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/startup_code.hpp"
+#include "persist.hpp"
 
 namespace cncd::daemon {
 namespace {
@@ -38,6 +44,9 @@ std::optional<std::string> state_directory_problem(const config::MachineConfig& 
                ? state + " is not writable: " + why
                : "cannot create " + state + ": '" + existing.string() + "' is not writable: " + why;
   }
+  // A directory yet to be made may sit in /tmp (sticky): only its own ownership counts then.
+  if (auto unsafe = unsafe_state_directory(existing, existing != dir))
+    return state + ": " + *unsafe;
   return std::nullopt;
 }
 
@@ -52,10 +61,29 @@ std::optional<std::string> fixed_directory_problem(const fs::path& dir) {
   if (const std::string why = cannot_write_in(dir); !why.empty()) {
     return "directory '" + dir.string() + "' is not writable: " + why;
   }
-  return std::nullopt;
+  return unsafe_state_directory(dir, false);
 }
 
 }  // namespace
+
+std::optional<std::string> unsafe_state_directory(const fs::path& dir, bool sticky_will_do) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0) return std::nullopt;  // reported as missing elsewhere
+  char mode[8];
+  std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+  const bool sticky = (st.st_mode & S_ISVTX) != 0;
+  if ((st.st_mode & S_IWOTH) != 0 && !(sticky && sticky_will_do)) {
+    return "'" + dir.string() + "' can be written by every user (mode " + mode +
+           "): another user could plant a link or a file of their own among the state files; "
+           "remove that right (chmod o-w) or choose another directory";
+  }
+  if (!sticky_will_do && st.st_uid != ::geteuid() && st.st_uid != 0) {
+    return "'" + dir.string() + "' belongs to uid " + std::to_string(st.st_uid) +
+           ", neither cncd's user (uid " + std::to_string(::geteuid()) +
+           ") nor root: its owner could replace the state files";
+  }
+  return std::nullopt;
+}
 
 std::vector<config::Problem> check_state_directories(const config::MachineConfig& config) {
   struct StateFile {
@@ -83,6 +111,43 @@ std::vector<config::Problem> check_state_directories(const config::MachineConfig
       problem = fixed_directory_problem(f.file.parent_path());
     }
     if (problem) problems.push_back(pipeline::ini_problem(config, f.section, f.key, *problem));
+  }
+  return problems;
+}
+
+std::vector<JointRange> joint_ranges(const config::MachineConfig& config) {
+  std::vector<JointRange> ranges;
+  for (const auto& joint : config.joints)
+    ranges.push_back({joint.min_limit, joint.max_limit});
+  return ranges;
+}
+
+std::vector<config::Problem> check_state_files(const config::MachineConfig& config) {
+  std::vector<config::Problem> problems;
+  // One interpreter a file, so that each refusal is reported at its own key.
+  const auto refused = [&](const char* section, const char* key, bool parameters) {
+    interp::InterpOptions options = pipeline::interpreter_options(config);
+    options.parameter_file =
+        parameters ? config::state_file_to_read(config.parameter_file, config.parameter_file_seed)
+                   : "";
+    options.tool_table =
+        parameters ? "" : config::state_file_to_read(config.tool_table, config.tool_table_seed);
+    const interp::Interpreter interp(options);
+    if (const auto& error = interp.load_error()) {
+      // The readers name the file and line themselves.
+      problems.push_back(pipeline::ini_problem(
+          config, section, key,
+          error->message.rfind(error->file, 0) == 0 ? error->message : error->to_string()));
+    }
+  };
+  if (!config.parameter_file.empty()) refused("RS274NGC", "PARAMETER_FILE", true);
+  if (!config.tool_table.empty()) refused("EMCIO", "TOOL_TABLE", false);
+  if (!config.position_file.empty()) {
+    std::string error;
+    const auto file = config::state_file_to_read(config.position_file, config.position_file_seed);
+    if (!read_position_file(file, joint_ranges(config), error)) {
+      problems.push_back(pipeline::ini_problem(config, "TRAJ", "POSITION_FILE", error));
+    }
   }
   return problems;
 }

@@ -5,15 +5,13 @@
 #include <spdlog/spdlog.h>
 
 #include "persist.hpp"
+#include "start_checks.hpp"
 #include "task.hpp"
 
 namespace cncd::daemon {
 
 std::vector<JointRange> Task::joint_ranges() const {
-  std::vector<JointRange> ranges;
-  for (const auto& joint : config_.joints)
-    ranges.push_back({joint.min_limit, joint.max_limit});
-  return ranges;
+  return daemon::joint_ranges(config_);
 }
 
 namespace {

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -138,6 +139,57 @@ TEST_F(StartChecksTest, StateDirectoryThatIsNotWritableIsRefused) {
                  "[EMCIO] TOOL_TABLE: the state directory '" + state.string() +
                      "' (--state-dir) is not writable");
   chmod(state.c_str(), 0755);
+}
+
+// A directory any user may write to lets one of them plant a link where cncd writes, or a
+// parameter file of their own before cncd makes one.
+TEST_F(StartChecksTest, StateDirectoryEveryUserMayWriteIsRefused) {
+  const fs::path ini = copy_example_machine(dir_.path());
+  for (const mode_t mode : {0777, 01777}) {
+    const fs::path state = dir_.path() / ("open" + std::to_string(mode));
+    fs::create_directory(state);
+    ASSERT_EQ(chmod(state.c_str(), mode), 0);
+    char shown[8];
+    std::snprintf(shown, sizeof shown, "%04o", static_cast<unsigned>(mode));
+    expect_refused(ini, state,
+                   at(22) + "[RS274NGC] PARAMETER_FILE: the state directory '" + state.string() +
+                       "' (--state-dir): '" + state.string() +
+                       "' can be written by every user (mode " + shown + ")");
+  }
+  // A state directory still to be made inside /tmp-like sticky directory is cncd's own.
+  const fs::path sticky = dir_.path() / "sticky";
+  fs::create_directory(sticky);
+  ASSERT_EQ(chmod(sticky.c_str(), 01777), 0);
+  const auto r = check_config(ini, sticky / "state");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+}
+
+TEST_F(StartChecksTest, StateDirectoryOfAnotherUserIsRefused) {
+  if (geteuid() != 0) GTEST_SKIP() << "giving a directory to another user needs root";
+  const fs::path state = dir_.path() / "theirs";
+  fs::create_directory(state);
+  ASSERT_EQ(chown(state.c_str(), 65534, 65534), 0);
+  expect_refused(copy_example_machine(dir_.path()), state,
+                 "'" + state.string() +
+                     "' belongs to uid 65534, neither cncd's user (uid 0) nor "
+                     "root: its owner could replace the state files");
+}
+
+// --check-config reads the state files as the daemon does at start, and refuses what it
+// refuses, at the file's line.
+TEST_F(StartChecksTest, ParameterFileTheDaemonRefusesIsRefusedByCheckConfig) {
+  const fs::path ini = copy_example_machine(dir_.path());
+  std::ofstream(dir_.path() / "sim_mm.var", std::ios::trunc) << "5161 0\n5162 oops\n";
+  expect_refused(ini, dir_.path(),
+                 at(22) + "[RS274NGC] PARAMETER_FILE: " + (dir_.path() / "sim_mm.var").string() +
+                     ":2: '5162 oops' is not a parameter line (NUMBER VALUE)");
+}
+
+TEST_F(StartChecksTest, PositionFileTheDaemonRefusesIsRefusedByCheckConfig) {
+  const fs::path ini = copy_example_machine(dir_.path());
+  std::ofstream(dir_.path() / "sim_mm.position", std::ios::trunc) << "1\n2\nthree\n";
+  expect_refused(ini, dir_.path(),
+                 (dir_.path() / "sim_mm.position").string() + ":3: 'three' is not a position");
 }
 
 }  // namespace
