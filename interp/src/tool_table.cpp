@@ -1,13 +1,19 @@
 #include "tool_table.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstring>
 #include <fstream>
 
 #include "cncd/interp/stored_values.hpp"
 #include "failure.hpp"
 
 namespace cncd::interp {
+namespace {
+constexpr const char* kWordLetters = "TPXYZABCUVWDIJQ";
+constexpr const char* kWordList = "T P X Y Z A B C U V W D I J Q";
+}  // namespace
 
 std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -27,7 +33,9 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
       text.resize(semicolon);
     }
     bool has_tool = false;
+    bool has_word = false;
     std::size_t i = 0;
+    const std::string where = path.string() + ":" + std::to_string(line_number) + ": ";
     while (i < text.size()) {
       const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
       if (std::isspace(static_cast<unsigned char>(text[i]))) {
@@ -37,13 +45,22 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
       std::size_t end = i + 1;
       while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end])))
         ++end;
+      // Recognised before it is trusted: a file of something else (a parameter file, the old
+      // table of bare numbers) would otherwise load as an empty table.
+      if (std::strchr(kWordLetters, letter) == nullptr || letter == '\0') {
+        std::string word = text.substr(i, std::min<std::size_t>(end - i, 40));
+        for (char& c : word)
+          c = std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+        return where + "'" + word + "' is not a tool table word (" + kWordList + ")" +
+               (loaded.empty() ? ": is this a tool table?" : "");
+      }
+      has_word = true;
       double value = 0;
       const char* first = text.data() + i + 1;
       if (first < text.data() + end && *first == '+') ++first;
       const auto result = std::from_chars(first, text.data() + end, value);
       if (result.ec != std::errc() || result.ptr != text.data() + end) {
-        return path.string() + ":" + std::to_string(line_number) + ": bad value '" +
-               text.substr(i, end - i) + "'";
+        return where + "bad value '" + text.substr(i, end - i) + "'";
       }
       const char* axes = "XYZABCUVW";
       for (int axis = 0; axis < kAxes; ++axis) {
@@ -74,10 +91,9 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
       }
       i = end;
     }
-    if (!has_tool) continue;
-    if (auto problem = tool_entry_problem(entry)) {
-      return path.string() + ":" + std::to_string(line_number) + ": " + *problem;
-    }
+    if (!has_word) continue;
+    if (!has_tool) return where + "no T word: a tool line is 'T<number> P<pocket> ... ;comment'";
+    if (auto problem = tool_entry_problem(entry)) return where + *problem;
     loaded[entry.number] = entry;
   }
   tools_ = std::move(loaded);

@@ -185,6 +185,24 @@ TEST_F(StartChecksTest, ParameterFileTheDaemonRefusesIsRefusedByCheckConfig) {
                      ":2: '5162 oops' is not a parameter line (NUMBER VALUE)");
 }
 
+TEST_F(StartChecksTest, ToolTableOfBareNumbersIsRefusedAtItsLine) {
+  // LinuxCNC 2.4's table of bare numbers (pocket, length, diameter) is no table cncd reads: it
+  // must not load as an empty table.
+  const fs::path ini = copy_example_machine(dir_.path());
+  std::ofstream(dir_.path() / "sim_mm.tbl", std::ios::trunc)
+      << ";old table\n10 10 12.5 3.175\n11 11 20.0 6.35\n";
+  expect_refused(ini, dir_.path(),
+                 at(kToolTableLine) +
+                     "[EMCIO] TOOL_TABLE: " + (dir_.path() / "sim_mm.tbl").string() +
+                     ":2: '10' is not a tool table word (T P X Y Z A B C U V W D I J Q): is this "
+                     "a tool table?");
+  // Words of a tool line without its T.
+  std::ofstream(dir_.path() / "sim_mm.tbl", std::ios::trunc) << "T1 P1 D6 Z0\nP2 D3 Z10\n";
+  expect_refused(ini, dir_.path(),
+                 (dir_.path() / "sim_mm.tbl").string() +
+                     ":2: no T word: a tool line is 'T<number> P<pocket> ... ;comment'");
+}
+
 TEST_F(StartChecksTest, PositionFileTheDaemonRefusesIsRefusedByCheckConfig) {
   const fs::path ini = copy_example_machine(dir_.path());
   std::ofstream(dir_.path() / "sim_mm.position", std::ios::trunc) << "1\n2\nthree\n";
