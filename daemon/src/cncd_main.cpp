@@ -17,6 +17,7 @@
 #include "cncd/config/ini_file.hpp"
 #include "cncd/config/machine_config.hpp"
 #include "cncd/pipeline/startup_code.hpp"
+#include "instance_lock.hpp"
 #include "logging.hpp"
 #include "methods.hpp"
 #include "server.hpp"
@@ -31,6 +32,7 @@ namespace {
 
 constexpr int kExitUsage = 64;        // EX_USAGE
 constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE
+constexpr int kExitTempFail = 75;     // EX_TEMPFAIL: another daemon holds the machine
 
 void print_usage(std::FILE* out) {
   std::fprintf(out,
@@ -128,6 +130,21 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
     return kExitUnavailable;
   }
 
+  // Before anything is written or driven: one daemon a state directory and a bus.
+  InstanceLocks locks;
+  std::string lock_message;
+  switch (lock_instance(config, locks, lock_message)) {
+    case LockVerdict::taken:
+      break;
+    case LockVerdict::busy:
+      spdlog::critical("{}", lock_message);
+      return kExitTempFail;
+    case LockVerdict::refused:
+      spdlog::critical("{}", lock_message);
+      return cncd::config::kExitConfig;
+  }
+  for (const auto& warning : locks.warnings)
+    spdlog::warn("{}", warning);
   std::vector<StateNote> notes;
   if (const auto error = prepare_state_files(config, notes); !error.empty()) {
     spdlog::critical("{}", error);

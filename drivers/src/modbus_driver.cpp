@@ -3,12 +3,15 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <thread>
 
+#include "cncd/drivers/exclusive_lock.hpp"
 #include "ini_lookup.hpp"
 #include "modbus_bus.hpp"
 
@@ -362,6 +365,51 @@ bool ModbusDriver::fault_reason(char* out, std::size_t size) const noexcept {
 std::uint64_t ModbusDriver::bus_cycles(int index) const noexcept {
   if (index < 0 || static_cast<std::size_t>(index) >= slots_.size()) return 0;
   return slots_[static_cast<std::size_t>(index)].bus->cycles();
+}
+
+std::vector<BusLockFile> bus_lock_files(const config::MachineConfig& machine,
+                                        const std::filesystem::path& lock_dir) {
+  std::vector<BusLockFile> out;
+  if (!machine.ini) return out;
+  std::set<int> numbers;
+  IniLookup ini(machine);
+  for (std::size_t j = 0; j < machine.joints.size(); ++j) {
+    const std::string s = joint_section(static_cast<int>(j));
+    if (machine.joints[j].driver == "modbus" && ini.has(s, "MODBUS")) {
+      numbers.insert(static_cast<int>(ini.integer(s, "MODBUS")));
+    }
+  }
+  std::map<int, IoSettings> io_by_bus;
+  collect_io(machine, io_by_bus);
+  for (const auto& entry : io_by_bus)
+    numbers.insert(entry.first);
+  // A name safe as a file name, whatever HOST or DEVICE hold.
+  const auto file_name = [](std::string name) {
+    for (char& c : name) {
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != ':') c = '_';
+    }
+    return name;
+  };
+  for (const int number : numbers) {
+    if (!machine.ini->has_section("MODBUS_" + std::to_string(number))) continue;
+    IniLookup bus_ini(machine);
+    const BusSettings b = read_bus(bus_ini, number);
+    if (!bus_ini.error().empty()) continue;  // configure() reports it
+    if (b.rtu) {
+      std::error_code ec;
+      const auto device = std::filesystem::canonical(b.device, ec);
+      const std::string real = ec ? b.device : device.string();
+      out.push_back({"[" + b.section + "] (rtu " + b.device + ")",
+                     lock_dir / ("cncd-modbus-rtu-" +
+                                 file_name(real.substr(real.starts_with('/') ? 1 : 0)) + ".lock")});
+    } else {
+      const std::string place = b.host + ":" + std::to_string(b.port);
+      out.push_back({"[" + b.section + "] (tcp " + place + ")",
+                     lock_dir / ("cncd-modbus-tcp-" + file_name(b.host) + "-" +
+                                 std::to_string(b.port) + ".lock")});
+    }
+  }
+  return out;
 }
 
 }  // namespace cncd::drivers

@@ -86,6 +86,8 @@ class DaemonProcess {
   // The next start() leaves the state directory to the INI and the environment.
   void use_default_state_dir() { default_state_dir_ = true; }
   const std::string& socket() const { return socket_; }
+  // The running daemon's pid, or -1.
+  pid_t pid() const { return pid_; }
   std::string log() const;
 
  private:
