@@ -74,14 +74,14 @@ ExclusiveLock::Outcome ExclusiveLock::take(const std::filesystem::path& file, st
     error = std::string(what) + " '" + file.string() + "': " + std::strerror(errno);
     return Outcome::failed;
   };
-  // O_NONBLOCK: a FIFO planted in the lock's place must not hang the start.
-  int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK, 0644);
-  bool writable = true;
+  // Locked through a read-only descriptor, so that a daemon holding the lock does not keep
+  // the file system from being remounted read-only. O_NONBLOCK: a FIFO planted in the lock's
+  // place must not hang the start.
+  constexpr int kFlags = O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK;
+  int fd = ::open(file.c_str(), kFlags | O_CREAT, 0644);
   if (fd < 0 && (errno == EACCES || errno == EPERM)) {
-    // Another user's lock file in a shared directory (/run/lock): a read-only descriptor
-    // locks it as well, only the pid cannot be written.
-    fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
-    writable = false;
+    // Another user's lock file in a shared sticky directory (/run/lock, protected_regular).
+    fd = ::open(file.c_str(), kFlags);
   }
   if (fd < 0) return os_error("cannot open the lock file");
   struct stat st {};
@@ -101,14 +101,17 @@ ExclusiveLock::Outcome ExclusiveLock::take(const std::filesystem::path& file, st
     ::close(fd);
     return Outcome::busy;
   }
-  if (writable) {
+  // The pid for whoever is refused next. A lock file we may not write (another user's), or
+  // a full disk, leaves it out: the lock holds all the same, its holder then found in
+  // /proc/locks.
+  const int out = ::open(file.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+  if (out >= 0) {
     char text[32];
     const int n = std::snprintf(text, sizeof text, "%ld\n", static_cast<long>(::getpid()));
-    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, text, static_cast<std::size_t>(n), 0) != n) {
-      const Outcome outcome = os_error("cannot write the lock file");
-      ::close(fd);
-      return outcome;
+    if (::ftruncate(out, 0) == 0) {
+      [[maybe_unused]] const ssize_t written = ::pwrite(out, text, static_cast<std::size_t>(n), 0);
     }
+    ::close(out);
   }
   if (fd_ >= 0) ::close(fd_);
   fd_ = fd;

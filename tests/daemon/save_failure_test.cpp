@@ -24,7 +24,8 @@ class SaveFailureTest : public ::testing::Test {
     state_ = dir_.path() / "state";
     fs::create_directories(state_);
     // Room for the seeds, the marker and the position file, and a little more.
-    if (mount("tmpfs", state_.c_str(), "tmpfs", 0, "size=64k") != 0) {
+    // Mode 0755: a tmpfs is 1777 by default, a state directory cncd refuses.
+    if (mount("tmpfs", state_.c_str(), "tmpfs", 0, "size=64k,mode=0755") != 0) {
       GTEST_SKIP() << "cannot mount a tmpfs on " << state_ << ": " << std::strerror(errno);
     }
     mounted_ = true;
@@ -66,9 +67,9 @@ class SaveFailureTest : public ::testing::Test {
   // The files in the state directory that are neither the state files nor the filler: a
   // temporary file left behind.
   std::vector<std::string> strays() const {
-    const std::set<std::string> known = {"sim_mm.var",      "sim_mm.tbl",
-                                         "sim_mm.position", "sim_mm.position.running",
-                                         "filler",          "filler2"};
+    const std::set<std::string> known = {
+        "sim_mm.var", "sim_mm.tbl", "sim_mm.position", "sim_mm.position.running",
+        "cncd.lock",  "filler",     "filler2"};
     std::vector<std::string> out;
     for (const auto& entry : fs::directory_iterator(state_)) {
       if (!known.contains(entry.path().filename().string()))
