@@ -1,9 +1,12 @@
 #include "test_util.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -87,6 +90,18 @@ StepStats step_stats(const std::vector<VcdChange>& changes, int joint) {
     }
   }
   return s;
+}
+
+bool realtime_scheduling_permitted() {
+  // Asked on a thread of its own, which ends with its priority.
+  bool permitted = false;
+  std::thread probe([&permitted] {
+    sched_param param{};
+    param.sched_priority = sched_get_priority_min(SCHED_FIFO);
+    permitted = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  });
+  probe.join();
+  return permitted;
 }
 
 }  // namespace cncd::test

@@ -36,6 +36,14 @@ struct StepStats {
   std::int64_t direction_changes = 0;
 };
 
+// Whether this process may run a thread at SCHED_FIFO, as cncd's servo and bus threads ask
+// to: root, CAP_SYS_NICE or an RLIMIT_RTPRIO (LinuxCNC's installs grant one to its users).
+bool realtime_scheduling_permitted();
+// Why a test of a real-time deadline is skipped without it.
+inline constexpr const char* kNoRealtime =
+    "needs real-time scheduling (SCHED_FIFO: CAP_SYS_NICE or an rtprio limit): without it a "
+    "loaded machine delays cncd's threads past the deadline judged";
+
 // Step timing of joint `joint` ("j<joint>_step", "j<joint>_dir") in a recording.
 StepStats step_stats(const std::vector<VcdChange>& changes, int joint);
 
