@@ -112,6 +112,11 @@ double VfdServer::revolutions(std::int64_t now_ns) {
   return a.revolutions + f * (b.revolutions - a.revolutions);
 }
 
+std::vector<double> VfdServer::turning_points() {
+  std::lock_guard lock(mutex_);
+  return turns_;
+}
+
 double VfdServer::rpm(std::int64_t now_ns) {
   std::lock_guard lock(mutex_);
   advance(now_ns);
@@ -133,6 +138,11 @@ void VfdServer::advance(std::int64_t now) {
              : rpm_ < target_rpm_ ? std::min(target_rpm_, rpm_ + accel * dt)
                                   : std::max(target_rpm_, rpm_ - accel * dt);
       revolutions_ += 0.5 * (before + rpm_) / 60.0 * dt;
+      // Once a point: a shaft that rests, then turns back, turned back there.
+      const bool again = !turns_.empty() && std::abs(turns_.back() - revolutions_) < 1e-3;
+      if (((before != 0 && rpm_ == 0) || before * rpm_ < 0) && !again && turns_.size() < 64) {
+        turns_.push_back(revolutions_);
+      }
       model_ns_ += step;
       history_[history_head_] = Past{model_ns_, revolutions_};
       history_head_ = (history_head_ + 1) % history_.size();

@@ -81,6 +81,9 @@ class VfdServer {
   // a position register.
   double revolutions(std::int64_t now_ns);
   double rpm(std::int64_t now_ns);
+  // Where the shaft came to rest or turned back, in order (revolutions; the first 64): what
+  // a test reads of a move however late its own threads ran.
+  std::vector<double> turning_points();
 
  private:
   void serve();
@@ -108,6 +111,7 @@ class VfdServer {
   };
   std::vector<Past> history_ = std::vector<Past>(20000);
   std::size_t history_head_ = 0;
+  std::vector<double> turns_;
   std::size_t history_size_ = 0;
   std::atomic<bool> silent_{false};
   std::atomic<int> answered_{0};
