@@ -47,11 +47,13 @@ TEST(BusLock, TwoDaemonsOnOneModbusServerAreRefusedThoughTheirStateDirectoriesDi
             std::string::npos)
       << refused;
 
-  // Once the first has gone, the bus is free.
+  // Once the first has gone, the bus is free (another process object: a second that started
+  // against the lock must not be left running).
   EXPECT_EQ(first.stop(), 0) << first.log();
-  EXPECT_EQ(second.start(second_dir.path(), {"--ini", (second_dir.path() / "sim_mm.ini").string()}),
+  DaemonProcess after;
+  EXPECT_EQ(after.start(second_dir.path(), {"--ini", (second_dir.path() / "sim_mm.ini").string()}),
             "");
-  EXPECT_EQ(second.stop(), 0) << second.log();
+  EXPECT_EQ(after.stop(), 0) << after.log();
 }
 
 }  // namespace
