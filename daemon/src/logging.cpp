@@ -95,4 +95,24 @@ void init_logging(spdlog::level::level_enum level) {
   spdlog::set_default_logger(logger);
 }
 
+bool LogLimiter::log(spdlog::level::level_enum level, const std::string& text,
+                     Clock::time_point now) {
+  if (in_window_ == 0 || now - window_start_ >= period_) {
+    window_start_ = now;
+    in_window_ = 0;
+  }
+  if (in_window_ >= burst_) {
+    ++left_out_;
+    return false;
+  }
+  ++in_window_;
+  if (left_out_ > 0) {
+    spdlog::log(level, "{} ({} more like it left out)", text, left_out_);
+    left_out_ = 0;
+  } else {
+    spdlog::log(level, "{}", text);
+  }
+  return true;
+}
+
 }  // namespace cncd::daemon
