@@ -1,6 +1,7 @@
 #include "rpc.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <exception>
 #include <set>
 #include <string>
@@ -42,13 +43,18 @@ void RpcDispatcher::add(const std::string& method, Handler handler,
     param->min = range.min;
     param->max = range.max;
   }
-  handlers_.emplace(method, Entry{std::move(handler), std::move(bound)});
+  handlers_.emplace(method, Entry{std::move(handler), nullptr, std::move(bound)});
 }
 
 void RpcDispatcher::add(const std::string& method, SimpleHandler handler,
                         const std::vector<Range>& ranges) {
   add(
       method, [h = std::move(handler)](const json& params, Session&) { return h(params); }, ranges);
+}
+
+void RpcDispatcher::add_raw(const std::string& method, RawHandler handler) {
+  add(method, [](const json&, Session&) { return json(); });
+  handlers_.find(method)->second.raw = std::move(handler);
 }
 
 void RpcDispatcher::require_all_added() const {
@@ -92,27 +98,32 @@ bool nested_too_deep(const std::string& line) {
   return false;
 }
 
+std::string text_of(const json& value) {
+  return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 json error_response(const json& id, int code, const std::string& message) {
   return json{
       {"jsonrpc", "2.0"}, {"id", id}, {"error", RpcDispatcher::error_object(code, message)}};
 }
 }  // namespace
 
-std::optional<json> RpcDispatcher::handle_one(const json& request, Session& session,
-                                              const RepeatedKey* repeated) const {
+std::optional<std::string> RpcDispatcher::handle_one(const json& request, Session& session,
+                                                     const RepeatedKey* repeated) const {
   if (!request.is_object())
-    return error_response(nullptr, kInvalidRequest, "request must be an object");
+    return text_of(error_response(nullptr, kInvalidRequest, "request must be an object"));
   json id = nullptr;
   const bool notification = !request.contains("id");
   if (!notification && !(repeated != nullptr && repeated->id)) {
     id = request["id"];
     if (!(id.is_null() || id.is_string() || id.is_number())) {
-      return error_response(nullptr, kInvalidRequest, "id must be a string, a number or null");
+      return text_of(
+          error_response(nullptr, kInvalidRequest, "id must be a string, a number or null"));
     }
   }
-  auto reply_error = [&](int code, const std::string& message) -> std::optional<json> {
+  auto reply_error = [&](int code, const std::string& message) -> std::optional<std::string> {
     if (notification) return std::nullopt;
-    return error_response(id, code, message);
+    return text_of(error_response(id, code, message));
   };
   if (repeated != nullptr) {
     return reply_error(kInvalidRequest, "duplicate key " + quoted_text(repeated->key) +
@@ -141,8 +152,20 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
     return reply_error(kInvalidParams, *error);
   }
   const json& params = std::get<json>(checked);
+  // Also when the handler throws: a refused command may have changed the state on its way.
+  struct AfterCommand {
+    const std::function<void()>* hook;
+    ~AfterCommand() {
+      if (hook != nullptr && *hook) (*hook)();
+    }
+  } after{entry.spec.needs == Access::control ? &after_command_ : nullptr};
   try {
     session.defer_token = 0;
+    if (entry.raw) {
+      std::string result = entry.raw(params, session);
+      if (notification) return std::nullopt;
+      return R"({"id":)" + text_of(id) + R"(,"jsonrpc":"2.0","result":)" + result + "}";
+    }
     json result = entry.handler(params, session);
     if (session.defer_token != 0) {
       if (!notification) session.open_requests.emplace_back(session.defer_token, id);
@@ -150,7 +173,7 @@ std::optional<json> RpcDispatcher::handle_one(const json& request, Session& sess
       return std::nullopt;
     }
     if (notification) return std::nullopt;
-    return json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}};
+    return text_of(json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}});
   } catch (const RpcError& e) {
     return reply_error(e.code(), e.what());
   } catch (const TaskError& e) {
@@ -222,47 +245,82 @@ class RepeatFinder : public json::json_sax_t {
 
 }  // namespace
 
-std::optional<std::string> RpcDispatcher::handle_line(const std::string& line, Session& session,
-                                                      std::size_t* requests) const {
-  if (requests != nullptr) *requests = 1;
-  if (nested_too_deep(line)) {
-    return error_response(nullptr, kInvalidRequest,
-                          "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
-        .dump();
+RpcDispatcher::Line RpcDispatcher::begin_line(const std::string& text) const {
+  Line line;
+  if (nested_too_deep(text)) {
+    line.whole =
+        error_response(nullptr, kInvalidRequest,
+                       "request nested deeper than " + std::to_string(kMaxNesting) + " levels")
+            .dump();
+    return line;
   }
-  json request = json::parse(line, nullptr, /*allow_exceptions=*/false);
+  json request = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (request.is_discarded()) {
-    return error_response(nullptr, kParseError, "parse error: not valid JSON").dump();
+    line.whole = error_response(nullptr, kParseError, "parse error: not valid JSON").dump();
+    return line;
   }
   if (request.is_array()) {
-    if (request.empty()) return error_response(nullptr, kInvalidRequest, "empty batch").dump();
+    if (request.empty()) {
+      line.whole = error_response(nullptr, kInvalidRequest, "empty batch").dump();
+      return line;
+    }
     if (request.size() > kMaxBatch) {
-      return error_response(nullptr, kInvalidRequest,
-                            "a batch may hold at most " + std::to_string(kMaxBatch) + " requests")
-          .dump();
+      line.whole =
+          error_response(nullptr, kInvalidRequest,
+                         "a batch may hold at most " + std::to_string(kMaxBatch) + " requests")
+              .dump();
+      return line;
     }
   }
   RepeatFinder finder;
-  json::sax_parse(line, &finder);
-  const auto repeated = [&](std::size_t index) -> const RepeatedKey* {
-    const auto it = finder.repeats.find(index);
-    return it == finder.repeats.end() ? nullptr : &it->second;
-  };
-  if (request.is_array()) {
-    if (requests != nullptr) *requests = request.size();
-    json responses = json::array();
-    session.in_batch = true;
-    for (std::size_t i = 0; i < request.size(); ++i) {
-      if (auto response = handle_one(request[i], session, repeated(i)))
-        responses.push_back(std::move(*response));
-    }
-    session.in_batch = false;
-    if (responses.empty()) return std::nullopt;
-    return responses.dump(-1, ' ', false, json::error_handler_t::replace);
+  json::sax_parse(text, &finder);
+  line.repeats = std::move(finder.repeats);
+  line.batch = request.is_array();
+  if (line.batch) {
+    line.requests = std::move(request);
+  } else {
+    line.requests.push_back(std::move(request));
   }
-  auto response = handle_one(request, session, repeated(0));
-  if (!response) return std::nullopt;
-  return response->dump(-1, ' ', false, json::error_handler_t::replace);
+  return line;
+}
+
+bool RpcDispatcher::serve(Line& line, Session& session, std::size_t& budget) const {
+  if (line.whole) return true;
+  session.in_batch = line.batch;
+  bool first = true;
+  while (line.next < line.requests.size() && (first || budget > 0)) {
+    first = false;
+    const std::size_t i = line.next++;
+    const auto repeat = line.repeats.find(i);
+    auto response = handle_one(line.requests[i], session,
+                               repeat == line.repeats.end() ? nullptr : &repeat->second);
+    line.requests[i] = nullptr;  // served: its memory is not held until the batch ends
+    std::size_t cost = kRequestCost;
+    if (response) {
+      if (line.answered++ > 0) line.answers += ',';
+      line.answers += *response;
+      cost += response->size();
+    }
+    budget -= std::min(budget, cost);
+  }
+  session.in_batch = false;
+  return line.next >= line.requests.size();
+}
+
+std::optional<std::string> RpcDispatcher::answer(Line& line) {
+  if (line.whole) return std::move(*line.whole);
+  if (line.answered == 0) return std::nullopt;
+  if (line.batch) return "[" + line.answers + "]";
+  return std::move(line.answers);
+}
+
+std::optional<std::string> RpcDispatcher::handle_line(const std::string& text, Session& session,
+                                                      std::size_t* requests) const {
+  Line line = begin_line(text);
+  if (requests != nullptr) *requests = line.batch ? line.requests.size() : 1;
+  std::size_t unlimited = SIZE_MAX;
+  serve(line, session, unlimited);
+  return answer(line);
 }
 
 int rpc_code(TaskErrorKind kind) {

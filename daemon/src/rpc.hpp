@@ -33,6 +33,7 @@ enum RpcCode : int {
   kFileError = 1007,  // a file (tool table, parameter file) could not be written
   kFault = 1008,      // the machine did not do it: a drive, its feedback or the estop input
   kCancelled = 1009,  // cancelled before it finished (program.open: a newer open, an estop)
+  kTooManyConnections = 1010,  // refused at connect: the connection limits are reached
 };
 
 class RpcError : public std::runtime_error {
@@ -105,6 +106,12 @@ class RpcDispatcher {
   // parameter that is not a number: no method is served without its parameters declared.
   void add(const std::string& method, Handler handler, const std::vector<Range>& ranges = {});
   void add(const std::string& method, SimpleHandler handler, const std::vector<Range>& ranges = {});
+  // Calls `hook` after each request to a method that needs control access has been handled.
+  void after_command(std::function<void()> hook) { after_command_ = std::move(hook); }
+  // A method whose result the handler gives as serialized JSON: status.get hands out one
+  // serialization of the status to every request of a turn instead of copying and printing it.
+  using RawHandler = std::function<std::string(const nlohmann::json& params, Session& session)>;
+  void add_raw(const std::string& method, RawHandler handler);
   // Throws std::logic_error naming the methods of the table that have no handler.
   void require_all_added() const;
   // Handles one line of input from a caller. Returns the serialized response without newline,
@@ -113,24 +120,48 @@ class RpcDispatcher {
   std::optional<std::string> handle_line(const std::string& line, Session& session,
                                          std::size_t* requests = nullptr) const;
 
-  static nlohmann::json error_object(int code, const std::string& message);
-
   // The first key a request repeats in one of its objects; `id` when that request's own "id"
   // is among the repeated keys.
   struct RepeatedKey {
     std::string key;
     bool id = false;
   };
+  // A line being served, perhaps over several turns of the server: a batch is answered a few
+  // requests at a time, so that a batch of slow requests holds up no other connection.
+  struct Line {
+    nlohmann::json requests = nlohmann::json::array();  // a batch's requests, or the one
+    bool batch = false;
+    std::map<std::size_t, RepeatedKey> repeats;  // by request index
+    std::size_t next = 0;                        // the next request to serve
+    std::size_t answered = 0;
+    std::string answers;               // the answers so far, separated by commas
+    std::optional<std::string> whole;  // the answer to a line refused as a whole
+  };
+  // Parses a line; nothing of it is served yet.
+  Line begin_line(const std::string& text) const;
+  // What a request costs beyond its answer's bytes, in the same bytes: checking and
+  // dispatching it, which a batch of requests with short answers must pay too.
+  static constexpr std::size_t kRequestCost = 512;
+  // Serves the line's next requests, at least one, until the line is done or the requests have
+  // used up `budget` (lowered by their answers' bytes and kRequestCost each). True once the
+  // line is done.
+  bool serve(Line& line, Session& session, std::size_t& budget) const;
+  // The answer to a line that is done, without newline; nullopt when nothing is to be sent.
+  static std::optional<std::string> answer(Line& line);
+
+  static nlohmann::json error_object(int code, const std::string& message);
 
  private:
   struct Entry {
     Handler handler;
+    RawHandler raw;   // when set, serves the method instead of `handler`
     MethodSpec spec;  // with the ranges given to add()
   };
-  std::optional<nlohmann::json> handle_one(const nlohmann::json& request, Session& session,
-                                           const RepeatedKey* repeated) const;
+  std::optional<std::string> handle_one(const nlohmann::json& request, Session& session,
+                                        const RepeatedKey* repeated) const;
   std::map<std::string, MethodSpec, std::less<>> table_;
   std::map<std::string, Entry, std::less<>> handlers_;
+  std::function<void()> after_command_;
 };
 
 }  // namespace cncd::daemon
