@@ -169,6 +169,14 @@ constexpr std::array kKeys{
              "Group whose members may read status; empty: only root and CONTROL_GROUP"),
     text_key("CNCD", "CONTROL_GROUP", "",
              "Group whose members may command the machine; empty: only root"),
+    integer_key("CNCD", "MAX_CONNECTIONS", "1000", 2, 1000000, "",
+                "Most control socket connections kept at once; lowered to fit the process's "
+                "RLIMIT_NOFILE (less 32). Past it a new connection gets error 1010 and is closed"),
+    integer_key("CNCD", "MAX_CONNECTIONS_PER_USER", "128", 1, 1000000, "",
+                "Most connections one user may hold; root and cncd's own user have no such cap"),
+    integer_key("CNCD", "CONTROL_RESERVE", "8", 1, 1000000, "",
+                "Connections of MAX_CONNECTIONS that only root, cncd's own user and "
+                "CONTROL_GROUP may take, so that an estop can always connect"),
     integer_key("CNCD", "RT_PRIORITY", "80", 1, 99, "", "SCHED_FIFO priority of the servo thread"),
     integer_key("CNCD", "RT_CPU", "-1", -1, 1023, "",
                 "CPU the servo thread is pinned to; -1 = any"),

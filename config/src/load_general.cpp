@@ -134,6 +134,17 @@ void load_cncd(TypedReader& r, CncdConfig& cncd) {
   cncd.read_group = std::string(strip_trailing_comment(r.text("CNCD", "READ_GROUP").value_or("")));
   cncd.control_group =
       std::string(strip_trailing_comment(r.text("CNCD", "CONTROL_GROUP").value_or("")));
+  if (const auto v = r.integer("CNCD", "MAX_CONNECTIONS"))
+    cncd.max_connections = static_cast<int>(*v);
+  if (const auto v = r.integer("CNCD", "MAX_CONNECTIONS_PER_USER"))
+    cncd.max_connections_per_user = static_cast<int>(*v);
+  if (const auto v = r.integer("CNCD", "CONTROL_RESERVE"))
+    cncd.control_reserve = static_cast<int>(*v);
+  if (cncd.control_reserve >= cncd.max_connections) {
+    r.problem("CNCD", "CONTROL_RESERVE",
+              "must be less than MAX_CONNECTIONS (" + std::to_string(cncd.max_connections) +
+                  "): readers would get no connection at all");
+  }
   if (const auto v = r.integer("CNCD", "RT_PRIORITY")) cncd.rt_priority = static_cast<int>(*v);
   if (const auto v = r.integer("CNCD", "RT_CPU")) cncd.rt_cpu = static_cast<int>(*v);
   if (const auto v = r.choice("CNCD", "LOG_LEVEL")) {

@@ -209,8 +209,13 @@ struct IoConfig {
 
 struct CncdConfig {
   std::string socket_path = "/run/cncd/cncd.sock";
-  std::string read_group;          // empty: only root and the control group may connect
-  std::string control_group;       // empty: only root may command
+  std::string read_group;     // empty: only root and the control group may connect
+  std::string control_group;  // empty: only root may command
+  // Control socket connections: in all, per user (not root or cncd's own), and the part of
+  // the total kept for control peers.
+  int max_connections = 1000;
+  int max_connections_per_user = 128;
+  int control_reserve = 8;
   int rt_priority = 80;            // SCHED_FIFO priority of the servo thread
   int rt_cpu = -1;                 // CPU to pin the servo thread to, -1 = any
   std::string log_level = "info";  // trace|debug|info|warn|error|critical|off
