@@ -48,7 +48,7 @@ std::string make_access_policy(const std::string& read_group, const std::string&
   return error;
 }
 
-Access peer_access(int fd, const AccessPolicy& policy, std::string& who) {
+Access peer_access(int fd, const AccessPolicy& policy, std::string& who, uid_t* uid) {
   ucred cred{};
   socklen_t len = sizeof cred;
   if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) != 0) {
@@ -56,6 +56,7 @@ Access peer_access(int fd, const AccessPolicy& policy, std::string& who) {
     return Access::none;
   }
   who = "uid " + std::to_string(cred.uid) + " pid " + std::to_string(cred.pid);
+  if (uid != nullptr) *uid = cred.uid;
   if (cred.uid == 0 || cred.uid == policy.owner) return Access::control;
   std::vector<gid_t> groups = peer_groups(fd);
   groups.push_back(cred.gid);

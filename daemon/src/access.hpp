@@ -21,7 +21,8 @@ struct AccessPolicy {
 std::string make_access_policy(const std::string& read_group, const std::string& control_group,
                                AccessPolicy& policy);
 
-// The access of the peer on a connected socket; `who` describes the peer for messages.
-Access peer_access(int fd, const AccessPolicy& policy, std::string& who);
+// The access of the peer on a connected socket; `who` describes the peer for messages, and
+// `uid`, when given, receives its user id.
+Access peer_access(int fd, const AccessPolicy& policy, std::string& who, uid_t* uid = nullptr);
 
 }  // namespace cncd::daemon

@@ -176,11 +176,15 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
     spdlog::critical("cannot start motion: {}", error);
     return kExitUnavailable;
   }
+  StatusCache status([&task, &config] { return status_json(task.status(), config); });
   RpcDispatcher dispatcher;
-  register_methods(dispatcher, task, config, events, completions);
-  Server server(
-      dispatcher, policy, [&task, &config] { return status_json(task.status(), config); }, events,
-      completions);
+  register_methods(dispatcher, task, config, events, completions, &status);
+  // A command may change what the status shows: the next status.get sees its effect.
+  dispatcher.after_command([&status] { status.invalidate(); });
+  const ConnectionLimits limits{static_cast<std::size_t>(config.cncd.max_connections),
+                                static_cast<std::size_t>(config.cncd.max_connections_per_user),
+                                static_cast<std::size_t>(config.cncd.control_reserve)};
+  Server server(dispatcher, policy, status, events, completions, limits);
   std::string serving = socket_path;
   // Socket activation: systemd hands over the listening socket of cncd.socket.
   if (sd_listen_fds(1) == 1 &&
@@ -194,6 +198,8 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   }
   spdlog::info("cncd {} serving {} on {} (servo period {} ns)", cncd::kVersion,
                config.path.string(), serving, config.servo_period_ns);
+  spdlog::info("at most {} connections, {} of them kept for control, {} per user",
+               server.limits().total, server.limits().control_reserve, server.limits().per_user);
   sd_notify(0, "READY=1\nSTATUS=ready");
 
   // Fed only while the servo heartbeat advances (watchdog_gate.hpp).

@@ -56,7 +56,8 @@ void add_command(RpcDispatcher& dispatcher, Task& task, const char* method,
 }  // namespace
 
 void register_methods(RpcDispatcher& dispatcher, Task& task, const config::MachineConfig& config,
-                      const EventLog& events, Completions& completions) {
+                      const EventLog& events, Completions& completions,
+                      StatusCache* shared_status) {
   dispatcher.add("errors.list", [&events](const json& params) {
     const auto since = params.value("since", std::uint64_t{0});
     return json{{"last_seq", events.last_seq()}, {"events", events_json(events.since(since))}};
@@ -80,16 +81,26 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                   {"drivers", drivers},
                   {"servo_period_ns", config.servo_period_ns}}}};
   });
-  dispatcher.add("status.get", [&task, &config](const json& params) {
+  const auto selected = [](const json& params, const json& status) {
     const auto fields = field_list(params);
-    const json status = status_json(task.status(), config);
-    if (fields.empty()) return status;
     check_fields(fields, status);
     json out = json::object();
     for (const auto& f : fields)
       out[f] = status[f];
     return out;
-  });
+  };
+  if (shared_status != nullptr) {
+    dispatcher.add_raw("status.get", [selected, cache = shared_status](const json& params,
+                                                                       Session&) {
+      if (!params.contains("fields") || params["fields"].empty()) return cache->text();
+      return selected(params, cache->get()).dump(-1, ' ', false, json::error_handler_t::replace);
+    });
+  } else {
+    dispatcher.add("status.get", [selected, &task, &config](const json& params) {
+      const json status = status_json(task.status(), config);
+      return field_list(params).empty() ? status : selected(params, status);
+    });
+  }
   dispatcher.add("status.subscribe",
                  [&task, &config](const json& params, Session& session) {
                    const int interval = params.value("interval_ms", 100);

@@ -2,19 +2,20 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <string_view>
 
 #include <spdlog/spdlog.h>
-
-#include "status_json.hpp"
 
 namespace cncd::daemon {
 namespace {
@@ -31,19 +32,48 @@ bool fill_address(const std::string& path, sockaddr_un& addr) {
   return true;
 }
 
+// The methods that stop the machine, as a request names them (with the quotes: a string
+// elsewhere in a line that merely holds these words only makes the line be served early).
+constexpr std::array<std::string_view, 5> kStops = {"\"machine.estop\"", "\"machine.off\"",
+                                                    "\"jog.stop\"", "\"program.pause\"",
+                                                    "\"program.abort\""};
+constexpr std::size_t kLongestStop = 15;
+
+// The configured limits, lowered to fit the descriptors this process may open.
+ConnectionLimits fit_limits(ConnectionLimits limits) {
+  rlimit files{};
+  if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur != RLIM_INFINITY) {
+    const auto room = files.rlim_cur > Server::kDescriptorHeadroom + 2
+                          ? static_cast<std::size_t>(files.rlim_cur) - Server::kDescriptorHeadroom
+                          : std::size_t{2};
+    if (limits.total > room) {
+      spdlog::warn("MAX_CONNECTIONS {} lowered to {} to fit RLIMIT_NOFILE {}", limits.total, room,
+                   files.rlim_cur);
+      limits.total = room;
+    }
+  }
+  limits.control_reserve = std::min(limits.control_reserve, limits.total - 1);
+  return limits;
+}
+
 }  // namespace
 
-Server::Server(const RpcDispatcher& dispatcher, AccessPolicy policy,
-               std::function<nlohmann::json()> status, const EventLog& events,
-               Completions& completions)
+Server::Server(const RpcDispatcher& dispatcher, AccessPolicy policy, StatusCache& status,
+               const EventLog& events, Completions& completions, ConnectionLimits limits)
     : dispatcher_(dispatcher),
       policy_(policy),
-      status_(std::move(status)),
+      status_(status),
       events_(events),
-      completions_(completions) {}
+      completions_(completions),
+      limits_(fit_limits(limits)),
+      spare_fd_(::open("/dev/null", O_RDONLY | O_CLOEXEC)),
+      accept_log_(std::chrono::minutes(1), 5),
+      refusal_log_(std::chrono::minutes(1), 10),
+      client_log_(std::chrono::minutes(1), 10) {}
 
 Server::~Server() {
   close();
+  if (spare_fd_ >= 0) ::close(spare_fd_);
 }
 
 void Server::adopt(int listen_fd) {
@@ -112,43 +142,11 @@ void Server::close() {
   }
 }
 
-void Server::accept_clients() {
-  for (;;) {
-    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (fd < 0) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-        spdlog::warn("accept on control socket failed: {}", errno_text());
-      }
-      return;
-    }
-    std::string who;
-    const Access access = peer_access(fd, policy_, who);
-    if (access == Access::none) {
-      // Refused with a reason; the socket is non-blocking and the reply small, so a single
-      // send either fits or the peer was not listening anyway.
-      const nlohmann::json refusal = {
-          {"jsonrpc", "2.0"},
-          {"id", nullptr},
-          {"error",
-           RpcDispatcher::error_object(
-               kPermissionDenied, "permission denied: " + who +
-                                      " is neither root nor in cncd's read or control group")}};
-      const std::string line = refusal.dump() + "\n";
-      [[maybe_unused]] const ssize_t n = ::send(fd, line.data(), line.size(), MSG_NOSIGNAL);
-      spdlog::info("control connection refused: {}", who);
-      ::close(fd);
-      continue;
-    }
-    Client client;
-    client.fd = fd;
-    client.session.access = access;
-    client.event_seq = events_.last_seq();
-    clients_.push_back(std::move(client));
-  }
-}
-
 void Server::drop(Client& client) {
   client.in.clear();
+  client.complete = 0;
+  client.stop_scanned = 0;
+  client.line.reset();
   client.out.clear();
   client.session.open_requests.clear();
   client.closing = true;
@@ -159,16 +157,19 @@ void Server::stop_reading(Client& client) {
   client.close_by = Clock::now() + kCloseGrace;
 }
 
-bool Server::has_pending_line(const Client& client) {
-  return client.in.find('\n') != std::string::npos;
+// Lines are read ahead up to kReadAheadBytes, so that the stops among them are seen however
+// much the connection has queued; an unfinished line is read on to its end.
+bool Server::wants_input(const Client& client) {
+  return !client.closing && (client.complete == 0 || client.in.size() < kReadAheadBytes);
 }
 
-// Reads until a complete line is in: serve_lines() serves lines a few at a time, and what the
-// client sends meanwhile stays in the socket.
+bool Server::has_work(const Client& client) const {
+  return (client.line || client.complete > 0) && client.out.size() <= kMaxBacklogBytes;
+}
+
 void Server::read_client(Client& client) {
   char buffer[65536];
-  bool line_complete = has_pending_line(client);
-  while (!line_complete) {
+  while (wants_input(client)) {
     const ssize_t n = ::read(client.fd, buffer, sizeof buffer);
     if (n == 0) {
       // A peer that only shut down its sending side (as socat and nc -N do) still gets the
@@ -181,46 +182,101 @@ void Server::read_client(Client& client) {
       if (errno != EAGAIN && errno != EWOULDBLOCK) drop(client);
       return;
     }
-    client.in.append(buffer, static_cast<std::size_t>(n));
-    line_complete = std::memchr(buffer, '\n', static_cast<std::size_t>(n)) != nullptr;
-    if (!line_complete && client.in.size() > kMaxLineBytes) {
+    const auto size = static_cast<std::size_t>(n);
+    if (const void* last = memrchr(buffer, '\n', size)) {
+      client.complete =
+          client.in.size() + static_cast<std::size_t>(static_cast<const char*>(last) - buffer + 1);
+    }
+    client.in.append(buffer, size);
+    if (client.in.size() - client.complete > kMaxLineBytes) {
       nlohmann::json error = {
           {"jsonrpc", "2.0"},
           {"id", nullptr},
           {"error", RpcDispatcher::error_object(kRequestTooLarge, "request longer than 1 MiB")}};
       client.out += error.dump() + "\n";
-      client.in.clear();
+      client.in.resize(client.complete);
       stop_reading(client);
       return;
     }
   }
 }
 
-void Server::serve_lines(Client& client) {
+// The end (past its newline) of the last complete line of `in` that names a stop; 0 when none.
+std::size_t Server::stop_through(Client& client) {
+  if (client.complete == 0) return 0;
+  const std::size_t from =
+      client.stop_scanned > kLongestStop ? client.stop_scanned - kLongestStop : 0;
+  const std::string_view window = std::string_view(client.in).substr(from, client.complete - from);
+  std::size_t through = 0;
+  for (const auto stop : kStops) {
+    const std::size_t at = window.rfind(stop);
+    if (at != std::string_view::npos)
+      through = std::max(through, client.in.find('\n', from + at) + 1);
+  }
+  client.stop_scanned = client.complete;
+  return through;
+}
+
+// A stop from a control connection is served first, with what that connection sent before it
+// (its own requests keep their order), ahead of every other connection's work. A read-only
+// connection's lines cannot stop anything and get no precedence.
+void Server::serve_stops() {
+  for (auto& client : clients_) {
+    if (client.session.access != Access::control) continue;
+    if (const std::size_t through = stop_through(client); through > 0) {
+      std::size_t budget = 0;
+      serve_client(client, budget, through);
+    }
+  }
+}
+
+// The rest of the turn: connections in turn, from where the last turn's round ended, each up
+// to kClientBytesPerTurn until kTurnBytes are used.
+void Server::serve_turn() {
+  const std::size_t count = clients_.size();
+  std::size_t turn_left = kTurnBytes;
+  std::size_t k = 0;
+  for (; k < count && turn_left > 0; ++k) {
+    Client& client = clients_[(next_client_ + k) % count];
+    if (!has_work(client)) continue;
+    const std::size_t given = std::min(turn_left, kClientBytesPerTurn);
+    std::size_t budget = given;
+    serve_client(client, budget, 0);
+    turn_left -= given - budget;
+  }
+  next_client_ = count == 0 ? 0 : (next_client_ + k) % count;
+}
+
+void Server::serve_client(Client& client, std::size_t& budget, std::size_t through) {
   std::size_t start = 0;
-  // A batch counts as the requests it holds, so that batches get a client no more work done
-  // in a turn than single requests do.
-  std::size_t served = 0;
-  while (served < kRequestsPerTurn && client.out.size() <= kMaxBacklogBytes) {
-    const std::size_t newline = client.in.find('\n', start);
-    if (newline == std::string::npos) break;
-    std::string line = client.in.substr(start, newline - start);
-    start = newline + 1;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) {
-      ++served;
-      continue;
+  for (;;) {
+    const bool priority = start < through;
+    if (!priority && (budget == 0 || client.out.size() > kMaxBacklogBytes)) break;
+    if (!client.line) {
+      if (start >= client.complete) break;
+      const std::size_t newline = client.in.find('\n', start);
+      std::string text = client.in.substr(start, newline - start);
+      start = newline + 1;
+      if (!text.empty() && text.back() == '\r') text.pop_back();
+      if (text.find_first_not_of(" \t") == std::string::npos) continue;
+      budget -= std::min(budget, kParseCost * text.size());
+      client.line = dispatcher_.begin_line(text);
     }
     requests_handled_ = true;
-    std::size_t requests = 1;
-    auto response = dispatcher_.handle_line(line, client.session, &requests);
-    served += requests;
-    if (response) {
+    std::size_t unlimited = SIZE_MAX;
+    const bool done =
+        dispatcher_.serve(*client.line, client.session, priority ? unlimited : budget);
+    if (!done) break;
+    if (auto response = RpcDispatcher::answer(*client.line)) {
       client.out += *response;
       client.out += '\n';
     }
+    client.line.reset();
   }
   client.in.erase(0, start);
+  client.complete -= start;
+  client.stop_scanned -= std::min(client.stop_scanned, start);
+  if (client.in.empty() && client.in.capacity() > kReadAheadBytes) std::string().swap(client.in);
 }
 
 void Server::write_client(Client& client) {
@@ -234,7 +290,9 @@ void Server::write_client(Client& client) {
     client.out.erase(0, static_cast<std::size_t>(n));
   }
   if (client.out.size() > kMaxBacklogBytes) {
-    spdlog::warn("control client not reading: {} bytes unsent, disconnecting", client.out.size());
+    client_log_.log(spdlog::level::warn,
+                    "control client not reading: " + std::to_string(client.out.size()) +
+                        " bytes unsent, disconnecting");
     // What it never read is dropped; the reason is sent once it reads what the socket holds
     // (within kCloseGrace). The newline ends a line the last send may have cut.
     const nlohmann::json notice = {
@@ -247,142 +305,42 @@ void Server::write_client(Client& client) {
   }
 }
 
-nlohmann::json merge_diff(const nlohmann::json& before, const nlohmann::json& after) {
-  if (!before.is_object() || !after.is_object()) return after;
-  nlohmann::json patch = nlohmann::json::object();
-  for (const auto& [key, value] : after.items()) {
-    const auto old = before.find(key);
-    if (old == before.end()) {
-      patch[key] = value;
-    } else if (*old != value) {
-      patch[key] = value.is_object() && old->is_object() ? merge_diff(*old, value) : value;
-    }
-  }
-  return patch;
-}
-
-int Server::next_update_in_ms(Clock::time_point now) const {
-  int wait_ms = -1;
-  for (const auto& client : clients_) {
-    if (client.session.subscribe_interval_ms <= 0 || client.closing) continue;
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(client.next_update - now).count();
-    const int ms = left < 0 ? 0 : static_cast<int>(left);
-    wait_ms = wait_ms < 0 ? ms : std::min(wait_ms, ms);
-  }
-  return wait_ms;
-}
-
-void Server::push_updates(Clock::time_point now) {
-  nlohmann::json status;  // produced once, only when some client is due
-  for (auto& client : clients_) {
-    const int interval = client.session.subscribe_interval_ms;
-    if (interval <= 0) {
-      client.last_sent = nullptr;
-      continue;
-    }
-    // Besides the periodic check, a request that may have changed the state is followed at
-    // once by an update to every client whose interval has passed since its last one.
-    const auto period = std::chrono::milliseconds(interval);
-    const bool due =
-        now >= client.next_update || (requests_handled_ && now - client.last_update >= period);
-    if (client.closing || !due) continue;
-    client.next_update = now + period;
-    // A client still holding unsent output gets the changes coalesced into a later update.
-    if (!client.out.empty()) continue;
-    if (status.is_null()) status = status_();
-    nlohmann::json view;
-    if (client.session.fields.empty()) {
-      view = status;
-    } else {
-      view = nlohmann::json::object();
-      for (const auto& field : client.session.fields) {
-        if (const auto it = status.find(field); it != status.end()) view[field] = *it;
-      }
-    }
-    nlohmann::json changed = client.last_sent.is_null() ? view : merge_diff(client.last_sent, view);
-    if (changed.empty()) continue;
-    const auto wall = std::chrono::system_clock::now().time_since_epoch();
-    const nlohmann::json update = {{"jsonrpc", "2.0"},
-                                   {"method", "status.update"},
-                                   {"params",
-                                    {{"seq", ++client.update_seq},
-                                     {"time", std::chrono::duration<double>(wall).count()},
-                                     {"full", client.last_sent.is_null()},
-                                     {"changed", std::move(changed)}}}};
-    client.last_sent = std::move(view);
-    client.last_update = now;
-    client.out += update.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-    client.out += '\n';
-    write_client(client);
-  }
-}
-
-void Server::deliver_completions() {
-  for (auto& done : completions_.take()) {
-    for (auto& client : clients_) {
-      auto& open = client.session.open_requests;
-      const auto it = std::find_if(open.begin(), open.end(),
-                                   [&](const auto& entry) { return entry.first == done.token; });
-      if (it == open.end()) continue;
-      nlohmann::json response = {{"jsonrpc", "2.0"}, {"id", it->second}};
-      if (done.error_code == 0) {
-        response["result"] = std::move(done.result);
-      } else {
-        response["error"] = RpcDispatcher::error_object(done.error_code, done.error_message);
-      }
-      open.erase(it);
-      if (client.closing) client.close_by = Clock::now() + kCloseGrace;
-      client.out += response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-      client.out += '\n';
-      write_client(client);
-      break;
-    }
-  }
-}
-
-void Server::push_events() {
-  const std::uint64_t last = events_.last_seq();
-  for (auto& client : clients_) {
-    if (client.closing || client.event_seq >= last) continue;
-    for (const auto& event : events_.since(client.event_seq)) {
-      const nlohmann::json note = {
-          {"jsonrpc", "2.0"}, {"method", "event"}, {"params", event_json(event)}};
-      client.out += note.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-      client.out += '\n';
-    }
-    client.event_seq = last;
-    write_client(client);
-  }
-}
-
 void Server::poll_once(int timeout_ms, int extra_fd) {
   // Answers posted since the last call (program.abort at rest, mdi.execute done) go out now,
   // not after the wait.
   deliver_completions();
-  const int update_in = next_update_in_ms(Clock::now());
+  auto now = Clock::now();
+  const int update_in = next_update_in_ms(now);
   if (update_in >= 0 && update_in < timeout_ms) timeout_ms = update_in;
+  const bool listening = now >= listen_rests_until_;
+  if (!listening) {
+    const auto rest = std::chrono::ceil<std::chrono::milliseconds>(listen_rests_until_ - now);
+    timeout_ms = std::min<int>(timeout_ms, static_cast<int>(rest.count()));
+  }
   std::vector<pollfd> fds;
   fds.reserve(clients_.size() + 2);
-  fds.push_back({listen_fd_, POLLIN, 0});
+  fds.push_back({listening ? listen_fd_ : -1, POLLIN, 0});
   fds.push_back({extra_fd, POLLIN, 0});
   for (const auto& client : clients_) {
-    // A client with requests still to serve is not read from meanwhile: back-pressure.
-    const bool pending = has_pending_line(client);
-    if (pending) timeout_ms = 0;
-    short events = client.closing || pending ? 0 : POLLIN;
+    if (has_work(client)) timeout_ms = 0;
+    short events = wants_input(client) ? POLLIN : 0;
     if (!client.out.empty()) events |= POLLOUT;
     // Left out while it waits for a deferred answer: a hung-up peer would wake poll at once.
     fds.push_back({events != 0 ? client.fd : -1, events, 0});
   }
   const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
   const std::size_t known = clients_.size();
-  for (std::size_t i = 0; i < known; ++i) {
-    const short revents = ready > 0 ? fds[i + 2].revents : 0;
-    Client& client = clients_[i];
-    if ((fds[i + 2].events & POLLIN) && (revents & (POLLIN | POLLHUP | POLLERR)))
-      read_client(client);
-    serve_lines(client);
+  // Every connection's input is read before any is served, so that the stops among it are
+  // served first.
+  for (std::size_t i = 0; i < known && ready > 0; ++i) {
+    if ((fds[i + 2].events & POLLIN) && (fds[i + 2].revents & (POLLIN | POLLHUP | POLLERR)))
+      read_client(clients_[i]);
+  }
+  bound_input();
+  status_.invalidate();
+  serve_stops();
+  serve_turn();
+  for (auto& client : clients_) {
     if (!client.out.empty()) write_client(client);
   }
   if (ready > 0 && (fds[0].revents & POLLIN)) accept_clients();
@@ -390,10 +348,10 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   push_events();
   push_updates(Clock::now());
   requests_handled_ = false;
-  const auto now = Clock::now();
+  now = Clock::now();
   std::erase_if(clients_, [now](const Client& client) {
-    const bool done =
-        client.out.empty() && client.session.open_requests.empty() && !has_pending_line(client);
+    const bool done = client.out.empty() && client.session.open_requests.empty() &&
+                      client.complete == 0 && !client.line;
     if (client.closing && (done || (!client.out.empty() && now >= client.close_by))) {
       ::close(client.fd);
       return true;

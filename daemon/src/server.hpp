@@ -3,10 +3,12 @@
 // Single-threaded: every method runs on the thread that calls poll_once().
 #pragma once
 
+#include <sys/types.h>
+
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,30 +16,54 @@
 
 #include "access.hpp"
 #include "event_log.hpp"
+#include "logging.hpp"
 #include "rpc.hpp"
+#include "status_cache.hpp"
 
 namespace cncd::daemon {
+
+// How many connections cncd keeps ([CNCD] MAX_CONNECTIONS, MAX_CONNECTIONS_PER_USER,
+// CONTROL_RESERVE; docs/protocol.md).
+struct ConnectionLimits {
+  std::size_t total = 1000;
+  std::size_t per_user = 128;  // root and cncd's own user have no cap of their own
+  std::size_t control_reserve = 8;
+};
 
 class Server {
  public:
   using Clock = std::chrono::steady_clock;
   // Largest request line accepted; a longer one gets an error and the connection is closed.
   static constexpr std::size_t kMaxLineBytes = 1 << 20;
+  // Unfinished request lines kept across all connections; past it the connections with the
+  // longest ones are told so and closed.
+  static constexpr std::size_t kInputBudgetBytes = 16 << 20;
   // Unsent output past which a client that does not read is disconnected.
   static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
   static constexpr int kMinSubscribeIntervalMs = 10;
-  // Requests served from one client per loop turn (a batch's requests count one by one; the
-  // line that reaches the count is served whole), so that a burst from one client does not
-  // hold up the others.
-  static constexpr std::size_t kRequestsPerTurn = 32;
+  // Complete lines read ahead of serving from one connection; the rest waits in its socket.
+  static constexpr std::size_t kReadAheadBytes = 64 << 10;
+  // Work a connection gets per turn, and all connections together, in bytes of requests read
+  // and answers written: a turn stays short whatever clients send, and the stops read at its
+  // start are never far off.
+  static constexpr std::size_t kClientBytesPerTurn = 32 << 10;
+  static constexpr std::size_t kTurnBytes = 128 << 10;
+  // Parsing a request line costs this many bytes of the budget per byte of the line.
+  static constexpr std::size_t kParseCost = 4;
+  // Status updates sent per turn; due ones past it go out in the next turns.
+  static constexpr std::size_t kUpdatesPerTurn = 32;
   // How long a closing connection may take to read what is still owed to it.
   static constexpr std::chrono::seconds kCloseGrace{5};
+  // Descriptors kept below RLIMIT_NOFILE for everything but connections.
+  static constexpr std::size_t kDescriptorHeadroom = 32;
+  // How long the listening socket rests after accept() failed for want of descriptors.
+  static constexpr std::chrono::milliseconds kAcceptBackoff{100};
 
-  // `status` produces the full status object for subscriptions (called at most once a loop);
+  // `status` is the status object for status.get and subscriptions, made fresh each turn;
   // every entry added to `events` is pushed to every client as an "event" notification.
   // Answers posted to `completions` go to the clients whose requests are waiting for them.
-  Server(const RpcDispatcher& dispatcher, AccessPolicy policy,
-         std::function<nlohmann::json()> status, const EventLog& events, Completions& completions);
+  Server(const RpcDispatcher& dispatcher, AccessPolicy policy, StatusCache& status,
+         const EventLog& events, Completions& completions, ConnectionLimits limits = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -56,12 +82,19 @@ class Server {
   // Closes every connection and removes the socket file (when this server created it).
   void close();
   std::size_t client_count() const { return clients_.size(); }
+  // The connection limits in force: the configured ones, lowered to fit RLIMIT_NOFILE.
+  const ConnectionLimits& limits() const { return limits_; }
 
  private:
   struct Client {
     int fd = -1;
+    uid_t uid = 0;
+    bool capped = true;  // counts against the per-user cap
     Session session;
     std::string in;
+    std::size_t complete = 0;                 // bytes of `in` up to and including its last newline
+    std::size_t stop_scanned = 0;             // bytes of `in` already searched for a stop
+    std::optional<RpcDispatcher::Line> line;  // a line served in part
     std::string out;
     // Reads no more; closed once `out` is flushed and no deferred answer is owed, or when
     // `out` is still unsent at `close_by`.
@@ -73,14 +106,26 @@ class Server {
     std::uint64_t update_seq = 0;
     std::uint64_t event_seq = 0;  // last event pushed to this client
   };
+  // server_admit.cpp: who gets a connection, and how much unfinished input is kept.
   void accept_clients();
+  void admit(int fd);
+  void take_with_spare();
+  std::string refusal(Access access, uid_t uid, bool capped) const;
+  void bound_input();
   // The peer is gone or misbehaves: nothing more is sent to it.
   static void drop(Client& client);
   static void stop_reading(Client& client);
-  static bool has_pending_line(const Client& client);
+  static bool wants_input(const Client& client);
+  bool has_work(const Client& client) const;
   void read_client(Client& client);
-  void serve_lines(Client& client);
+  static std::size_t stop_through(Client& client);
+  void serve_stops();
+  void serve_turn();
+  // Serves the line in progress and the next ones while `budget` lasts, and those before
+  // `through` in `in` whatever the budget.
+  void serve_client(Client& client, std::size_t& budget, std::size_t through);
   void write_client(Client& client);
+  // server_push.cpp: what the server sends unasked.
   void push_updates(Clock::time_point now);
   void push_events();
   void deliver_completions();
@@ -88,13 +133,21 @@ class Server {
 
   const RpcDispatcher& dispatcher_;
   AccessPolicy policy_;
-  std::function<nlohmann::json()> status_;
+  StatusCache& status_;
   const EventLog& events_;
   Completions& completions_;
+  ConnectionLimits limits_;
   int listen_fd_ = -1;
+  int spare_fd_ = -1;  // given up to take a connection when descriptors run out
+  Clock::time_point listen_rests_until_;
   std::string path_;  // empty when the socket was handed over
   std::vector<Client> clients_;
-  bool requests_handled_ = false;  // a request was served in this poll_once
+  std::size_t next_client_ = 0;         // where the next turn's round starts
+  std::size_t next_update_client_ = 0;  // where the next turn's status updates start
+  bool requests_handled_ = false;       // a request was served in this poll_once
+  LogLimiter accept_log_;
+  LogLimiter refusal_log_;
+  LogLimiter client_log_;
 };
 
 // {"a":1,"b":{"c":2}} vs {"a":1,"b":{"c":3}} gives {"b":{"c":3}}: a JSON merge patch (RFC 7386)
