@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
 #include <string>
 #include <thread>
@@ -104,18 +105,34 @@ inline std::filesystem::path bench_dir(std::initializer_list<const char*> extens
   return dir;
 }
 
+// A program of `lines` lines of feed moves over a 200 x 150 mm field.
+inline void write_program(const std::filesystem::path& path, long lines) {
+  std::ofstream out(path);
+  out << "G21 G90 G94\n";
+  char line[64];
+  for (long i = 1; i < lines - 1; ++i) {
+    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f F3000\n", static_cast<double>(i % 200),
+                  static_cast<double>((i / 200) % 150));
+    out << line;
+  }
+  out << "M2\n";
+}
+
 // Starts cncd on `dir`/sim_mm.ini with `args` added to its command line; returns its pid.
+// $CNCD_BENCH_BINARY names another cncd to run (an older build, to compare).
 inline pid_t start_cncd(const std::filesystem::path& dir, const std::string& sock,
                         std::vector<std::string> args) {
   const std::string ini = (dir / "sim_mm.ini").string();
-  args.insert(args.begin(), {CNCD_BINARY, "--ini", ini, "--socket", sock});
+  const char* other = std::getenv("CNCD_BENCH_BINARY");
+  const std::string binary = other != nullptr && *other != '\0' ? other : CNCD_BINARY;
+  args.insert(args.begin(), {binary, "--ini", ini, "--socket", sock});
   std::vector<char*> argv;
   for (auto& arg : args)
     argv.push_back(arg.data());
   argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
-    execv(CNCD_BINARY, argv.data());
+    execv(argv[0], argv.data());
     _exit(127);
   }
   return pid;

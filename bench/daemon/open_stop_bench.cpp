@@ -62,17 +62,7 @@ int main(int argc, char** argv) {
     ini.replace(at + 1, ini.find('\n', at + 1) - at - 1, "PROGRAM_PREFIX = .");
   std::ofstream(dir / "sim_mm.ini") << ini;
   const fs::path program = dir / "big.ngc";
-  {
-    std::ofstream out(program);
-    out << "G21 G90 G94\n";
-    char line[64];
-    for (long i = 1; i < lines - 1; ++i) {
-      std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f F3000\n", static_cast<double>(i % 200),
-                    static_cast<double>((i / 200) % 150));
-      out << line;
-    }
-    out << "M2\n";
-  }
+  write_program(program, lines);
   const std::string sock = (dir / "cncd.sock").string();
   const pid_t pid = start_cncd(dir, sock, {"--state-dir", dir.string(), "--log-level", "error"});
   Conn control = connect_when_up(sock);
