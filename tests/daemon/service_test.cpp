@@ -97,7 +97,8 @@ TEST(SocketActivation, ServesTheHandedOverSocketAndLeavesItToSystemd) {
   if (pid == 0) {
     // As systemd does: the socket as fd 3, LISTEN_FDS and LISTEN_PID naming this process,
     // and the unit's StateDirectory= as $STATE_DIRECTORY.
-    if (dup2(listen_fd, 3) != 3) _exit(127);
+    // When the socket already is fd 3, dup2 keeps its close-on-exec flag: clear it.
+    if (dup2(listen_fd, 3) != 3 || fcntl(3, F_SETFD, 0) != 0) _exit(127);
     setenv("STATE_DIRECTORY", (dir.path() / "state").c_str(), 1);
     setenv("LISTEN_FDS", "1", 1);
     setenv("LISTEN_PID", std::to_string(getpid()).c_str(), 1);
