@@ -14,6 +14,7 @@
 #include "client.hpp"
 #include "client_checks.hpp"
 #include "daemon_process.hpp"
+#include "daemon_util.hpp"
 #include "test_util.hpp"
 #include "vfd_server.hpp"
 
@@ -22,7 +23,6 @@ namespace {
 
 using nlohmann::json;
 
-const std::string kExamples = std::string(CNCD_SOURCE_DIR) + "/config/examples/";
 const std::string kProgram = std::string(CNCD_SOURCE_DIR) + "/examples/g81_example1.ngc";
 
 // cncd-drive-sim on a free loopback port, stopped on destruction. It serves at real-time
@@ -85,38 +85,6 @@ class DriveSimProcess {
   int out_fd_ = -1;
 };
 
-json result(const json& response) {
-  EXPECT_TRUE(response.contains("result")) << response.dump();
-  return response.value("result", json());
-}
-
-// Polls status.get every few milliseconds until `done(status)` or `seconds` pass (a test
-// failure that shows the last status and the daemon's log); returns the last status.
-template <typename Done>
-json wait_for(daemon::Client& client, const DaemonProcess& daemon, int seconds, Done done) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
-  json s;
-  while (std::chrono::steady_clock::now() < deadline) {
-    s = result(client.call("status.get"));
-    if (done(s)) return s;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  ADD_FAILURE() << "condition not reached; last status: " << s.dump() << "\n" << daemon.log();
-  return s;
-}
-
-// Machine reset, on and homed, and at rest.
-void make_ready(daemon::Client& client, const DaemonProcess& daemon) {
-  result(client.call("machine.reset"));
-  result(client.call("machine.on"));
-  result(client.call("machine.home"));
-  wait_for(client, daemon, 60, [](const json& s) {
-    for (const auto& h : s["homed"])
-      if (!h.get<bool>()) return false;
-    return s["motion"] == "idle";
-  });
-}
-
 // Runs the example program on `ini` (already adapted) and returns the final status.
 json run_example(const TempDir& dir, const std::string& ini,
                  const std::string& program = kProgram) {
@@ -143,21 +111,6 @@ json run_example(const TempDir& dir, const std::string& ini,
   // A clean stop, so that the drivers close what they write (a recording's last transitions).
   EXPECT_EQ(daemon.stop(), 0) << daemon.log();
   return settled;
-}
-
-// The example INI with its files redirected into `dir`.
-std::string adapt(const TempDir& dir, const std::string& name,
-                  const std::vector<std::pair<std::string, std::string>>& replace) {
-  std::string text = relocate_example_ini(slurp(kExamples + name));
-  for (const auto& [from, to] : replace) {
-    auto at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    for (; at != std::string::npos; at = text.find(from, at + to.size()))
-      text.replace(at, from.size(), to);
-  }
-  dir.write("sim_mm.tbl", slurp(kExamples + "sim_mm.tbl"));
-  dir.write("sim_mm.var", slurp(kExamples + "sim_mm.var"));
-  return dir.write(name, text).string();
 }
 
 // The Modbus example pointed at the drive simulator on `port`, with the example's own
@@ -402,14 +355,8 @@ TEST(DriversEndToEnd, ARigidTapRunsOnAModbusServoSpindle) {
   VfdServer server(servo_spindle_map(), 3);
   ASSERT_EQ(server.start(), "");
   TempDir dir;
-  const std::string ini = adapt(
-      dir, "sim_mm.ini",
-      {{"[SPINDLE_0]\nDRIVER = sim\n",
-        "[MODBUS_1]\nTRANSPORT = tcp\nHOST = 127.0.0.1\nPORT = " + std::to_string(server.port()) +
-            "\nTIMEOUT_MS = 40\nUPDATE_PERIOD_MS = 5\n\n"
-            "[SPINDLE_0]\nDRIVER = modbus\nMODBUS = 1\nSLAVE = 3\nSPEED_SCALE = 0.1\n"
-            "POSITION_REGISTER = 10\nPOSITION_SCALE = 4096\n"},
-       {"ACCELERATION = 6000", "ACCELERATION = 3000"}});
+  const std::string ini =
+      modbus_spindle_ini(dir, server.port(), 5, "POSITION_REGISTER = 10\nPOSITION_SCALE = 4096\n");
   const std::string program = dir.write("tap.ngc",
                                         "G21 G90\nG0 X10 Y10 Z5\nM3 S300\nG33.1 Z-5 K1.25\n"
                                         "G1 X20 F600\nM5\nM2\n")
