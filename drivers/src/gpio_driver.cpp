@@ -85,6 +85,7 @@ void GpioDriver::write_io(const IoCommand& command) noexcept {
   block.spindle_enable = command.spindle.enable;
   block.spindle_reverse = command.spindle.reverse;
   block.spindle_rpm = command.spindle.rpm;
+  block.spindle_sequence = command.spindle.sequence;
   block.flood = command.flood;
   block.mist = command.mist;
   block.digital = command.digital;
@@ -110,6 +111,7 @@ void GpioDriver::read_io(IoFeedback& feedback) noexcept {
   fb.has_position = encoder_ != nullptr;
   fb.revolutions = encoder_ ? spindle_feedback_.revolutions : 0;
   fb.time_ns = encoder_ ? spindle_feedback_.time_ns : 0;
+  fb.acknowledged = spindle_feedback_.acknowledged;
 }
 
 void GpioDriver::set_output(const OutputLine& line, bool on) noexcept {
@@ -159,6 +161,7 @@ void GpioDriver::run_io(double dt, std::int64_t time_ns) noexcept {
   } else {
     state.rpm = std::abs(ramp_rpm_);
   }
+  state.acknowledged = io_.spindle_sequence;
   spindle_state_.store(state);
 }
 

@@ -362,6 +362,8 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
   const bool wrote =
       run == v.command_stop ? write_command() && write_speed() : write_speed() && write_command();
   if (!wrote) return errno != 0 && is_exception(errno);
+  // The drive has the command now: what is read from here on answers it.
+  const std::uint64_t reached = sp.sequence;
 
   std::uint16_t regs[8] = {};
   const auto read = [&](bool input, int first, int count) {
@@ -416,6 +418,7 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
 
   const std::int64_t now = monotonic_ns();
   io_last_.vfd_time_ns = now;
+  io_last_.vfd_acknowledged = reached;
   io_last_.vfd_status = status;
   io_last_.vfd_rpm = has_speed               ? raw_speed / v.speed_scale
                      : has_position          ? std::abs(io_last_.vfd_position.rps) * 60.0

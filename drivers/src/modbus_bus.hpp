@@ -110,6 +110,9 @@ struct IoReadback {
   std::uint16_t vfd_status = 0;
   bool vfd_fault = false;           // the fault bit, a refused reverse, or not running when told to
   SpindlePositionFit vfd_position;  // the shaft's motion at its last reading (valid: read)
+  // The spindle command (SpindleCommand::sequence) written, or found already there, before
+  // the reads of the VFD's last full answer.
+  std::uint64_t vfd_acknowledged = 0;
 };
 
 // Servo thread -> I/O thread.

@@ -338,6 +338,7 @@ void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
                   ((rb.vfd_status >> at_speed_bit_) & 1u) != 0;
     fb.fault = rb.vfd_fault;
     fb.stale = rb.vfd_time_ns == 0 || now - rb.vfd_time_ns > slot.stale_ns;
+    fb.acknowledged = rb.vfd_acknowledged;
     if (rb.vfd_position.valid) {
       // Where the shaft is now, not where it was when the bus last read it.
       fb.has_position = true;

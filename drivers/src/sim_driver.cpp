@@ -88,6 +88,7 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   spindle_command_ = SpindleCommand{};
   spindle_rpm_ = 0;
   spindle_revolutions_ = 0;
+  spindle_acknowledged_ = 0;
   return "";
 }
 
@@ -181,9 +182,12 @@ void SimDriver::simulate_spindle(IoFeedback& feedback) noexcept {
       spindle_rpm_ += target > spindle_rpm_ ? step : -step;
     }
     spindle_revolutions_ += (before + spindle_rpm_) * 0.5 / 60.0 * period_s_;
+    // This period ran with the command: its reading answers it.
+    spindle_acknowledged_ = c.sequence;
   }
   fb.rpm = std::abs(spindle_rpm_);
   fb.revolutions = spindle_revolutions_;
+  fb.acknowledged = spindle_acknowledged_;
 }
 
 void SimDriver::read_io(IoFeedback& feedback) noexcept {

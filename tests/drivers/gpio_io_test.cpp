@@ -190,6 +190,30 @@ TEST_F(GpioIo, WithoutAnEncoderTheSpeedIsTheRamp) {
   EXPECT_FALSE(fb.spindle.stale || fb.spindle.fault);
 }
 
+// The base thread's reading answers the spindle command it ran with: a command the base
+// thread has not taken yet is not acknowledged.
+TEST_F(GpioIo, AReadingAcknowledgesTheCommandTheBaseThreadRanWith) {
+  ASSERT_EQ(start([](config::MachineConfig& c) {
+              c.spindle.enable = gpio("10");
+              c.spindle.direction = gpio("11");
+              c.spindle.acceleration = 12000;
+            }),
+            "");
+  IoCommand c = m3(1200);
+  c.spindle.sequence = 3;
+  IoFeedback fb = servo_for(2, 0, c);
+  EXPECT_EQ(fb.spindle.acknowledged, 3u);
+  // Written, but no base period has run since: the reading is the old command's.
+  c.spindle.sequence = 4;
+  c.spindle.reverse = true;
+  driver_.write_io(c);
+  fb = IoFeedback{};
+  driver_.read_io(fb);
+  EXPECT_EQ(fb.spindle.acknowledged, 3u);
+  fb = servo(0, c);
+  EXPECT_EQ(fb.spindle.acknowledged, 4u);
+}
+
 TEST_F(GpioIo, AQuadratureEncoderGivesSpeedAndPosition) {
   ASSERT_EQ(start([](config::MachineConfig& c) {
               c.spindle.enable = gpio("10");

@@ -130,6 +130,39 @@ TEST_F(ModbusIo, GenericVfdRunsForwardReverseAndStops) {
   EXPECT_EQ(server_->writes(0), 4);
 }
 
+// Each reading says which spindle command the VFD had been written before it was read: the
+// first one after M4 S800 to a VFD turning forward at 1350 rpm shows its at-speed bit off, and
+// none before it claims the new command.
+TEST_F(ModbusIo, AVfdReadingAcknowledgesTheCommandWrittenBeforeIt) {
+  VfdMap map;
+  map.units_per_rpm = 0.1;
+  map.acceleration_rpm_s = 3000;
+  start_vfd(map, generic_spindle());
+  IoCommand forward = spindle(true, false, 1350);
+  forward.spindle.sequence = 1;
+  ASSERT_TRUE(servo_until(forward, [&] {
+    return feedback_.spindle.acknowledged == 1 && feedback_.spindle.at_speed;
+  })) << reason();
+  IoCommand reverse = spindle(true, true, 800);
+  reverse.spindle.sequence = 2;
+  bool first = true;
+  ASSERT_TRUE(servo_until(reverse, [&] {
+    if (feedback_.spindle.acknowledged < 2) return false;
+    if (first) {
+      first = false;
+      // The registers had the command before the reading was taken.
+      EXPECT_EQ(server_->holding(0), 2);
+      EXPECT_EQ(server_->holding(1), 80);
+      EXPECT_FALSE(feedback_.spindle.at_speed);
+    }
+    return feedback_.spindle.at_speed;
+  })) << reason();
+  EXPECT_FALSE(first);
+  const auto log = server_->at_speed_log();
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_DOUBLE_EQ(log[1].rpm, -800);
+}
+
 TEST_F(ModbusIo, AServoSpindlesPositionIsFollowedBetweenReadings) {
   // A servo spindle with a 16-bit position counter (it wraps every 16 revolutions), read every
   // 5 ms, ramping at 3000 rpm/s: up to 600 rpm, over to -600 and back to rest. Each servo

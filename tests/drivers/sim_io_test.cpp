@@ -62,6 +62,28 @@ TEST(SimSpindle, WithoutAccelerationItIsAtSpeedAtOnce) {
   EXPECT_DOUBLE_EQ(fb.spindle.rpm, 0);
 }
 
+// A reading answers the command the period it was taken in ran with, never a newer one;
+// while the feedback is stale nothing is simulated and nothing newer is answered.
+TEST(SimSpindle, AReadingAcknowledgesTheCommandItsPeriodRanWith) {
+  SimDriver sim;
+  ASSERT_EQ(sim.configure(machine(3000), {}), "");
+  IoCommand c = spindle(true, false, 1350);
+  c.spindle.sequence = 7;
+  IoFeedback fb;
+  sim.read_io(fb);
+  EXPECT_EQ(fb.spindle.acknowledged, 0u);  // no command yet
+  fb = run(sim, c, 1);
+  EXPECT_EQ(fb.spindle.acknowledged, 7u);
+  c.spindle.sequence = 8;
+  c.spindle.reverse = true;
+  sim.set_spindle_stale(true);
+  fb = run(sim, c, 5);
+  EXPECT_EQ(fb.spindle.acknowledged, 7u);
+  sim.set_spindle_stale(false);
+  fb = run(sim, c, 1);
+  EXPECT_EQ(fb.spindle.acknowledged, 8u);
+}
+
 TEST(SimSpindle, RampsAtItsAccelerationAndReversesThroughZero) {
   SimDriver sim;
   ASSERT_EQ(sim.configure(machine(1000), {}), "");  // 1000 rpm/s: 1 rpm per 1 ms period

@@ -123,8 +123,13 @@ double VfdServer::rpm(std::int64_t now_ns) {
   return rpm_;
 }
 
+std::vector<VfdServer::AtSpeed> VfdServer::at_speed_log() {
+  std::lock_guard lock(mutex_);
+  return at_speed_log_;
+}
+
 void VfdServer::advance(std::int64_t now) {
-  if (map_.position_register < 0) return;
+  if (!ramps()) return;
   if (model_ns_ == 0 || now <= model_ns_) {
     if (model_ns_ == 0) model_ns_ = now;
   } else {
@@ -149,6 +154,7 @@ void VfdServer::advance(std::int64_t now) {
       history_size_ = std::min(history_size_ + 1, history_.size());
     }
   }
+  if (map_.position_register < 0) return;
   modbus_mapping_t* m = as_mapping(mapping_);
   const auto counts = static_cast<std::int64_t>(std::floor(revolutions_ * map_.counts_per_rev));
   const auto word = static_cast<std::uint64_t>(counts);
@@ -171,8 +177,9 @@ void VfdServer::update_model() {
   // Without a shaft, the motor reaches the commanded speed at once; with one, it ramps.
   std::uint16_t speed = commanded;
   bool at_speed = running && speed > 0;
-  if (map_.position_register >= 0) {
-    target_rpm_ = (reverse ? -1.0 : 1.0) * commanded / map_.units_per_rpm;
+  const double target = (reverse ? -1.0 : 1.0) * commanded / map_.units_per_rpm;
+  if (ramps()) {
+    target_rpm_ = target;
     speed = static_cast<std::uint16_t>(std::lround(std::abs(rpm_) * map_.units_per_rpm));
     at_speed = running && commanded > 0 && rpm_ == target_rpm_;
   }
@@ -181,6 +188,12 @@ void VfdServer::update_model() {
   if (at_speed) status |= map_.at_speed_bits;
   if (running && reverse) status |= map_.reverse_bits;
   if (fault_) status |= map_.fault_bits;
+  if (at_speed && !at_speed_ && map_.at_speed_bits != 0) {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    at_speed_log_.push_back({ts.tv_sec * 1'000'000'000LL + ts.tv_nsec, target});
+  }
+  at_speed_ = at_speed;
   (map_.actual_speed_holding ? m->tab_registers
                              : m->tab_input_registers)[map_.actual_speed_register] = speed;
   (map_.status_holding ? m->tab_registers : m->tab_input_registers)[map_.status_register] = status;

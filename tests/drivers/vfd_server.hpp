@@ -33,7 +33,8 @@ struct VfdMap {
   // A servo spindle's shaft: a counter of position_width bits (two registers for 32, high word
   // first) in input registers (holding with position_holding), counts_per_rev a revolution;
   // -1 = none. The motor then turns in real time at up to acceleration_rpm_s (0: at once), the
-  // speed register in units_per_rpm.
+  // speed register in units_per_rpm. A drive without a position counter ramps alike when
+  // acceleration_rpm_s is given (its at-speed bit set once the speed is reached).
   int position_register = -1;
   bool position_holding = false;
   int position_width = 32;
@@ -84,11 +85,20 @@ class VfdServer {
   // Where the shaft came to rest or turned back, in order (revolutions; the first 64): what
   // a test reads of a move however late its own threads ran.
   std::vector<double> turning_points();
+  // Each time an answer first showed the at-speed bit: when (CLOCK_MONOTONIC) and at what
+  // speed (rpm, signed: negative in reverse).
+  struct AtSpeed {
+    std::int64_t time_ns = 0;
+    double rpm = 0;
+  };
+  std::vector<AtSpeed> at_speed_log();
 
  private:
   void serve();
   void update_model();             // with mutex_ held
   void advance(std::int64_t now);  // the shaft, up to `now`; with mutex_ held
+  // The motor ramps in real time (a position counter, or an acceleration given).
+  bool ramps() const { return map_.position_register >= 0 || map_.acceleration_rpm_s > 0; }
 
   VfdMap map_;
   int slave_;
@@ -104,6 +114,8 @@ class VfdServer {
   double rpm_ = 0;
   double revolutions_ = 0;
   std::int64_t model_ns_ = 0;  // 0: not yet started
+  bool at_speed_ = false;      // the at-speed bit of the last update
+  std::vector<AtSpeed> at_speed_log_;
   // Where the shaft was, every 100 us, for the last 2 s: a ring, newest at history_head_ - 1.
   struct Past {
     std::int64_t time_ns = 0;

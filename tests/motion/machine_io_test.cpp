@@ -37,6 +37,7 @@ class SpindleDrive final : public FakeDriver {
     }
     feedback.spindle.present = true;
     feedback.spindle.rpm = rpm_;
+    feedback.spindle.acknowledged = command_.spindle.sequence;
     feedback.spindle.fault = fault_.load();
     feedback.digital = inputs_.load();
     feedback.analog[0] = analog_.load();

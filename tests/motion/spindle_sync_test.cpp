@@ -328,11 +328,14 @@ class LateSpindle final : public FakeDriver {
   LateSpindle(std::size_t delay, bool dead) : FakeDriver("late"), delay_(delay), dead_(dead) {}
   void write_io(const drivers::IoCommand& command) noexcept override {
     told_.push_back(told_rps(command));  // test code
+    sequences_.push_back(command.spindle.sequence);
   }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
-    const double rps = dead_ || told_.size() <= delay_ ? 0.0 : told_[told_.size() - 1 - delay_];
+    const bool has = told_.size() > delay_;
+    const double rps = dead_ || !has ? 0.0 : told_[told_.size() - 1 - delay_];
     revolutions_ += rps * 0.001;
     feedback.spindle.present = true;
+    feedback.spindle.acknowledged = has ? sequences_[told_.size() - 1 - delay_] : 0;
     feedback.spindle.has_position = true;
     feedback.spindle.rpm = std::abs(rps) * 60;
     feedback.spindle.revolutions = revolutions_;
@@ -342,6 +345,7 @@ class LateSpindle final : public FakeDriver {
   std::size_t delay_;
   bool dead_;
   std::vector<double> told_;
+  std::vector<std::uint64_t> sequences_;
   double revolutions_ = 0;
 };
 
@@ -380,8 +384,12 @@ TEST_F(SpindleSyncTest, ASpindleThatRunsOnPastTheBottomStopsTheTap) {
 class JumpingSpindle final : public FakeDriver {
  public:
   explicit JumpingSpindle(double jump_at) : FakeDriver("jumping"), jump_at_(jump_at) {}
-  void write_io(const drivers::IoCommand& command) noexcept override { rps_ = told_rps(command); }
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    rps_ = told_rps(command);
+    sequence_ = command.spindle.sequence;
+  }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
+    feedback.spindle.acknowledged = sequence_;
     const double before = revolutions_;
     revolutions_ += rps_ * 0.001;
     if (before < jump_at_ && revolutions_ >= jump_at_) revolutions_ += 3;
@@ -393,6 +401,7 @@ class JumpingSpindle final : public FakeDriver {
 
  private:
   double jump_at_;
+  std::uint64_t sequence_ = 0;
   double rps_ = 0;
   double revolutions_ = 0;
 };
@@ -445,16 +454,22 @@ class BusSpindle final : public FakeDriver {
   }
   void write_io(const drivers::IoCommand& command) noexcept override {
     told_rpm_ = told_rps(command) * 60.0;
+    told_sequence_ = command.spindle.sequence;
   }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
     // This period's moment, in 0.1 ms steps of the shaft.
     for (int i = 0; i < 10; ++i) {
       const std::int64_t t = now_ + i * kMs / 10;
       const std::int64_t into = t % (update_ms_ * kMs);
-      if (into == 0) request_rpm_ = told_rpm_;  // the bus takes the command...
+      if (into == 0) {
+        // the bus takes the command...
+        request_rpm_ = told_rpm_;
+        request_sequence_ = told_sequence_;
+      }
       if (into == latency_ms_ * kMs) {
         // ... it reaches the drive, which reads its counter as it takes it
         target_rpm_ = request_rpm_;
+        acknowledged_ = request_sequence_;
         sampled_ = Reading{counts(), t};
       }
       if (into == 2 * latency_ms_ * kMs) tracker_.add(sampled_.raw, sampled_.time_ns);
@@ -467,6 +482,7 @@ class BusSpindle final : public FakeDriver {
     truth_ = revolutions_;
     feedback.spindle.present = true;
     feedback.spindle.rpm = std::abs(rpm_);
+    feedback.spindle.acknowledged = acknowledged_;
     feedback.spindle.has_position = tracker_.fit().valid;
     feedback.spindle.revolutions = tracker_.fit().at(now_, 200 * kMs);
     feedback.spindle.time_ns = now_;
@@ -495,6 +511,9 @@ class BusSpindle final : public FakeDriver {
   std::int64_t now_ = 0;
   double told_rpm_ = 0;
   double request_rpm_ = 0;
+  std::uint64_t told_sequence_ = 0;
+  std::uint64_t request_sequence_ = 0;
+  std::uint64_t acknowledged_ = 0;
   double target_rpm_ = 0;
   double rpm_ = 0;
   double revolutions_ = 0;
@@ -569,8 +588,12 @@ TEST_F(SpindleSyncTest, RigidTapStaysOnTheHelixOfASpindleOnAFieldBus) {
 class ClockSpindle final : public FakeDriver {
  public:
   explicit ClockSpindle(bool stamped) : FakeDriver("clock"), stamped_(stamped) {}
-  void write_io(const drivers::IoCommand& command) noexcept override { rps_ = told_rps(command); }
+  void write_io(const drivers::IoCommand& command) noexcept override {
+    rps_ = told_rps(command);
+    sequence_ = command.spindle.sequence;
+  }
   void read_io(drivers::IoFeedback& feedback) noexcept override {
+    feedback.spindle.acknowledged = sequence_;
     ++period_;
     const std::int64_t step = period_ % 200 == 0 ? 6'000'000 : period_ % 200 <= 5 ? 0 : 1'000'000;
     now_ += step;
@@ -584,6 +607,7 @@ class ClockSpindle final : public FakeDriver {
 
  private:
   bool stamped_;
+  std::uint64_t sequence_ = 0;
   std::int64_t period_ = 0;
   std::int64_t now_ = 1'000'000'000;
   double rps_ = 0;

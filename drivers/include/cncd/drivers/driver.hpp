@@ -63,6 +63,9 @@ struct SpindleCommand {
   bool enable = false;   // turning
   bool reverse = false;  // M4
   double rpm = 0;        // >= 0: the speed to turn at (override applied, within the limits)
+  // One more for every change of enable, reverse or rpm: the driver hands back the newest one
+  // that had reached the drive when it took a reading (SpindleFeedback::acknowledged).
+  std::uint64_t sequence = 0;
 };
 
 // The machine's outputs as the servo thread commands them each period. A driver writes the
@@ -92,6 +95,11 @@ struct SpindleFeedback {
   // How long a speed command takes to reach the spindle, on average (a field bus's update
   // period): commands already sent still turn it that long. 0: at once.
   std::int64_t command_delay_ns = 0;
+  // The newest command (SpindleCommand::sequence) that had reached the drive before this
+  // reading was taken: a Modbus drive's reading read after that command was written; the sim
+  // and gpio spindles' reading of a period run with it. A reading older than the command says
+  // nothing about whether the spindle has reached it.
+  std::uint64_t acknowledged = 0;
 };
 
 // The machine's inputs as the drivers report them each period; a driver fills in the signals

@@ -88,6 +88,7 @@ class GpioDriver final : public Driver {
     bool spindle_enable = false;
     bool spindle_reverse = false;
     double spindle_rpm = 0;
+    std::uint64_t spindle_sequence = 0;
     bool flood = false;
     bool mist = false;
     std::uint32_t digital = 0;
@@ -96,7 +97,8 @@ class GpioDriver final : public Driver {
   struct SpindleState {
     double rpm = 0;  // >= 0
     double revolutions = 0;
-    std::int64_t time_ns = 0;  // the base period that counted it
+    std::int64_t time_ns = 0;        // the base period that counted it
+    std::uint64_t acknowledged = 0;  // the spindle command that base period ran with
   };
   struct OutputLine {
     int output = -1;  // index into output_levels_, -1 = none

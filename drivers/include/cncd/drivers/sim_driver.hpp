@@ -135,6 +135,7 @@ class SimDriver final : public Driver {
   SpindleCommand spindle_command_{};
   double spindle_rpm_ = 0;  // signed: negative turns in reverse
   double spindle_revolutions_ = 0;
+  std::uint64_t spindle_acknowledged_ = 0;  // the command of the last period simulated
   // Servo thread only.
   std::array<double, kMaxJoints> commanded_{};
   std::array<double, kMaxJoints> position_{};

@@ -90,6 +90,12 @@ class MachineIo final : public ActionGate {
   // The commanded speed from the programmed one, the override and the limits.
   CNCD_RT void update_command() noexcept;
   CNCD_RT bool at_speed() const noexcept;
+  // What the drive is told: a change takes the next sequence number.
+  CNCD_RT void command_spindle(bool enable, bool reverse, double rpm) noexcept;
+  // This period's reading was taken after the latest spindle command reached the drive.
+  CNCD_RT bool acknowledged() const noexcept;
+  // Below this the spindle counts as at rest.
+  CNCD_RT double stopped_rpm() const noexcept;
   CNCD_RT bool wait_at_speed(bool first) noexcept;
   // The spindle has not reached its speed within AT_SPEED_TIMEOUT: the error take_error() gives.
   CNCD_RT void not_at_speed() noexcept;
@@ -134,6 +140,10 @@ class MachineIo final : public ActionGate {
   double elapsed_s_ = 0;
   double spindle_rps_ = 0;  // measured, signed
   std::uint64_t syncs_done_ = 0;
+  // The way the spindle was last told to turn (1, -1; 0: never), and whether a reversal is
+  // under way: told the other way, and not yet seen at rest or turning the new way.
+  int turning_ = 0;
+  bool reversing_ = false;
 };
 
 }  // namespace cncd::motion
