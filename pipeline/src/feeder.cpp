@@ -133,7 +133,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               add_stop_point();
               move.spindle_sync = motion::SpindleSync::thread;
               move.per_rev = per_rev_;
-              move.feed = per_rev_ * nominal_rpm() / 60.0;
+              move.feed = per_rev_ * nominal_rpm(end_[0]) / 60.0;
+              if (!unsupported && machine_ != nullptr) {
+                // G96 turns fastest at the end nearer the spindle's axis.
+                const double rpm = std::max(nominal_rpm(end_[0]), nominal_rpm(move.end[0]));
+                if (auto why = thread_too_fast(*machine_, end_, move.end, per_rev_, rpm,
+                                               spindle_direction, spindle_speed))
+                  unsupported = Unsupported{m.line, *why};
+              }
             } else {
               move.feed = feed_per_second();
               if (per_revolution_) move.feed_per_rev = tracker_.feed_per_minute();
@@ -152,7 +159,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             move.spindle_sync = motion::SpindleSync::tap;
             move.per_rev = per_rev_;
             move.retract_scale = c.scale;
-            move.feed = per_rev_ * nominal_rpm() / 60.0;
+            move.feed = per_rev_ * nominal_rpm(end_[0]) / 60.0;
             const motion::AxisPose start = end_;
             moving(move);
             // The tap ends where it started, the spindle turning as before: a feed move after
@@ -337,47 +344,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   pending.push_back(move);
 }
 
-std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine) {
-  const config::SpindleConfig& sp = machine.spindle;
-  // Without [SPINDLE_0] the spindle is ideal: its position is where its command took it.
-  if (!sp.present) return std::nullopt;
-  switch (sp.driver) {
-    case config::SpindleDriver::sim:
-      return std::nullopt;
-    case config::SpindleDriver::gpio:
-      if (sp.encoder_ppr > 0) return std::nullopt;
-      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
-             "position: [SPINDLE_0] has no encoder (ENCODER_A, ENCODER_B, ENCODER_PPR)";
-    case config::SpindleDriver::modbus:
-      if (sp.position_register >= 0) return std::nullopt;
-      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
-             "position: the Modbus spindle ([SPINDLE_0] DRIVER = modbus) has no "
-             "POSITION_REGISTER";
-    case config::SpindleDriver::none:
-      break;
-  }
-  return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs a spindle: [SPINDLE_0] "
-         "DRIVER = none";
-}
-
-std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine) {
-  const config::SpindleConfig& sp = machine.spindle;
-  if (!sp.present || sp.driver == config::SpindleDriver::none) return std::nullopt;
-  if (sp.max_reverse_velocity == 0) {
-    return "rigid tapping turns the spindle back out of the hole, and [SPINDLE_0] "
-           "MAX_REVERSE_VELOCITY = 0 forbids reverse";
-  }
-  if (sp.driver == config::SpindleDriver::modbus && sp.command_reverse == sp.command_stop) {
-    return "rigid tapping turns the spindle back out of the hole, and the Modbus spindle cannot "
-           "reverse ([SPINDLE_0] COMMAND_REVERSE = COMMAND_STOP)";
-  }
-  return std::nullopt;
-}
-
-double ProgramFeeder::nominal_rpm() const {
+double ProgramFeeder::nominal_rpm(double x) const {
   if (css_max_rpm_ <= 0) return spindle_speed;
   const motion::IoAction a = spindle_action();
-  const double radius = std::abs(end_[0] - a.css_x_origin);
+  const double radius = std::abs(x - a.css_x_origin);
   double rpm = radius > 1e-9 ? std::min(a.css_max_rpm, a.css_numerator / radius) : a.css_max_rpm;
   if (machine_ != nullptr && machine_->spindle.present)
     rpm = std::min(rpm, machine_->spindle.max_forward_velocity);
@@ -387,7 +357,7 @@ double ProgramFeeder::nominal_rpm() const {
 double ProgramFeeder::feed_per_second() const {
   const double f = tracker_.feed_per_minute();
   // G95: F per revolution at the programmed speed (the interpreter refuses it at S 0).
-  return (per_revolution_ ? f * nominal_rpm() : f) / 60.0;
+  return (per_revolution_ ? f * nominal_rpm(end_[0]) : f) / 60.0;
 }
 
 Drained ProgramFeeder::drain(MoveTarget& target) {

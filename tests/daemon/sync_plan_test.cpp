@@ -219,6 +219,38 @@ TEST_F(SyncPlan, AMachineWithoutTheSpindlesPositionRefusesSynchronizedMotion) {
       << r.err;
 }
 
+// K x S beyond an axis's MAX_VELOCITY: the thread would fall behind the spindle. A tap or a
+// G95 feed at the same speeds is no such problem: the tap drives the spindle no faster than
+// the axis follows, and a feed runs at the axis's limit.
+TEST_F(SyncPlan, AThreadTheAxisCannotFollowIsRefusedAtItsLineWithTheSpeeds) {
+  const auto check = [&](const std::string& name, const std::string& program) {
+    return run_command(
+        {CNCD_CHECK_BINARY, "--ini", ini_.string(), dir_.write(name, program).string()});
+  };
+  const auto fast = check("fast.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S6000\nG33 Z-10 K100\nM2\n");
+  EXPECT_EQ(fast.exit_status, 1);
+  EXPECT_NE(fast.err.find("fast.ngc:4: G33 at S6000 with 100 mm per revolution needs Z at 10000 "
+                          "mm/s; [AXIS_Z] MAX_VELOCITY is 100 mm/s: the thread would fall behind "
+                          "the spindle (at most 60 rpm at this pitch, or at most 1 mm per "
+                          "revolution at this speed)"),
+            std::string::npos)
+      << fast.err;
+  // A taper: X and Z share the path speed; X's share is over its 200 mm/s.
+  const auto taper = check("taper.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S3000\nG33 X50 Z2 K5\nM2\n");
+  EXPECT_EQ(taper.exit_status, 1);
+  EXPECT_NE(taper.err.find("taper.ngc:4: G33 at S3000 with 5 mm per revolution needs X at "),
+            std::string::npos)
+      << taper.err;
+  EXPECT_NE(taper.err.find("[AXIS_X] MAX_VELOCITY is 200 mm/s"), std::string::npos) << taper.err;
+  // Within the limit (1.5 mm x 60 rev/s = 90 mm/s), it passes.
+  const auto ok = check("ok.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S3600\nG33 Z-10 K1.5\nM2\n");
+  EXPECT_EQ(ok.exit_status, 0) << ok.err;
+  const auto tap = check("tap.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S6000\nG33.1 Z-10 K2\nM2\n");
+  EXPECT_EQ(tap.exit_status, 0) << tap.err;
+  const auto g95 = check("g95.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S6000\nG95 G1 Z-10 F2\nM2\n");
+  EXPECT_EQ(g95.exit_status, 0) << g95.err;
+}
+
 TEST_F(SyncPlan, ASpindleThatCannotReverseRefusesRigidTappingButThreads) {
   std::string ini;
   {

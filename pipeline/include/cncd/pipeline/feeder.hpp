@@ -48,6 +48,14 @@ struct HoldInfo {
 std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine);
 // Why `machine` cannot tap rigidly (its spindle cannot reverse), or nothing.
 std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine);
+// Why `machine`'s axes cannot follow a thread (G33) from `start` to `end` (machine
+// coordinates) of `per_rev` machine units a revolution with the spindle at `rpm` (the speed
+// it is commanded at 100 % spindle override; `programmed` is the S word, `direction` M3 1 or
+// M4 -1), or nothing.
+std::optional<std::string> thread_too_fast(const config::MachineConfig& machine,
+                                           const motion::AxisPose& start,
+                                           const motion::AxisPose& end, double per_rev, double rpm,
+                                           int direction, double programmed);
 
 class ProgramFeeder final : public interp::CanonSink {
  public:
@@ -135,9 +143,9 @@ class ProgramFeeder final : public interp::CanonSink {
   // The feed of the next feed move, machine units per second: F, or under G95 F per revolution
   // times the programmed spindle speed.
   double feed_per_second() const;
-  // The spindle's speed as programmed (rpm): S, or under G96 the speed at the X the last move
-  // ends at, within D.
-  double nominal_rpm() const;
+  // The spindle's speed as programmed (rpm): S, or under G96 the speed at `x` (machine
+  // coordinates), within D.
+  double nominal_rpm(double x) const;
   bool per_revolution_ = false;  // G95
   // Between START_SPEED_FEED_SYNCH and its stop: machine units per revolution (0: none).
   double per_rev_ = 0;
