@@ -154,7 +154,16 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     return ok();
   });
   add_command(dispatcher, task, "program.step", &Task::step);
-  add_command(dispatcher, task, "program.pause", &Task::pause);
+  dispatcher.add("program.pause", [&task](const json&) {
+    const PauseWaitReport wait = task.pause();
+    json answer = ok();
+    if (!wait.kind.empty()) {
+      answer["waits_for"] = wait.kind;
+      answer["line"] = wait.line;
+      answer["message"] = wait.message;
+    }
+    return answer;
+  });
   add_command(dispatcher, task, "program.resume", &Task::resume);
   dispatcher.add("tool.change_done", [&task](const json& params) {
     task.tool_change_done(params["tool"].get<int>());

@@ -173,6 +173,10 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
                                           {"phase", s.sync.phase},
                                           {"per_rev", s.sync.per_rev},
                                           {"progress", s.sync.progress}}},
+      {"pause_wait", s.pause_wait.kind.empty() ? json(nullptr)
+                                               : json{{"kind", s.pause_wait.kind},
+                                                      {"line", s.pause_wait.line},
+                                                      {"message", s.pause_wait.message}}},
       {"tool",
        {{"number", s.tool.number},
         {"prepared", s.tool.prepared},

@@ -228,11 +228,14 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   skip_to_line_ = 0;
 }
 
-void Task::pause() {
+PauseWaitReport Task::pause() {
   if (exec_ != ExecState::running)
     throw TaskError(TaskErrorKind::wrong_state, "no program is running");
   motion_.pause();
   set_exec(ExecState::paused);
+  // As the servo thread last published: a synchronized move under way then runs to its end.
+  const auto status = motion_.status();
+  return pause_wait_report(status.sync, status.line);
 }
 
 void Task::resume() {

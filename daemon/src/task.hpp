@@ -71,7 +71,8 @@ class Task {
   void run_program(int from_line = 0, bool step = false);
   // Runs one more line of the program (from idle: the first), then pauses; resume runs on.
   void step();
-  void pause();
+  // The feed hold; what it waits for first (a thread's or a tap's end), if anything.
+  PauseWaitReport pause();
   void resume();
   // Stops under control; the answer under `token` (if not 0) is posted once at rest.
   void abort(std::uint64_t token = 0);

@@ -109,6 +109,16 @@ struct SyncReport {
   double progress = 0;  // revolutions from the move's start
 };
 
+// A feed hold that takes effect only once the move in step with the spindle under way has
+// ended: a thread or a tap is never left midway.
+struct PauseWaitReport {
+  std::string kind;  // "thread_end" | "tap_end" | "" (none)
+  int line = 0;      // the move's line
+  std::string message;
+};
+// What a feed hold waits for while `sync` is under way on `line` (none without one).
+PauseWaitReport pause_wait_report(const motion::SyncStatus& sync, int line);
+
 struct ToolReport {
   int number = 0;     // in the spindle, 0 = none
   int prepared = -1;  // -1 = none
@@ -149,6 +159,7 @@ struct TaskStatus {
   WaitReport wait;
   ProbeReport probe;
   SyncReport sync;
+  PauseWaitReport pause_wait;  // while a feed hold waits for a synchronized move's end
   ToolReport tool;
   ActiveOffsets offsets;
   std::vector<std::string> gcodes;  // active, in modal-group order: "G1", "G17" ...

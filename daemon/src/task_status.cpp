@@ -42,6 +42,23 @@ SyncReport sync_report(const motion::SyncStatus& sync) {
   out.progress = sync.progress;
   return out;
 }
+}  // namespace
+
+PauseWaitReport pause_wait_report(const motion::SyncStatus& sync, int line) {
+  PauseWaitReport out;
+  if (sync.mode == motion::SpindleSync::none) return out;
+  const bool tap = sync.mode == motion::SpindleSync::tap;
+  out.kind = tap ? "tap_end" : "thread_end";
+  out.line = line;
+  out.message = std::string("the feed hold takes effect once the ") +
+                (tap ? "tap (G33.1, rigid G84/G74) is back out of the hole"
+                     : "thread (G33) has reached its end") +
+                " (line " + std::to_string(line) + ")";
+  return out;
+}
+
+namespace {
+
 // Machine coordinates -> work coordinates, all in machine units: the inverse of LinuxCNC's
 // machine = rotate_xy(work + g92, rotation) + g5x + tool.
 motion::AxisPose work_pose(const motion::AxisPose& machine, const interp::InterpState& st) {
@@ -248,6 +265,7 @@ TaskStatus Task::status() const {
   if (sp.has_position) out.spindle.position = sp.revolutions;
   if (sp.css_numerator > 0) out.spindle.css_max_rpm = sp.css_max_rpm;
   out.sync = sync_report(s.sync);
+  if (s.motion == motion::MotionState::pausing) out.pause_wait = pause_wait_report(s.sync, s.line);
   out.mist = s.io.mist;
   out.flood = s.io.flood;
   out.io.douts = s.io.douts;

@@ -1,7 +1,8 @@
 // G33.1 and G33 through the real daemon on the example sim machine: status shows the tap's
 // phases while it runs, the tap ends where it started with the spindle turning forward again,
-// a feed hold lets the tap come out before the machine holds, and the next feed waits until
-// the spindle is back at speed.
+// a feed hold lets the tap come out before the machine holds (and one during a thread says it
+// waits for the thread's end), the next feed waits until the spindle is back at speed, and a
+// thread the axis cannot follow is refused at open.
 #include <set>
 #include <string>
 
@@ -80,6 +81,52 @@ TEST_F(SyncDaemon, ThreadRunsToItsEnd) {
   ASSERT_EQ(s["program"]["result"], "done") << s.dump();
   EXPECT_TRUE(following);
   EXPECT_NEAR(z(s), 20, 1e-9);
+}
+
+// A feed hold cannot stop a thread midway: the answer and status say that it takes effect at
+// the thread's end, and it does.
+TEST_F(SyncDaemon, FeedHoldDuringAThreadSaysItWaitsForTheThreadsEnd) {
+  ready_machine();
+  start_program("thread.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33 Z-40 K1.5\nG0 Z20\nM2\n");
+  wait_until([](const nlohmann::json& st) {
+    return !st["sync"].is_null() && st["sync"]["phase"] == "following" && z(st) < 0;
+  });
+  auto answer = result_of(call("program.pause"));  // not const: a missing key reads as null
+  EXPECT_EQ(answer["ok"], true);
+  EXPECT_EQ(answer["waits_for"], "thread_end") << answer.dump();
+  EXPECT_EQ(answer["line"], 4) << answer.dump();
+  EXPECT_NE(answer.value("message", "").find("thread (G33)"), std::string::npos) << answer.dump();
+  auto pausing = wait_until([](const nlohmann::json& st) {
+    return st["motion"] == "pausing" || st["motion"] == "paused";
+  });
+  if (pausing["motion"] == "pausing") {
+    EXPECT_EQ(pausing["pause_wait"]["kind"], "thread_end") << pausing.dump();
+    EXPECT_EQ(pausing["pause_wait"]["line"], 4);
+  }
+  auto held = wait_until([](const nlohmann::json& st) { return st["motion"] == "paused"; });
+  EXPECT_NEAR(z(held), -40, 1e-9);  // the thread ran to its end
+  EXPECT_TRUE(held["pause_wait"].is_null()) << held.dump();
+  result_of(call("program.resume"));
+  const auto s = wait_until([](const nlohmann::json& st) {
+    return st["exec"] == "idle" && st["program"]["result"] != "";
+  });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+}
+
+// A thread whose pitch at its speed is more than the axis can follow is refused at open.
+TEST_F(SyncDaemon, AThreadTheAxisCannotFollowIsRefusedAtOpen) {
+  ready_machine();
+  const auto program =
+      dir_.write("fast.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S6000\nG33 Z-10 K100\nM2\n");
+  const auto opened = call("program.open", {{"path", program.string()}});
+  ASSERT_TRUE(opened.contains("error")) << opened.dump();
+  EXPECT_EQ(opened["error"]["code"], 1003);
+  const std::string message = opened["error"].value("message", "");
+  EXPECT_NE(message.find("fast.ngc:4"), std::string::npos) << message;
+  EXPECT_NE(message.find("G33 at S6000 with 100 mm per revolution needs Z at 10000 mm/s; "
+                         "[AXIS_Z] MAX_VELOCITY is 100 mm/s"),
+            std::string::npos)
+      << message;
 }
 
 // G96: the spindle's speed follows X (program X0 the spindle's axis) within D; G97 turns at S.
