@@ -165,6 +165,9 @@ constexpr std::array kKeys{
     path_key("CNCD", "STATE_DIR", "",
              "Directory of the parameter, tool and position files given as relative paths; "
              "default $STATE_DIRECTORY under systemd, else $XDG_STATE_HOME/cncd/<INI name>"),
+    path_key("CNCD", "PROBE_DIR", "",
+             "Directory the (PROBEOPEN name) result files go to, relative to the state directory; "
+             "default probe/ in the state directory, created (mode 0750) when first needed"),
     text_key("CNCD", "READ_GROUP", "",
              "Group whose members may read status; empty: only root and CONTROL_GROUP"),
     text_key("CNCD", "CONTROL_GROUP", "",

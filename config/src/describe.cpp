@@ -192,6 +192,8 @@ std::string describe(const MachineConfig& c) {
   line(out, "Parameters:   " + state_file(c.parameter_file, c.parameter_file_seed));
   line(out, "Tool table:   " + state_file(c.tool_table, c.tool_table_seed));
   line(out, "Positions:    " + state_file(c.position_file, c.position_file_seed));
+  line(out, "Probe files:  " +
+                (c.cncd.probe_dir.empty() ? std::string("none") : c.cncd.probe_dir.string()));
   if (!c.startup_code.empty()) line(out, "Startup code: " + c.startup_code);
   line(out, std::string("Dialect:      ") +
                 (c.dialect == Dialect::numeryx ? "numeryx" : "linuxcnc") +

@@ -68,6 +68,13 @@ void load_state_files(TypedReader& r, MachineConfig& c, const LoadOptions& optio
   place(r, c, "RS274NGC", "PARAMETER_FILE", c.parameter_file, c.parameter_file_seed);
   place(r, c, "EMCIO", "TOOL_TABLE", c.tool_table, c.tool_table_seed);
   place(r, c, "TRAJ", "POSITION_FILE", c.position_file, c.position_file_seed);
+  const auto probe = r.text("CNCD", "PROBE_DIR");
+  const std::filesystem::path given = probe ? *probe : std::string();
+  if (given.is_absolute()) {
+    c.cncd.probe_dir = given.lexically_normal();
+  } else if (!c.cncd.state_dir.empty()) {
+    c.cncd.probe_dir = (c.cncd.state_dir / (given.empty() ? "probe" : given)).lexically_normal();
+  }
 }
 
 std::filesystem::path state_file_to_read(const std::filesystem::path& file,

@@ -55,7 +55,8 @@ Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& a
             events.add("info", "message", "line " + std::to_string(line) + ": " + text);
           },
           &config)),
-      interp_(std::make_unique<interp::Interpreter>(pipeline::interpreter_options(config))),
+      interp_(std::make_unique<interp::Interpreter>(
+          with_probe_writer(pipeline::interpreter_options(config), probe_writer_))),
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
@@ -143,7 +144,7 @@ void Task::run_program(int from_line, bool step) {
   const ProgramFile file = find_program(program_path_, config_.program_dirs);
   tool_at_start_ = interp_->state().tool_in_spindle;
   if (!file.error.empty()) throw TaskError(TaskErrorKind::program, file.error);
-  if (auto error = interp_->open(file.path)) {
+  if (auto error = interp_->open(file.path, program_subs_)) {
     throw TaskError(TaskErrorKind::program, error->to_string());
   }
   // The file may have been changed since it was opened.
@@ -376,6 +377,7 @@ void Task::poll() {
     abort_tokens_.clear();
   }
   confirm_machine_on(status);
+  poll_probe_file();
   if (exec_ == ExecState::idle) return;
   if (status.machine != motion::MachineState::on) {
     finish_program("aborted", status.fault_reason[0] != '\0' ? status.fault_reason

@@ -21,6 +21,7 @@
 #include "event_log.hpp"
 #include "persist.hpp"
 #include "plan_estimate.hpp"
+#include "probe_writer.hpp"
 #include "program_open.hpp"
 #include "task_outcome.hpp"
 #include "task_report.hpp"
@@ -135,6 +136,9 @@ class Task {
   // The holds the path waits in (task_io.cpp): a tool change waits for tool_change_done(), a
   // user M code runs and its end releases the path. Returns false when the run has ended.
   bool poll_holds(const motion::Status& status);
+  // A probe file line that could not be written ends the run with the error at its line
+  // (task_io.cpp); between runs it goes to the event log.
+  void poll_probe_file();
   // What the path waits for, in words (task_io.cpp).
   WaitReport wait_report(const motion::Status& status) const;
   // Answers the machine.on requests waiting for the drives (task_machine.cpp).
@@ -178,6 +182,8 @@ class Task {
   TaskAnswers& answers_;
   motion::MotionController motion_;
   std::unique_ptr<pipeline::ProgramFeeder> feeder_;
+  // Before interp_, which writes through it.
+  std::shared_ptr<QueuedProbeWriter> probe_writer_ = std::make_shared<QueuedProbeWriter>();
   std::unique_ptr<interp::Interpreter> interp_;
   std::vector<interp::ToolEntry> saved_tools_;  // the tool table as its file holds it
   std::vector<double> saved_parameters_;        // the persistent parameters as the file holds them
@@ -187,6 +193,7 @@ class Task {
   std::vector<std::uint64_t> abort_tokens_;
   std::string program_path_;
   std::uint64_t program_lines_ = 0;
+  std::shared_ptr<const interp::SubroutineIndex> program_subs_;  // of the open program
   // The dialect the open program is read in; with none open, the machine's (MDI's).
   interp::Dialect program_dialect_ = interp::Dialect::linuxcnc;
   bool interp_done_ = false;

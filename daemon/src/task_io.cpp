@@ -116,3 +116,18 @@ bool Task::poll_holds(const motion::Status& s) {
 }
 
 }  // namespace cncd::daemon
+
+namespace cncd::daemon {
+
+void Task::poll_probe_file() {
+  const auto error = probe_writer_->take_error();
+  if (!error) return;
+  if (exec_ == ExecState::idle) {
+    events_.add("error", "program", *error);
+    return;
+  }
+  motion_.abort();
+  finish_program("error", *error);
+}
+
+}  // namespace cncd::daemon

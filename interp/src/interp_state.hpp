@@ -227,6 +227,7 @@ struct Interpreter::Impl {
   // (PROBEOPEN name) and (PROBECLOSE); true when the comment was one of them.
   bool probe_file_comment(const std::string& text);
   void close_probe_file();
+  ProbeFileWriter& probe_writer();
   // Writes #5061-#5069 as a line of the open probe file; Failure when it cannot.
   void write_probe_line();
 
@@ -275,6 +276,7 @@ struct Interpreter::Impl {
   void do_call();
   void do_return(bool has_value, double value);
   void skip_block(const std::string& name, std::initializer_list<OKind> stops);
+  bool find_indexed_sub(const std::string& name, std::int64_t offset);
   bool find_sub(const std::string& name);
   void skip_loop_end(const ControlFrame& frame);
   std::string label_error(const char* what) const;
@@ -360,13 +362,12 @@ struct Interpreter::Impl {
     Units units = Units::mm;
   };
   StandaloneCanon standalone_;
-  // (PROBEOPEN name): the file the probe results go to, absolute. It is opened (and emptied)
-  // with the first result, so that a run without a machine (a check) leaves it as it was.
-  std::filesystem::path probe_path_;
-  struct FileCloser {
-    void operator()(std::FILE* file) const { std::fclose(file); }
-  };
-  std::unique_ptr<std::FILE, FileCloser> probe_file_;
+  // (PROBEOPEN name): the file the probe results go to. The writer opens (and empties) it with
+  // the first result, so that a run without a machine (a check) leaves it as it was.
+  std::optional<ProbeFileTarget> probe_target_;
+  bool probe_opened_ = false;
+  std::shared_ptr<ProbeFileWriter> probe_writer_;
+  std::shared_ptr<const SubroutineIndex> sub_index_;  // of the program file open()
   std::filesystem::path program_dir_;  // of the program file open(); empty for MDI and text
   double last_value_ = 0;              // #<_value>
   bool value_returned_ = false;        // #<_value_returned>

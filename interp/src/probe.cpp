@@ -1,8 +1,6 @@
 // G38.2-G38.5 straight probes with LinuxCNC's checks, the result the machine hands back (or,
 // without a machine, the one LinuxCNC's standalone interpreter makes up), and the probe file
 // of (PROBEOPEN name) / (PROBECLOSE).
-#include <unistd.h>
-
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -15,24 +13,6 @@
 #include "interp_state.hpp"
 
 namespace cncd::interp {
-namespace {
-
-// Why `path` could not be opened for writing, without creating or emptying it; empty if it
-// could. A check (cncd-check, the daemon's program.open) runs the program too, and must leave
-// the results of the last run alone.
-std::string open_problem(const std::filesystem::path& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (std::filesystem::is_directory(status)) return std::strerror(EISDIR);
-  if (std::filesystem::exists(status)) {
-    return ::access(path.c_str(), W_OK) == 0 ? std::string() : std::strerror(errno);
-  }
-  const auto dir = path.parent_path();
-  if (!std::filesystem::is_directory(dir, ec)) return std::strerror(ENOENT);
-  return ::access(dir.c_str(), W_OK | X_OK) == 0 ? std::string() : std::strerror(errno);
-}
-
-}  // namespace
 
 void Interpreter::Impl::do_probe(int code) {
   // cncd's own check first (LinuxCNC would probe at the last per-minute feed and ignore the
@@ -121,8 +101,8 @@ void Interpreter::Impl::track_standalone(const CanonOp& op) {
   }
 }
 
-// LinuxCNC's canon acts on these two comments (exactly so, in capitals); a relative name is
-// taken from the program's directory (cncd's choice: LinuxCNC's is its own working directory).
+// LinuxCNC's canon acts on these two comments (exactly so, in capitals). The name is a file
+// name in the probe directory (InterpOptions::probe_dir; without one, the program's directory).
 bool Interpreter::Impl::probe_file_comment(const std::string& text) {
   if (text.starts_with("PROBECLOSE")) {
     close_probe_file();
@@ -133,46 +113,58 @@ bool Interpreter::Impl::probe_file_comment(const std::string& text) {
   const std::size_t first = name.find_first_not_of(" \t");
   const std::size_t last = name.find_last_not_of(" \t");
   name = first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
-  if (name.empty()) fail("PROBEOPEN without a file name: (PROBEOPEN results.txt)");
-  std::filesystem::path path = name;
-  if (path.is_relative()) {
-    if (!program_dir_.empty()) {
-      path = program_dir_ / path;
-    } else if (!options_.subroutine_path.empty() && !options_.subroutine_path.front().empty()) {
-      path = options_.subroutine_path.front() / path;
-    } else {
-      fail("Cannot open probe file " + name +
-           ": a relative name is taken from the program's directory, and MDI has none (give a "
-           "full path, or set [RS274NGC] SUBROUTINE_PATH)");
-    }
+  if (const auto problem = probe_name_problem(name); !problem.empty()) fail(problem);
+  ProbeFileTarget target;
+  target.name = name;
+  if (!options_.probe_dir.empty()) {
+    target.dir = options_.probe_dir;
+  } else if (!program_dir_.empty()) {
+    target.dir = program_dir_;
+  } else if (!options_.subroutine_path.empty() && !options_.subroutine_path.front().empty()) {
+    target.dir = options_.subroutine_path.front();
+  } else {
+    fail("Cannot open probe file " + name +
+         ": MDI has no program directory to put it in (set [RS274NGC] SUBROUTINE_PATH)");
   }
   std::error_code ec;
-  const auto absolute = std::filesystem::absolute(path, ec);
-  if (!ec) path = absolute.lexically_normal();
-  const std::string problem = open_problem(path);
-  if (!problem.empty()) fail("Cannot open probe file " + path.string() + ": " + problem);
+  if (const auto absolute = std::filesystem::absolute(target.dir, ec); !ec)
+    target.dir = absolute.lexically_normal();
+  target.state_files = options_.state_files;
+  target.state_files.push_back(options_.parameter_file);
+  target.state_files.push_back(options_.tool_table);
+  if (const auto problem = probe_target_problem(target); !problem.empty()) fail(problem);
   close_probe_file();
-  probe_path_ = path;
+  probe_target_ = std::move(target);
   return true;
 }
 
 void Interpreter::Impl::close_probe_file() {
-  probe_file_.reset();
-  probe_path_.clear();
+  if (probe_opened_) probe_writer().close();
+  probe_opened_ = false;
+  probe_target_.reset();
+}
+
+ProbeFileWriter& Interpreter::Impl::probe_writer() {
+  if (!probe_writer_) {
+    probe_writer_ =
+        options_.probe_writer ? options_.probe_writer : std::make_shared<SyncProbeWriter>();
+  }
+  return *probe_writer_;
 }
 
 // "%f %f %f %f %f %f %f %f %f": X Y Z A B C U V W of #5061-#5069, as LinuxCNC writes them.
-// The first result empties the file, as LinuxCNC's opening it does; each is flushed.
+// The first result empties the file, as LinuxCNC's opening it does; each is written at once.
 void Interpreter::Impl::write_probe_line() {
-  if (probe_path_.empty()) return;
-  if (!probe_file_) {
-    probe_file_.reset(std::fopen(probe_path_.c_str(), "w"));
-    if (!probe_file_) {
-      const std::string why = std::strerror(errno);
-      const std::string name = probe_path_.string();
-      close_probe_file();
-      fail("Cannot open probe file " + name + ": " + why);
+  if (!probe_target_) return;
+  const std::string where = (sources_.empty() ? program_name_ : sources_.back().name()) + ":" +
+                            std::to_string(current_line_);
+  if (!probe_opened_) {
+    const std::string problem = probe_writer().open(*probe_target_, where);
+    if (!problem.empty()) {
+      probe_target_.reset();
+      fail(problem);
     }
+    probe_opened_ = true;
   }
   std::string line;
   char number[400];
@@ -181,13 +173,9 @@ void Interpreter::Impl::write_probe_line() {
     if (n > 0) line.append(number, static_cast<std::size_t>(n));
     line += axis + 1 < kAxes ? ' ' : '\n';
   }
-  const bool written = std::fwrite(line.data(), 1, line.size(), probe_file_.get()) == line.size() &&
-                       std::fflush(probe_file_.get()) == 0;
-  if (!written) {
-    const std::string why = std::strerror(errno);
-    const std::string name = probe_path_.string();
+  if (const std::string problem = probe_writer().write(line, where); !problem.empty()) {
     close_probe_file();
-    fail("Cannot write probe file " + name + ": " + why);
+    fail(problem);
   }
 }
 

@@ -17,6 +17,8 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   options.parameter_file = config.parameter_file;
   options.tool_table = config.tool_table;
   options.subroutine_path = config.subroutine_path;
+  options.probe_dir = config.cncd.probe_dir;
+  options.state_files = {config.position_file};
   // As LinuxCNC's task looks for M100-M199: the first program directory, then [RS274NGC]
   // USER_M_PATH (the config lists them in that order).
   options.user_m_path = config.io.user_m_path;

@@ -202,6 +202,22 @@ int DaemonProcess::end_with(int signal) {
   return decode_status(status);
 }
 
+int DaemonProcess::stop_within(int limit_ms) {
+  if (pid_ <= 0) return -1;
+  kill(pid_, SIGTERM);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(limit_ms);
+  int status = 0;
+  while (waitpid(pid_, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      end_with(SIGKILL);
+      return -2;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  pid_ = -1;
+  return decode_status(status);
+}
+
 void DaemonProcess::signal(int signal) {
   if (pid_ > 0) kill(pid_, signal);
 }

@@ -79,6 +79,9 @@ class DaemonProcess {
   std::string start(const std::filesystem::path& dir, const std::vector<std::string>& args);
   // SIGTERM and wait; returns the exit status.
   int stop();
+  // SIGTERM and wait up to `limit`: the exit status, or -2 when it had not ended by then (it
+  // is then killed with SIGKILL).
+  int stop_within(int limit_ms);
   // Sends `signal` without waiting (SIGTERM: the daemon starts shutting down).
   void signal(int signal);
   // SIGKILL and wait: the daemon dies wherever it is. Returns the exit status.

@@ -224,6 +224,9 @@ struct CncdConfig {
   // name> ($HOME/.local/state/cncd/<INI name>). Empty only when none of them is known.
   std::filesystem::path state_dir;
   std::string state_dir_origin;  // which of those chose it, for messages
+  // [CNCD] PROBE_DIR, absolute: where (PROBEOPEN name) files go; a relative key is taken from
+  // the state directory, and no key is its probe/ subdirectory. Empty only without either.
+  std::filesystem::path probe_dir;
 };
 
 struct MachineConfig {

@@ -6,13 +6,16 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "cncd/interp/canon.hpp"
+#include "cncd/interp/probe_file.hpp"
 #include "cncd/interp/to_machine.hpp"
 #include "cncd/interp/tool_entry.hpp"  // MachineTracker, which every user of the stream needs
 
@@ -71,7 +74,38 @@ struct InterpOptions {
   // LinuxCNC's floating-holder cycle; in the Numeryx dialect g84 (its g74 always is). Whether
   // the machine can (spindle position feedback) is for its configuration to say.
   bool rigid_tapping = false;
+  // [CNCD] PROBE_DIR: the directory (PROBEOPEN name) files go to. Empty: the program's
+  // directory, or for MDI the first subroutine_path directory (a library use without a
+  // machine configuration).
+  std::filesystem::path probe_dir;
+  // Files a probe file may never be, besides parameter_file and tool_table ([TRAJ]
+  // POSITION_FILE).
+  std::vector<std::filesystem::path> state_files;
+  // Who opens and writes the probe file; null = the interpreter's thread (SyncProbeWriter).
+  std::shared_ptr<ProbeFileWriter> probe_writer;
 };
+
+// Where each o<name> sub of a program file is defined, found by reading the file once
+// (index_program()), so that a call of a subroutine defined far below need not read its way
+// there while the machine runs.
+struct SubroutineIndex {
+  struct Definition {
+    std::int64_t offset = 0;  // of the sub's line
+    int line = 0;             // its number
+  };
+  // By lower-case name (digits for o123), in file order.
+  std::unordered_map<std::string, std::vector<Definition>> definitions;
+  std::uint64_t lines = 0;  // lines of the file, a last one without a newline counted too
+  // More definitions than this refuse the program: the index must stay small.
+  static constexpr std::size_t kMaxDefinitions = 100'000;
+};
+
+// Reads `program` through once, as a program check does (on a thread where waiting is
+// harmless): its subroutine definitions and lines, or the error that refuses it (it cannot be
+// read, a line is too long). `cancelled`, when given, is asked every few thousand lines; a
+// cancelled read returns an error saying so.
+std::optional<InterpError> index_program(const std::filesystem::path& program, SubroutineIndex& out,
+                                         const std::function<bool()>& cancelled = {});
 
 // What the interpreter holds between blocks, for status displays. Lengths in machine units,
 // angles in degrees. The interpreter reads ahead of motion: during a program this is the state
@@ -114,8 +148,11 @@ class Interpreter {
   // after open(), whose reset may change them.
   void set_machine_position(const Pose& machine);
 
-  // Opens a program file and resets to the start-of-program modal state.
-  std::optional<InterpError> open(const std::filesystem::path& program);
+  // Opens a program file and resets to the start-of-program modal state. With `index` (of
+  // this file, index_program()), a call finds a subroutine defined below it there rather than
+  // by reading on; a definition no longer where the index says is an error (the file changed).
+  std::optional<InterpError> open(const std::filesystem::path& program,
+                                  std::shared_ptr<const SubroutineIndex> index = nullptr);
   // Opens one MDI block: the modal state stays as the last line or program left it, and the
   // end of the text ends it (no M2 or % needed).
   std::optional<InterpError> open_mdi(std::string line);
