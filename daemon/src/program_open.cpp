@@ -3,7 +3,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <fstream>
 #include <utility>
 
 #include "cncd/pipeline/program_check.hpp"
@@ -11,22 +10,6 @@
 
 namespace cncd::daemon {
 namespace {
-
-// Lines of the file, a last line without a newline counted too; 0 when cancelled part-way.
-std::uint64_t count_lines(const std::string& path, const std::atomic<bool>& cancel) {
-  std::ifstream in(path, std::ios::binary);
-  std::uint64_t lines = 0;
-  char buffer[65536];
-  bool last_newline = true;
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-    if (cancel.load(std::memory_order_relaxed)) return 0;
-    const auto n = static_cast<std::size_t>(in.gcount());
-    for (std::size_t i = 0; i < n; ++i)
-      lines += buffer[i] == '\n';
-    last_newline = buffer[n - 1] == '\n';
-  }
-  return last_newline ? lines : lines + 1;
-}
 
 // Refuses a program whose moves leave the soft limits, from where the machine stood and with
 // the offsets and tools saved in the parameter file and tool table, or that the interpreter
@@ -64,7 +47,13 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
   }
   if (report.error) return fail(report.error->to_string());
   out.dialect = report.dialect;
-  out.lines = count_lines(file.path, cancel);
+  auto subs = std::make_shared<interp::SubroutineIndex>();
+  const auto unread = interp::index_program(
+      file.path, *subs, [&cancel] { return cancel.load(std::memory_order_relaxed); });
+  if (cancel.load()) return out;
+  if (unread) return fail(unread->to_string());
+  out.lines = subs->lines;
+  out.subs = std::move(subs);
   return out;
 }
 

@@ -1,7 +1,7 @@
 // program.open's long work, off the daemon's loop: the interpreter and soft-limit check of the
-// whole program (check_program) and counting its lines run on a worker thread of their own, so
-// that estop, jog.stop, pause and abort are answered at once however long the check takes.
-// start(), cancel() and take() are called on the loop thread. The worker shares nothing the
+// whole program (check_program) and indexing its lines and subroutines run on a worker thread of
+// their own, so that estop, jog.stop, pause and abort are answered at once however long the check
+// takes. start(), cancel() and take() are called on the loop thread. The worker shares nothing the
 // loop changes: it gets a copy of what it needs in OpenRequest, reads the machine
 // configuration (never changed after loading), builds its own interpreter and hands back an
 // OpenOutcome.
@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -37,6 +38,9 @@ struct OpenOutcome {
   std::optional<TaskError> error;  // none: the program passed and may be opened
   std::string path;                // the program file, symlinks resolved
   std::uint64_t lines = 0;
+  // Its subroutine definitions: a run's calls go straight to them, never reading the program
+  // forward on the daemon's loop.
+  std::shared_ptr<const interp::SubroutineIndex> subs;
   interp::Dialect dialect = interp::Dialect::linuxcnc;  // the one the program is read in
   // For the event log: the check stopped before the program's end (its time budget).
   std::vector<std::string> warnings;

@@ -67,6 +67,7 @@ void Task::finish_open(OpenOutcome outcome) {
   estimator_.start(outcome.path, pipeline::interpreter_options(config_), pending.start);
   program_path_ = outcome.path;
   program_lines_ = outcome.lines;
+  program_subs_ = std::move(outcome.subs);
   program_dialect_ = outcome.dialect;
   last_result_.clear();
   last_error_.clear();

@@ -1,6 +1,7 @@
 // O-word control flow: subroutines (in the program file or in NAME.ngc on the subroutine
 // path), if/elseif/else, while, do/while, repeat, break, continue, return. The program is
 // re-read from remembered file offsets, so loops and calls cost no memory per line.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -97,16 +98,45 @@ void Interpreter::Impl::skip_block(const std::string& name, std::initializer_lis
   }
 }
 
+// The first definition of `name` at or after `offset` in the indexed program file: seeks
+// there, checks it is still the sub's line and registers it.
+bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t offset) {
+  const auto found = sub_index_->definitions.find(name);
+  if (found == sub_index_->definitions.end()) return false;
+  const auto& all = found->second;
+  const auto def = std::lower_bound(
+      all.begin(), all.end(), offset,
+      [](const SubroutineIndex::Definition& d, std::int64_t at) { return d.offset < at; });
+  if (def == all.end()) return false;
+  const int line_number = source().line_number();
+  source().seek(def->offset, def->line - 1);
+  OKind kind = OKind::none;
+  const bool there = source().read_line(line_) && scan_o_word(line_, o_scan_name_, kind) &&
+                     kind == OKind::sub && o_scan_name_ == name;
+  if (!there) {
+    source().seek(offset, line_number);
+    fail(source().name() + " has changed since it was opened (" + o_label(name) +
+         " sub is no longer at line " + std::to_string(def->line) + "): open it again");
+  }
+  subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
+  source().seek(offset, line_number);
+  return true;
+}
+
 bool Interpreter::Impl::find_sub(const std::string& name) {
   // Search the rest of the program file first, as LinuxCNC does, then NAME.ngc files.
   const std::int64_t offset = source().tell();
   const int line_number = source().line_number();
   OKind kind = OKind::none;
-  while (source().read_line(line_)) {
-    if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
-      subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
-      source().seek(offset, line_number);
-      return true;
+  if (sub_index_ && sources_.size() == 1) {
+    if (find_indexed_sub(name, offset)) return true;
+  } else {
+    while (source().read_line(line_)) {
+      if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
+        subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
+        source().seek(offset, line_number);
+        return true;
+      }
     }
   }
   source().seek(offset, line_number);
@@ -117,7 +147,8 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
     std::error_code error;  // a name too long for a file name is simply not found
     if (!std::filesystem::exists(file, error)) continue;
     LineSource sub_file;
-    if (!sub_file.open_file(file)) continue;
+    if (const std::string why = sub_file.open_file(file); !why.empty())
+      fail("Cannot read subroutine file " + file.string() + ": " + why);
     while (sub_file.read_line(line_)) {
       if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
         sources_.push_back(std::move(sub_file));
@@ -339,6 +370,37 @@ void Interpreter::Impl::loop_back(std::int64_t offset, int line_before) {
          " loop iterations without a move or dwell");
   }
   source().seek(offset, line_before);
+}
+
+std::optional<InterpError> index_program(const std::filesystem::path& program, SubroutineIndex& out,
+                                         const std::function<bool()>& cancelled) {
+  out = SubroutineIndex{};
+  LineSource source;
+  if (const std::string why = source.open_file(program); !why.empty())
+    return InterpError{program.string(), 0, 0, "Unable to open file: " + why};
+  std::string line;
+  std::string name;
+  std::size_t count = 0;
+  try {
+    for (;;) {
+      const std::int64_t offset = source.tell();
+      if (!source.read_line(line)) break;
+      if ((source.line_number() & 4095) == 0 && cancelled && cancelled())
+        return InterpError{program.string(), 0, 0, "reading the program was cancelled"};
+      OKind kind = OKind::none;
+      if (!scan_o_word(line, name, kind) || kind != OKind::sub) continue;
+      if (++count > SubroutineIndex::kMaxDefinitions) {
+        return InterpError{program.string(), source.line_number(), 0,
+                           "more than " + std::to_string(SubroutineIndex::kMaxDefinitions) +
+                               " subroutine definitions"};
+      }
+      out.definitions[name].push_back({offset, source.line_number()});
+    }
+  } catch (const Failure& failure) {
+    return InterpError{failure.file, failure.line, 0, failure.message};
+  }
+  out.lines = static_cast<std::uint64_t>(source.line_number());
+  return std::nullopt;
 }
 
 }  // namespace cncd::interp

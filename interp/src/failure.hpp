@@ -10,6 +10,10 @@ namespace cncd::interp {
 struct Failure {
   std::string message;
   int column = 0;  // 1-based column in the source line, 0 = whole line
+  // Where, when not the line being executed (a line read ahead while seeking); line 0 = that
+  // line.
+  std::string file;
+  int line = 0;
 };
 
 // A program or file value used as an integer (L, P, T, H, Q words, loop counts, tool table
@@ -23,7 +27,7 @@ inline int to_int(double value) {
 }
 
 [[noreturn]] inline void fail(std::string message, int column = 0) {
-  throw Failure{std::move(message), column};
+  throw Failure{std::move(message), column, {}, 0};
 }
 
 }  // namespace cncd::interp

@@ -150,6 +150,10 @@ InterpError Interpreter::Impl::make_error(const Failure& failure) const {
   InterpError error;
   error.file = sources_.empty() ? program_name_ : sources_.back().name();
   error.line = current_line_;
+  if (failure.line > 0) {
+    error.file = failure.file;
+    error.line = failure.line;
+  }
   error.column = failure.column;
   error.message = failure.message;
   return error;
@@ -356,9 +360,11 @@ void Interpreter::set_machine_position(const Pose& machine) {
   impl_->sync_standalone();
 }
 
-std::optional<InterpError> Interpreter::open(const std::filesystem::path& program) {
+std::optional<InterpError> Interpreter::open(const std::filesystem::path& program,
+                                             std::shared_ptr<const SubroutineIndex> index) {
   impl_->mdi_ = false;
   impl_->sources_.clear();
+  impl_->sub_index_ = std::move(index);
   impl_->close_probe_file();
   std::error_code ec;
   const auto absolute = std::filesystem::absolute(program, ec);
@@ -366,8 +372,8 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
   impl_->error_ = impl_->config_error_;  // a new program starts without the last one's error
   impl_->program_name_ = program.string();
   LineSource source;
-  if (!source.open_file(program)) {
-    impl_->error_ = InterpError{program.string(), 0, 0, "Unable to open file"};
+  if (const std::string why = source.open_file(program); !why.empty()) {
+    impl_->error_ = InterpError{program.string(), 0, 0, "Unable to open file: " + why};
     return impl_->error_;
   }
   impl_->sources_.push_back(std::move(source));
@@ -384,6 +390,7 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
 
 std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   impl_->sources_.clear();
+  impl_->sub_index_.reset();
   impl_->program_dir_.clear();  // a probe file opened by an earlier MDI line stays open
   impl_->error_ = impl_->config_error_;
   impl_->program_name_ = "MDI";
@@ -405,6 +412,7 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
 std::optional<InterpError> Interpreter::open_string(std::string text, std::string name) {
   impl_->mdi_ = false;
   impl_->sources_.clear();
+  impl_->sub_index_.reset();
   impl_->close_probe_file();
   impl_->program_dir_.clear();
   impl_->error_ = impl_->config_error_;

@@ -63,7 +63,8 @@ void Parameters::pop_scope() {
 
 void Parameters::check(int number, double value, int column) const {
   if (is_persistent_parameter(number) && !storable(value)) {
-    throw Failure{out_of_range_message("Parameter #" + std::to_string(number), value), column};
+    throw Failure{
+        out_of_range_message("Parameter #" + std::to_string(number), value), column, {}, 0};
   }
 }
 

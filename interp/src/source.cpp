@@ -1,7 +1,14 @@
 #include "source.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstring>
 #include <utility>
+
+#include "failure.hpp"
 
 namespace cncd::interp {
 namespace {
@@ -32,16 +39,33 @@ LineSource& LineSource::operator=(LineSource&& other) noexcept {
   return *this;
 }
 
-bool LineSource::open_file(const std::filesystem::path& path) {
+std::string LineSource::open_file(const std::filesystem::path& path) {
   if (file_ != nullptr) std::fclose(file_);
-  file_ = std::fopen(path.c_str(), "rb");
+  file_ = nullptr;
+  // O_NONBLOCK: opening a FIFO with no writer would wait for ever.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  std::string problem;
+  struct stat st {};
+  if (fd < 0) {
+    problem = std::strerror(errno);
+  } else if (::fstat(fd, &st) != 0) {
+    problem = std::strerror(errno);
+  } else if (S_ISDIR(st.st_mode)) {
+    problem = std::strerror(EISDIR);
+  } else if (!S_ISREG(st.st_mode)) {
+    problem = S_ISFIFO(st.st_mode) ? "it is a FIFO, not a regular file" : "not a regular file";
+  } else if (::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0 ||
+             (file_ = ::fdopen(fd, "rb")) == nullptr) {
+    problem = std::strerror(errno);
+  }
+  if (file_ == nullptr && fd >= 0) ::close(fd);
   is_text_ = false;
   name_ = path.string();
   buffer_.resize(kBufferSize);
   buffer_pos_ = buffer_len_ = 0;
   offset_ = 0;
   line_number_ = 0;
-  return file_ != nullptr;
+  return problem;
 }
 
 void LineSource::open_text(std::string text, std::string name) {
@@ -62,12 +86,14 @@ bool LineSource::fill() {
 
 bool LineSource::read_line(std::string& line) {
   line.clear();
+  const std::int64_t line_start = offset_;
   if (is_text_) {
     const auto start = static_cast<std::size_t>(offset_);
     if (start >= text_.size()) return false;
     std::size_t end = text_.find('\n', start);
     const std::size_t next = end == std::string::npos ? text_.size() : end + 1;
     if (end == std::string::npos) end = text_.size();
+    if (end - start > kMaxLineLength + 1) too_long(line_start);
     line.assign(text_, start, end - start);
     offset_ = static_cast<std::int64_t>(next);
   } else {
@@ -81,11 +107,14 @@ bool LineSource::read_line(std::string& line) {
       const void* found = std::memchr(begin, '\n', available);
       if (found != nullptr) {
         const auto count = static_cast<std::size_t>(static_cast<const char*>(found) - begin);
+        if (line.size() + count > kMaxLineLength + 1)
+          too_long(line_start);  // +1: a '\r' before '\n'
         line.append(begin, count);
         buffer_pos_ += count + 1;
         offset_ += static_cast<std::int64_t>(count + 1);
         break;
       }
+      if (line.size() + available > kMaxLineLength + 1) too_long(line_start);
       line.append(begin, available);
       buffer_pos_ += available;
       offset_ += static_cast<std::int64_t>(available);
@@ -93,8 +122,18 @@ bool LineSource::read_line(std::string& line) {
     if (!any) return false;
   }
   if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.size() > kMaxLineLength) too_long(line_start);
   ++line_number_;
   return true;
+}
+
+// The line is left unread: every later read of this source fails on it the same way.
+void LineSource::too_long(std::int64_t line_start) {
+  const int number = line_number_ + 1;
+  seek(line_start, line_number_);
+  throw Failure{"Line is longer than " + std::to_string(kMaxLineLength) +
+                    " characters (the longest line a program may have)",
+                0, name_, number};
 }
 
 void LineSource::seek(std::int64_t offset, int line_number_before) {

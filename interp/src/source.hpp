@@ -19,11 +19,17 @@ class LineSource {
   LineSource(LineSource&& other) noexcept;
   LineSource& operator=(LineSource&& other) noexcept;
 
-  // Returns false when the file cannot be opened.
-  bool open_file(const std::filesystem::path& path);
+  // The longest line a program may have, in bytes without its line end (LinuxCNC's is 256):
+  // a longer one is an error, read without holding more than this in memory.
+  static constexpr std::size_t kMaxLineLength = 4096;
+
+  // Opens a regular file, never waiting (a FIFO is refused, not read). Returns "" or why it
+  // cannot be opened.
+  std::string open_file(const std::filesystem::path& path);
   void open_text(std::string text, std::string name);
 
   // Reads the next line (without its line terminator) into `line`. Returns false at end.
+  // Throws Failure, naming this source and the line, for a line over kMaxLineLength.
   bool read_line(std::string& line);
   // Offset of the next line to read and its 1-based line number.
   std::int64_t tell() const { return offset_; }
@@ -36,6 +42,7 @@ class LineSource {
 
  private:
   bool fill();
+  [[noreturn]] void too_long(std::int64_t line_start);
 
   std::FILE* file_ = nullptr;
   bool is_text_ = false;

@@ -102,7 +102,7 @@ TEST(InterpreterApi, MissingFileIsAnError) {
   Interpreter interp;
   const auto error = interp.open("/nonexistent/cncd/part.ngc");
   ASSERT_TRUE(error);
-  EXPECT_EQ(error->message, "Unable to open file");
+  EXPECT_EQ(error->message, "Unable to open file: No such file or directory");
 }
 
 TEST(InterpreterApi, StartupCodeRunsBeforeTheProgram) {

@@ -79,9 +79,12 @@ struct Segment {
   AxisPose point_at(double s) const noexcept;
 };
 
-// Calls `visit(s, axis)` for every point of an arc where its angle is a multiple of a quarter
-// turn, in order: s is the path distance there and `axis` the plane axis that reaches farthest
-// there (for a spiral, very near there). Nothing for other segments. The one model of how far
+// Calls `visit(s, axis)` for the points of an arc where its angle is a multiple of a quarter
+// turn, in order, that can reach farthest: s is the path distance there and `axis` the plane
+// axis that reaches farthest there (for a spiral, very near there). Nothing for other segments.
+// The radius changes linearly with the angle, so along each way of each axis the farthest such
+// point lies in the first or the last turn: only those are visited, and an arc of a hundred
+// million turns (G2 ... P100000000) costs what one of two turns does. The one model of how far
 // an arc reaches, shared by the planner's soft-limit check and the offline check of a program.
 template <typename Visit>
 void for_each_arc_extreme(const Segment& segment, Visit&& visit) {
@@ -90,10 +93,18 @@ void for_each_arc_extreme(const Segment& segment, Visit&& visit) {
   const double end_angle = segment.start_angle + segment.sweep;
   const double from = std::min(segment.start_angle, end_angle);
   const double to = std::max(segment.start_angle, end_angle);
-  for (double k = std::ceil(from / quarter); k * quarter <= to; k += 1) {
+  const double first = std::ceil(from / quarter);
+  double last = std::floor(to / quarter);
+  while (last * quarter > to)
+    last -= 1;
+  const auto at = [&](double k) {
     const int axis = std::fmod(std::abs(k), 2.0) == 0 ? segment.first_axis : segment.second_axis;
     visit(segment.length * (k * quarter - segment.start_angle) / segment.sweep, axis);
-  }
+  };
+  for (double k = first; k <= last && k < first + 4; k += 1)
+    at(k);
+  for (double k = std::max(first + 4, last - 3); k <= last; k += 1)
+    at(k);
 }
 
 }  // namespace cncd::motion
