@@ -80,6 +80,19 @@ TEST_F(StateDirTest, TheDirectoryIsChosenInTheDocumentedOrder) {
   EXPECT_EQ(result.config->tool_table, dir_ / "cli/tools/mill.tbl");
 }
 
+// [CNCD] PROBE_DIR: by default probe/ in the state directory, a relative one in it too.
+TEST_F(StateDirTest, ProbeFilesGoToTheStateDirectorysProbeDirectory) {
+  const std::filesystem::path state = "/srv/cnc/state";
+  auto probe_dir = [&](const std::string& cncd) {
+    const auto result = load("STATE_DIR = " + state.string() + "\n" + cncd, kFiles);
+    EXPECT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+    return result.ok() ? result.config->cncd.probe_dir : std::filesystem::path();
+  };
+  EXPECT_EQ(probe_dir(""), state / "probe");
+  EXPECT_EQ(probe_dir("PROBE_DIR = results\n"), state / "results");
+  EXPECT_EQ(probe_dir("PROBE_DIR = /srv/cnc/probes\n"), "/srv/cnc/probes");
+}
+
 TEST_F(StateDirTest, AbsoluteStateFilesAreUsedWhereTheyAreWithoutASeed) {
   const auto result = load("", "[RS274NGC]\nPARAMETER_FILE = /srv/mill/params.var\n");
   ASSERT_TRUE(result.ok());
