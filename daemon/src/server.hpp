@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,7 +101,9 @@ class Server {
     // `out` is still unsent at `close_by`.
     bool closing = false;
     Clock::time_point close_by;
-    nlohmann::json last_sent;       // status as this client last saw it
+    // Status as this client last saw it: the whole of it, or the fields it subscribed to.
+    std::shared_ptr<const nlohmann::json> last_whole;
+    nlohmann::json last_view;
     Clock::time_point next_update;  // when the next status update is due
     Clock::time_point last_update;  // when the last one was sent
     std::uint64_t update_seq = 0;

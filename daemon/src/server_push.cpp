@@ -1,5 +1,8 @@
 // What the server sends unasked: status updates, events, and answers that come later.
 #include <algorithm>
+#include <memory>
+#include <unordered_map>
+#include <utility>
 
 #include "server.hpp"
 #include "status_json.hpp"
@@ -32,17 +35,31 @@ int Server::next_update_in_ms(Clock::time_point now) const {
   return wait_ms;
 }
 
+namespace {
+
+std::string dump(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+}  // namespace
+
 void Server::push_updates(Clock::time_point now) {
   // At most kUpdatesPerTurn updates a turn, from where the last turn's ended: the rest are
   // still due and go out in the next turns, after the stops read meanwhile.
   const std::size_t count = clients_.size();
   std::size_t sent = 0;
   std::size_t k = 0;
+  // The changes since a snapshot, serialized once for every whole-status subscriber that last
+  // saw that snapshot (clients served in one turn are mostly served together again).
+  std::unordered_map<const nlohmann::json*,
+                     std::pair<std::shared_ptr<const nlohmann::json>, std::string>>
+      since;
   for (; k < count && sent < kUpdatesPerTurn; ++k) {
     Client& client = clients_[(next_update_client_ + k) % count];
     const int interval = client.session.subscribe_interval_ms;
     if (interval <= 0) {
-      client.last_sent = nullptr;
+      client.last_whole.reset();
+      client.last_view = nullptr;
       continue;
     }
     // Besides the periodic check, a request that may have changed the state is followed at
@@ -55,30 +72,45 @@ void Server::push_updates(Clock::time_point now) {
     // A client still holding unsent output gets the changes coalesced into a later update.
     if (!client.out.empty()) continue;
     ++sent;
-    const nlohmann::json& status = status_.get();
-    nlohmann::json view;
+    const auto& status = status_.snapshot();
+    bool full = false;
+    std::string changed;
     if (client.session.fields.empty()) {
-      view = status;
-    } else {
-      view = nlohmann::json::object();
-      for (const auto& field : client.session.fields) {
-        if (const auto it = status.find(field); it != status.end()) view[field] = *it;
+      client.last_view = nullptr;
+      full = client.last_whole == nullptr;
+      if (full) {
+        changed = status_.text();
+      } else if (client.last_whole != status) {
+        auto [entry, added] = since.try_emplace(client.last_whole.get());
+        if (added)
+          entry->second = {client.last_whole, dump(merge_diff(*client.last_whole, *status))};
+        changed = entry->second.second;
       }
+      client.last_whole = status;
+      if (changed.empty() || changed == "{}") continue;
+    } else {
+      client.last_whole.reset();
+      nlohmann::json view = nlohmann::json::object();
+      for (const auto& field : client.session.fields) {
+        if (const auto it = status->find(field); it != status->end()) view[field] = *it;
+      }
+      full = client.last_view.is_null();
+      const nlohmann::json diff = full ? view : merge_diff(client.last_view, view);
+      if (diff.empty()) continue;
+      changed = dump(diff);
+      client.last_view = std::move(view);
     }
-    nlohmann::json changed = client.last_sent.is_null() ? view : merge_diff(client.last_sent, view);
-    if (changed.empty()) continue;
     const auto wall = std::chrono::system_clock::now().time_since_epoch();
-    const nlohmann::json update = {{"jsonrpc", "2.0"},
-                                   {"method", "status.update"},
-                                   {"params",
-                                    {{"seq", ++client.update_seq},
-                                     {"time", std::chrono::duration<double>(wall).count()},
-                                     {"full", client.last_sent.is_null()},
-                                     {"changed", std::move(changed)}}}};
-    client.last_sent = std::move(view);
+    // {"jsonrpc","method","params":{"changed","full","seq","time"}}, as nlohmann orders keys.
+    std::string& out = client.out;
+    out += R"({"jsonrpc":"2.0","method":"status.update","params":{"changed":)";
+    out += changed;
+    out += full ? R"(,"full":true,"seq":)" : R"(,"full":false,"seq":)";
+    out += std::to_string(++client.update_seq);
+    out += R"(,"time":)";
+    out += nlohmann::json(std::chrono::duration<double>(wall).count()).dump();
+    out += "}}\n";
     client.last_update = now;
-    client.out += update.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-    client.out += '\n';
     write_client(client);
   }
   next_update_client_ = count == 0 ? 0 : (next_update_client_ + k) % count;

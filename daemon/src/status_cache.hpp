@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -14,9 +15,12 @@ namespace cncd::daemon {
 class StatusCache {
  public:
   explicit StatusCache(std::function<nlohmann::json()> build) : build_(std::move(build)) {}
-  const nlohmann::json& get() {
+  const nlohmann::json& get() { return *snapshot(); }
+  // The status of this turn, kept unchanged for as long as someone holds it: status updates
+  // compare against the snapshot a client last saw without copying it.
+  const std::shared_ptr<const nlohmann::json>& snapshot() {
     if (!fresh_) {
-      status_ = build_();
+      status_ = std::make_shared<const nlohmann::json>(build_());
       fresh_ = true;
     }
     return status_;
@@ -33,7 +37,7 @@ class StatusCache {
 
  private:
   std::function<nlohmann::json()> build_;
-  nlohmann::json status_;
+  std::shared_ptr<const nlohmann::json> status_;
   std::string text_;
   bool fresh_ = false;
   bool text_fresh_ = false;
