@@ -246,6 +246,11 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
     if (!has_active_) {
       if (window_count_ == 0) fill_window();
       if ((abort_requested_ && at_rest(path_v_)) || window_count_ == 0) break;
+      // A move in step with the spindle cannot stop once under way: a hold there before it
+      // starts holds before it.
+      if (pause_requested_ && at_rest(path_v_) &&
+          window_at(head_seq_).spindle_sync != SpindleSync::none)
+        break;
       has_active_ = true;
       // Path motion drives every joint of an axis to the axis position: a gantry joint homed
       // apart from its twin (or to another HOME) would jump.
