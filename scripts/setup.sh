@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(cmake ninja-build g++ pkg-config libmodbus-dev libgpiod-dev libspdlog-dev
-          nlohmann-json3-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache)
+          nlohmann-json3-dev libssl-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache)
 if [[ "${1:-}" == "--with-oracle" ]]; then
   # LinuxCNC's standalone interpreter, used by the differential tests when present.
   packages+=(linuxcnc-uspace)

@@ -119,6 +119,12 @@ class CheckSink final : public interp::CanonSink {
       holes_.straight(position_, move.end, feed && move.probe == motion::ProbeMode::none,
                       move.line);
     ++(feed ? report_.feeds : report_.traverses);
+    if (options_.preview != nullptr) {
+      const PieceKind kind = move.probe != motion::ProbeMode::none ? PieceKind::probe
+                             : feed                                ? PieceKind::feed
+                                                                   : PieceKind::rapid;
+      options_.preview->move(kind, position_, move.end, move.line);
+    }
     if (feed) report_.feed_length += xyz_distance(position_, move.end);
     reach(move.end, move.line, feed ? "feed move" : "rapid move");
     position_ = move.end;
@@ -224,9 +230,30 @@ class CheckSink final : public interp::CanonSink {
         if (low[a] < move.end[a]) reach_axis(a, low[a], move.line);
         if (high[a] > move.end[a]) reach_axis(a, high[a], move.line);
       }
+      if (options_.preview != nullptr) preview_arc(*segment, move);
     }
     reach(move.end, move.line, "arc");
     position_ = move.end;
+  }
+
+  // The arc as chords that stay within a tenth of the preview's tolerance of it (an arc of
+  // very many turns gets at most kMaxChords).
+  void preview_arc(const motion::Segment& segment, const motion::Move& move) {
+    constexpr double kMaxChords = 20'000;
+    const double radius = std::max(segment.radius, segment.radius + segment.radius_change);
+    const double chord_error = std::max(options_.preview->tolerance() / 10, 1e-9);
+    const double step = radius > chord_error ? 2 * std::acos(1 - chord_error / radius) : 1.0;
+    const double chords = std::clamp(std::ceil(std::abs(segment.sweep) / step), 1.0, kMaxChords);
+    Pose from = position_;
+    for (double k = 1; k <= chords; ++k) {
+      Pose to = move.end;
+      if (k < chords) {
+        const motion::AxisPose at = segment.point_at(segment.length * k / chords);
+        std::copy(at.begin(), at.begin() + kAxes, to.begin());
+      }
+      options_.preview->move(PieceKind::arc, from, to, move.line);
+      from = to;
+    }
   }
 
   void reach_axis(std::size_t axis, double value, int line) {
@@ -308,6 +335,18 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
       break;
     }
     ++report.blocks;
+    if (options.preview != nullptr && options.preview->has_block()) {
+      const interp::InterpState state = interp.state();
+      const int mode = state.gcodes[1];
+      const bool cycle = mode == 730 || mode == 740 || mode == 760 || (mode >= 810 && mode <= 890);
+      PreviewFrame frame;
+      for (std::size_t a = 0; a < 3; ++a) {
+        frame.origin[a] = state.g5x_offset[a] + state.tool_offset[a];
+        frame.g92[a] = state.g92_offset[a];
+      }
+      frame.rotation_deg = state.rotation_deg;
+      options.preview->end_block(cycle, frame);
+    }
     if (sink.refusal) {
       report.error = sink.refusal;
       break;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,6 +30,7 @@
 #include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/plan_sim.hpp"
 #include "cncd/pipeline/program_check.hpp"
+#include "cncd/pipeline/program_preview.hpp"
 #include "cncd/pipeline/startup_code.hpp"
 
 namespace {
@@ -43,6 +45,7 @@ int usage(const std::string& why) {
          "                  [--dialect linuxcnc|numeryx] [--tool-units mm|inch]\n"
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
+         "       cncd-check --preview [--tolerance T] [--ini FILE ...] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
          "               start-up code and the axis soft limits from the machine's INI\n"
          "  --state-dir DIR  where the machine's parameter file and tool table live\n"
@@ -61,6 +64,10 @@ int usage(const std::string& why) {
          "               feed-limited and exact-stop bounds, peak axis velocity and\n"
          "               acceleration, largest deviation from the programmed path\n"
          "  --json       with --plan: print one JSON object instead\n"
+         "  --preview    print the toolpath as program.preview answers it (one JSON object):\n"
+         "               extents and polylines in machine coordinates, tagged with lines\n"
+         "  --tolerance T  with --preview: how far the drawn path may pass from a point it\n"
+         "               leaves out, machine units (default 0.01 mm, 0.0004 in)\n"
          "  --trajectory FILE.csv  with --plan: write t, every axis and the spindle's\n"
          "               position (revolutions) per servo period\n"
          "exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI\n";
@@ -167,6 +174,8 @@ int main(int argc, char** argv) {
   std::optional<interp::Dialect> dialect;
   bool plan = false;
   bool json = false;
+  bool preview = false;
+  std::optional<double> tolerance;
   std::string trajectory;
   std::string ini;
   config::LoadOptions load_options;
@@ -181,13 +190,15 @@ int main(int argc, char** argv) {
       holes = true;
     } else if (arg == "--plan") {
       plan = true;
+    } else if (arg == "--preview") {
+      preview = true;
     } else if (arg == "--json") {
       json = true;
     } else if (arg == "--inch") {
       inch = true;
     } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
                arg == "--max-seconds" || arg == "--trajectory" || arg == "--state-dir" ||
-               arg == "--dialect") {
+               arg == "--dialect" || arg == "--tolerance") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
@@ -199,6 +210,11 @@ int main(int argc, char** argv) {
       } else if (arg == "--dialect") {
         dialect = interp::parse_dialect(value);
         if (!dialect) return usage("--dialect must be linuxcnc or numeryx");
+      } else if (arg == "--tolerance") {
+        char* end = nullptr;
+        tolerance = std::strtod(value.c_str(), &end);
+        if (*end != '\0' || !(*tolerance > 0) || !std::isfinite(*tolerance))
+          return usage("--tolerance needs a number above 0");
       } else if (arg == "--max-seconds") {
         char* end = nullptr;
         max_seconds = std::strtod(value.c_str(), &end);
@@ -226,6 +242,9 @@ int main(int argc, char** argv) {
   if (holes && (plan || canon)) return usage("--holes goes without --plan and --canon");
   if (!plan && (json || !trajectory.empty()))
     return usage("--json and --trajectory go with --plan");
+  if (preview && (plan || canon || holes))
+    return usage("--preview goes without --plan, --canon and --holes");
+  if (tolerance && !preview) return usage("--tolerance goes with --preview");
 
   pipeline::CheckOptions options;
   options.max_seconds = max_seconds;
@@ -278,6 +297,20 @@ int main(int argc, char** argv) {
     plan_options.interp = options.interp;
     plan_options.max_wall_s = max_seconds;
     return check_plan(*loaded->config, program, plan_options, json, trajectory);
+  }
+  if (preview) {
+    pipeline::PreviewOptions preview_options;
+    preview_options.tolerance = tolerance.value_or(
+        pipeline::default_preview_tolerance(options.interp.machine_units == interp::Units::inches));
+    const auto result = pipeline::preview_program(program, options, preview_options);
+    if (result.report.blocks > 0 || !result.report.error)
+      std::cout << pipeline::preview_json(result).dump() << '\n';
+    std::cout.flush();
+    if (result.report.error) std::cerr << result.report.error->to_string() << '\n';
+    if (result.report.stopped) std::cerr << result.report.stopped->to_string() << '\n';
+    for (const auto& problem : result.report.problems)
+      std::cerr << problem.to_string() << '\n';
+    return result.report.ok() ? 0 : kExitProblems;
   }
   interp::Rs274Printer printer(std::cout);
   if (canon) options.trace = &printer;

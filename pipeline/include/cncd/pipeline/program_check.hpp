@@ -17,6 +17,7 @@
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/pipeline/holes.hpp"
 #include "cncd/pipeline/machine.hpp"
+#include "cncd/pipeline/preview.hpp"
 
 namespace cncd::pipeline {
 
@@ -50,6 +51,8 @@ struct CheckOptions {
   interp::CanonSink* trace = nullptr;
   // Collect the holes the program drills in CheckReport::holes (cncd-check --holes).
   bool find_holes = false;
+  // Receives the path for display (cncd-check --preview, program.preview).
+  PreviewBuilder* preview = nullptr;
 };
 
 struct CheckReport {
