@@ -148,6 +148,16 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     session.defer_token = token;
     return json();
   });
+  // Answered once worked out on a worker thread, or at once when kept from an earlier ask.
+  dispatcher.add("program.preview", [&task, &completions](const json& params, Session& session) {
+    if (session.in_batch) {
+      throw RpcError(kInvalidRequest, "program.preview cannot be part of a batch");
+    }
+    const auto token = completions.next_token();
+    task.preview_program(params.value("tolerance", 0.0), token);
+    session.defer_token = token;
+    return json();
+  });
   dispatcher.add("program.run", [&task](const json& params) {
     // 0: from the top.
     task.run_program(params.value("from_line", 0));

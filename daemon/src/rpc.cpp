@@ -346,12 +346,15 @@ int rpc_code(TaskErrorKind kind) {
 }
 
 void Completions::post(std::uint64_t token, TaskOutcome outcome) {
-  Completion done{token, nullptr, 0, {}};
+  Completion done;
+  done.token = token;
   if (const auto* error = std::get_if<TaskError>(&outcome)) {
     done.error_code = rpc_code(error->kind());
     done.error_message = error->what();
   } else if (const auto* opened = std::get_if<ProgramOpened>(&outcome)) {
     done.result = json{{"path", opened->path}};
+  } else if (auto* preview = std::get_if<PreviewResult>(&outcome)) {
+    done.raw_result = std::move(preview->json);
   } else {
     done.result = json{{"ok", true}};
   }

@@ -56,7 +56,8 @@ class Completions final : public TaskAnswers {
  public:
   struct Completion {
     std::uint64_t token = 0;
-    nlohmann::json result;  // used when error_code == 0
+    nlohmann::json result;  // used when error_code == 0 and raw_result is not set
+    std::shared_ptr<const std::string> raw_result;  // the result, serialized
     int error_code = 0;
     std::string error_message;
   };

@@ -289,7 +289,8 @@ void Server::write_client(Client& client) {
     }
     client.out.erase(0, static_cast<std::size_t>(n));
   }
-  if (client.out.size() > kMaxBacklogBytes) {
+  client.asked_bytes = std::min(client.asked_bytes, client.out.size());
+  if (client.out.size() > kMaxBacklogBytes + client.asked_bytes) {
     client_log_.log(spdlog::level::warn,
                     "control client not reading: " + std::to_string(client.out.size()) +
                         " bytes unsent, disconnecting");

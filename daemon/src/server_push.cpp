@@ -123,6 +123,19 @@ void Server::deliver_completions() {
       const auto it = std::find_if(open.begin(), open.end(),
                                    [&](const auto& entry) { return entry.first == done.token; });
       if (it == open.end()) continue;
+      if (client.closing) client.close_by = Clock::now() + kCloseGrace;
+      if (done.error_code == 0 && done.raw_result) {
+        // {"id","jsonrpc","result"}, as nlohmann orders keys; the result is copied, not parsed.
+        client.out += R"({"id":)";
+        client.out += it->second.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        client.out += R"(,"jsonrpc":"2.0","result":)";
+        client.out += *done.raw_result;
+        client.out += "}\n";
+        client.asked_bytes += done.raw_result->size();
+        open.erase(it);
+        write_client(client);
+        break;
+      }
       nlohmann::json response = {{"jsonrpc", "2.0"}, {"id", it->second}};
       if (done.error_code == 0) {
         response["result"] = std::move(done.result);
@@ -130,7 +143,6 @@ void Server::deliver_completions() {
         response["error"] = RpcDispatcher::error_object(done.error_code, done.error_message);
       }
       open.erase(it);
-      if (client.closing) client.close_by = Clock::now() + kCloseGrace;
       client.out += response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
       client.out += '\n';
       write_client(client);

@@ -60,7 +60,8 @@ Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& a
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
-      opener_(config) {
+      opener_(config),
+      previewer_(config) {
   program_dialect_ = interp_->dialect();  // before any program: the machine's
   feeder_->on_warning([this](int line, const std::string& text) {
     const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
@@ -364,6 +365,8 @@ void Task::poll() {
   if (opening_) {
     if (auto outcome = opener_.take()) finish_open(std::move(*outcome));
   }
+  for (auto& [token, outcome] : previewer_.take())
+    answers_.post(token, std::move(outcome));
   const auto status = motion_.status();
   keep_positions(status);
   // An estop from the drives or an input, not machine.estop, cancels a pending open too.

@@ -23,6 +23,7 @@
 #include "plan_estimate.hpp"
 #include "probe_writer.hpp"
 #include "program_open.hpp"
+#include "program_preview.hpp"
 #include "task_outcome.hpp"
 #include "task_report.hpp"
 #include "user_m.hpp"
@@ -67,6 +68,9 @@ class Task {
   // by the interpreter) or cancelled (a newer open, an estop, shutdown). Refuses at once
   // (TaskError) while a program or MDI block runs or the machine jogs or homes.
   void open_program(const std::string& path, std::uint64_t token);
+  // program.preview: the open program's toolpath at `tolerance` (0: the machine's default),
+  // answered under `token` once worked out in the background (task_open.cpp).
+  void preview_program(double tolerance, std::uint64_t token);
   // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
   // `step` runs its first line only, as program.step does.
   void run_program(int from_line = 0, bool step = false);
@@ -263,6 +267,7 @@ class Task {
   };
   mutable FirstMove first_move_;
   ProgramOpener opener_;
+  ProgramPreviewer previewer_;
 };
 
 }  // namespace cncd::daemon

@@ -2,6 +2,7 @@
 // answered when the check ends (or is cancelled), while the loop goes on serving.
 #include <spdlog/spdlog.h>
 
+#include "cncd/pipeline/preview.hpp"
 #include "cncd/pipeline/program_check.hpp"
 #include "task.hpp"
 
@@ -65,6 +66,7 @@ void Task::finish_open(OpenOutcome outcome) {
     return;
   }
   estimator_.start(outcome.path, pipeline::interpreter_options(config_), pending.start);
+  previewer_.open(outcome.path, pipeline::interpreter_options(config_), pending.start);
   program_path_ = outcome.path;
   program_lines_ = outcome.lines;
   program_subs_ = std::move(outcome.subs);
@@ -73,6 +75,14 @@ void Task::finish_open(OpenOutcome outcome) {
   last_error_.clear();
   spdlog::info("program opened: {} ({} lines)", program_path_, program_lines_);
   answers_.post(pending.token, ProgramOpened{program_path_});
+}
+
+void Task::preview_program(double tolerance, std::uint64_t token) {
+  if (tolerance <= 0) {
+    tolerance =
+        pipeline::default_preview_tolerance(config_.linear_units == config::LinearUnits::inch);
+  }
+  previewer_.request(tolerance, token);
 }
 
 }  // namespace cncd::daemon

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -40,7 +41,12 @@ struct CommandDone {};
 struct ProgramOpened {
   std::string path;
 };
-using TaskOutcome = std::variant<CommandDone, ProgramOpened, TaskError>;
+// program.preview: the result, already serialized (it is large, and shared by every client
+// that asks for the same preview).
+struct PreviewResult {
+  std::shared_ptr<const std::string> json;
+};
+using TaskOutcome = std::variant<CommandDone, ProgramOpened, PreviewResult, TaskError>;
 
 // Where the task posts the outcomes of the commands answered later, each under the token the
 // command was given.

@@ -89,6 +89,7 @@ class RpcParamsTest : public MachineTest {
         {"jog.stop", {{"axis", "X"}}},
         {"jog.increment", {{"axis", "x"}, {"distance", 1}, {"velocity", 1.5}}},
         {"program.open", {{"path", program.string()}}},
+        {"program.preview", {{"tolerance", 0.05}}},
         {"program.run", {{"from_line", 1}}},
         {"mdi.execute", {{"line", "G0 X0"}}},
         {"override.feed", {{"value", 1.0}}},
