@@ -12,6 +12,9 @@ using Xyz = std::array<double, 3>;
 // Points since the last kept one are tested against every new chord: a bounded run keeps the
 // work per point bounded on long straight stretches.
 constexpr std::size_t kMaxRun = 256;
+// A polyline longer than this goes on as another one from its last point: the budget then
+// counts every point kept, and thinning works on bounded pieces.
+constexpr std::size_t kMaxPolyline = 16384;
 
 double distance_to_segment(const Xyz& p, const Xyz& a, const Xyz& b) {
   const Xyz ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
@@ -115,7 +118,8 @@ void PreviewBuilder::add(PieceKind kind, std::uint32_t frame, const Point& from,
   } else if (last->at == to.at) {
     return;  // no length: nothing to draw
   }
-  const double tolerance = options_.tolerance;
+  // Once the path has been thinned, what comes next is decimated to the tolerance reached.
+  const double tolerance = options_.tolerance + extra_;
   const Xyz& anchor = current_.points.back().at;
   bool fits = pending_.size() < kMaxRun;
   for (std::size_t i = 0; fits && i < pending_.size(); ++i)
@@ -123,6 +127,14 @@ void PreviewBuilder::add(PieceKind kind, std::uint32_t frame, const Point& from,
   if (!fits) {
     current_.points.push_back(pending_.back());
     pending_.clear();
+    if (current_.points.size() >= kMaxPolyline) {
+      const Point end = current_.points.back();
+      close_run();
+      open_ = true;
+      current_.kind = kind;
+      current_.frame = frame;
+      current_.points.assign(1, end);
+    }
   }
   pending_.push_back(to);
 }
@@ -140,8 +152,12 @@ void PreviewBuilder::close_run() {
 
 void PreviewBuilder::thin_all() {
   // Each pass doubles the tolerance reached, until the points fit in three quarters of the
-  // budget or a pass drops nothing more.
+  // budget or only the ends of polylines are left.
   while (kept_ > options_.max_points * 3 / 4) {
+    std::size_t inner = 0;
+    for (const Polyline& polyline : done_)
+      inner += polyline.points.size() > 2 ? polyline.points.size() - 2 : 0;
+    if (inner == 0) break;
     const double step = std::max(options_.tolerance + extra_, 1e-6);
     std::size_t kept = 0;
     for (Polyline& polyline : done_) {
@@ -155,9 +171,7 @@ void PreviewBuilder::thin_all() {
       kept += polyline.points.size();
     }
     extra_ += step;
-    const bool dropped = kept < kept_;
     kept_ = kept;
-    if (!dropped) break;
   }
 }
 

@@ -81,8 +81,11 @@ TEST(Preview, ThinningKeepsBothEndsAndPassesWithinTheToleranceOfEveryPointItDrop
 TEST(Preview, EveryPointOfARandomPathIsWithinTheReportedToleranceEvenPastTheBudget) {
   std::mt19937 random(11);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2);
-  for (const std::size_t budget : {std::size_t{1024}, std::size_t{1'000'000}}) {
-    pipeline::PreviewBuilder builder({0.01, budget});
+  // A tolerance far below the path's detail thins nothing at first: the budget holds anyway.
+  const std::vector<std::pair<double, std::size_t>> cases = {
+      {0.01, 1024}, {0.01, 1'000'000}, {1e-9, 1024}};
+  for (const auto& [asked, budget] : cases) {
+    pipeline::PreviewBuilder builder({asked, budget});
     std::vector<Xyz> path{{0, 0, 0}};
     for (int i = 0; i < 5000; ++i) {
       const Xyz next{path.back()[0] + 0.05, std::sin(i * 0.04) * 5 + jitter(random) * 0.1,
@@ -96,10 +99,10 @@ TEST(Preview, EveryPointOfARandomPathIsWithinTheReportedToleranceEvenPastTheBudg
     ASSERT_EQ(preview.counts.size(), 1u);
     EXPECT_LE(preview.lines.size(), budget);
     EXPECT_EQ(preview.source_points, path.size());
-    EXPECT_GE(preview.tolerance, 0.01);
+    EXPECT_GE(preview.tolerance, asked);
     // The small budget made it thin the path again, at a wider tolerance.
     if (budget == 1024) {
-      EXPECT_GT(preview.tolerance, 0.02);
+      EXPECT_GT(preview.tolerance, 2 * asked);
     }
     // float32 points: a few micrometres of rounding on top.
     const auto drawn = polylines(preview).front();
@@ -133,6 +136,27 @@ TEST(Preview, CollinearMovesBecomeOneLineAndKindsStartNewPolylines) {
   EXPECT_EQ(preview.frames[1].origin, (std::array<double, 3>{10, 20, 0}));
   // The feed line's end carries the line of the last move merged into it.
   EXPECT_EQ(preview.lines[3], 101u);
+}
+
+TEST(Preview, ALongPolylineGoesOnFromItsLastPointInPiecesOfBoundedLength) {
+  pipeline::PreviewBuilder builder({0.001, 1'000'000});
+  for (int i = 0; i < 40'000; ++i) {
+    builder.move(PieceKind::feed, pose(i, i % 2, 0), pose(i + 1, (i + 1) % 2, 0), i + 1);
+    builder.end_block(false, {});
+  }
+  const pipeline::Preview preview = builder.finish();
+  ASSERT_GT(preview.counts.size(), 1u);
+  const auto drawn = polylines(preview);
+  std::size_t points = 0;
+  for (std::size_t k = 0; k < drawn.size(); ++k) {
+    EXPECT_LE(drawn[k].size(), 16384u);
+    EXPECT_EQ(preview.kinds[k], PieceKind::feed);
+    if (k > 0) {
+      EXPECT_EQ(drawn[k].front(), drawn[k - 1].back()) << "piece " << k;
+    }
+    points += drawn[k].size() - (k > 0 ? 1 : 0);
+  }
+  EXPECT_EQ(points, 40'001u);  // a zigzag keeps every corner
 }
 
 TEST(Preview, AnArcIsDrawnWithinTheToleranceOfItsCircle) {
