@@ -32,6 +32,36 @@ std::string surface(int rows, int columns) {
   return text + "G0 Z5\nM2\n";
 }
 
+// Asks for the preview under `id` on a connection of its own, without waiting; the descriptor.
+int ask_preview(const std::string& socket, int id) {
+  const int fd = raw_connect(socket);
+  const std::string ask =
+      R"({"jsonrpc":"2.0","id":)" + std::to_string(id) + R"(,"method":"program.preview"})" + "\n";
+  if (fd >= 0 && ::write(fd, ask.data(), ask.size()) != static_cast<ssize_t>(ask.size())) return -1;
+  return fd;
+}
+
+// The answer under `id` among the lines `fd` receives (events come to every connection), after
+// `seen`, what was read from it already; null when none comes within `limit`.
+json answer_to(int fd, int id, std::string seen, std::chrono::seconds limit) {
+  const std::string key = R"("id":)" + std::to_string(id) + ",";
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  for (;;) {
+    const auto at = seen.find(key);
+    if (at != std::string::npos && seen.find('\n', at) != std::string::npos) {
+      const auto start = seen.rfind('\n', at) == std::string::npos ? 0 : seen.rfind('\n', at) + 1;
+      return json::parse(seen.substr(start, seen.find('\n', at) - start));
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    pollfd ready{fd, POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&ready, 1, static_cast<int>(left.count())) != 1) return nullptr;
+    const std::string more = received(fd);
+    if (more.empty()) return nullptr;  // the daemon closed the connection
+    seen += more;
+  }
+}
+
 class PreviewDaemon : public MachineTest {
  protected:
   void open(const std::filesystem::path& program) {
@@ -77,35 +107,16 @@ TEST_F(PreviewDaemon, ABatchMayNotAskForAPreview) {
 TEST_F(PreviewDaemon, AStopIsAnsweredWhileALargePreviewIsWorkedOut) {
   ready_machine();
   open(dir_.write("surface.ngc", surface(200, 500)));
-  // The preview is asked for on a connection of its own and not waited for.
-  const int asker = raw_connect(daemon_.socket());
+  const int asker = ask_preview(daemon_.socket(), 7);
   ASSERT_GE(asker, 0);
-  const std::string ask = R"({"jsonrpc":"2.0","id":7,"method":"program.preview"})"
-                          "\n";
-  ASSERT_EQ(::write(asker, ask.data(), ask.size()), static_cast<ssize_t>(ask.size()));
   result_of(call("jog.start", {{"axis", "X"}, {"velocity", 20}}));
   result_of(call("machine.estop"));
-  // Events (the estop's) come to every connection; the answer is the line with the id.
-  std::string answer = received(asker);
-  EXPECT_EQ(answer.find(R"("id":7)"), std::string::npos) << "answered before the estop";
+  const std::string before = received(asker);
+  EXPECT_EQ(before.find(R"("id":7,)"), std::string::npos) << "answered before the estop";
   EXPECT_EQ(status()["state"], "estop");
   // The preview still comes, whole.
-  char buffer[65536];
-  const auto answered = [&answer] {
-    const auto at = answer.find(R"({"id":7)");
-    return at != std::string::npos && answer.find('\n', at) != std::string::npos;
-  };
-  while (!answered()) {
-    pollfd ready{asker, POLLIN, 0};
-    ASSERT_EQ(::poll(&ready, 1, 120'000), 1) << "no preview within 120 s";
-    const ssize_t n = ::read(asker, buffer, sizeof buffer);
-    ASSERT_GT(n, 0);
-    answer.append(buffer, static_cast<std::size_t>(n));
-  }
+  const json reply = answer_to(asker, 7, before, std::chrono::seconds(120));
   ::close(asker);
-  const auto at = answer.find(R"({"id":7)");
-  answer = answer.substr(at, answer.find('\n', at) - at);
-  const json reply = json::parse(answer);
   ASSERT_TRUE(reply.contains("result")) << reply.dump();
   const json preview = reply["result"];
   EXPECT_EQ(preview["complete"], true);
@@ -116,24 +127,12 @@ TEST_F(PreviewDaemon, AStopIsAnsweredWhileALargePreviewIsWorkedOut) {
 
 TEST_F(PreviewDaemon, OpeningAnotherProgramCancelsTheOneWaitedFor) {
   open(dir_.write("surface.ngc", surface(200, 500)));
-  const int asker = raw_connect(daemon_.socket());
+  const int asker = ask_preview(daemon_.socket(), 8);
   ASSERT_GE(asker, 0);
-  const std::string ask = R"({"jsonrpc":"2.0","id":8,"method":"program.preview"})"
-                          "\n";
-  ASSERT_EQ(::write(asker, ask.data(), ask.size()), static_cast<ssize_t>(ask.size()));
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   open(dir_.write("small.ngc", "G21 G90\nG1 X3 F500\nM2\n"));
-  std::string lines;
-  while (lines.find(R"("id":8)") == std::string::npos || lines.back() != '\n') {
-    pollfd ready{asker, POLLIN, 0};
-    ASSERT_EQ(::poll(&ready, 1, 30'000), 1) << lines;
-    lines += received(asker);
-  }
+  const json answer = answer_to(asker, 8, "", std::chrono::seconds(30));
   ::close(asker);
-  // The line with the id: {"error":...,"id":8,...}.
-  const auto id = lines.find(R"("id":8)");
-  const auto at = lines.rfind('\n', id) == std::string::npos ? 0 : lines.rfind('\n', id) + 1;
-  const json answer = json::parse(lines.substr(at, lines.find('\n', id) - at));
   EXPECT_EQ(answer["error"]["code"], 1009) << answer.dump();
   // The start is no target of the program: X reaches 3 only.
   EXPECT_EQ(result_of(call("program.preview"))["extents"]["X"], json({3.0, 3.0}));
