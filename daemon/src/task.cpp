@@ -230,30 +230,6 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   skip_to_line_ = 0;
 }
 
-PauseWaitReport Task::pause() {
-  if (exec_ != ExecState::running)
-    throw TaskError(TaskErrorKind::wrong_state, "no program is running");
-  motion_.pause();
-  set_exec(ExecState::paused);
-  // As the servo thread last published: a synchronized move under way then runs to its end.
-  const auto status = motion_.status();
-  return pause_wait_report(status.sync, status.line);
-}
-
-void Task::resume() {
-  if (exec_ != ExecState::paused)
-    throw TaskError(TaskErrorKind::wrong_state, "the program is not paused");
-  stepping_ = false;
-  motion_.resume();
-  set_exec(ExecState::running);
-}
-
-void Task::abort(std::uint64_t token) {
-  motion_.abort();
-  if (exec_ != ExecState::idle) finish_program("aborted", "aborted by request");
-  if (token != 0) abort_tokens_.push_back(token);
-}
-
 void Task::finish_program(const std::string& ended, const std::string& why) {
   user_m_.stop();
   user_m_hold_ = 0;
