@@ -113,6 +113,20 @@ TEST_F(SyncDaemon, FeedHoldDuringAThreadSaysItWaitsForTheThreadsEnd) {
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
 }
 
+TEST_F(SyncDaemon, CncctlPauseDuringAThreadPrintsThatTheHoldWaitsForItsEnd) {
+  ready_machine();
+  start_program("thread.ngc", "G21 G90\nG0 X10 Y10 Z5\nM3 S600\nG33 Z-40 K1.5\nG0 Z20\nM2\n");
+  wait_until([](const nlohmann::json& st) {
+    return !st["sync"].is_null() && st["sync"]["phase"] == "following" && z(st) < 0;
+  });
+  const auto paused = cncctl({"pause"});
+  EXPECT_EQ(paused.exit_status, 0) << paused.err;
+  EXPECT_EQ(paused.out,
+            "the feed hold takes effect once the thread (G33) has reached its end (line 4)\n");
+  const auto held = wait_until([](const nlohmann::json& st) { return st["motion"] == "paused"; });
+  EXPECT_NEAR(z(held), -40, 1e-9);
+}
+
 // A thread whose pitch at its speed is more than the axis can follow is refused at open.
 TEST_F(SyncDaemon, AThreadTheAxisCannotFollowIsRefusedAtOpen) {
   ready_machine();

@@ -39,7 +39,8 @@ void usage(std::FILE* out) {
       "                      open FILE, run it (from LINE) and follow it to the end\n"
       "  open FILE           open FILE for run or step\n"
       "  step [FILE]         run one more line of the open program (or of FILE) and wait\n"
-      "  pause | resume      feed hold and continue\n"
+      "  pause | resume      feed hold (during a thread or tap: at its end, and says so)\n"
+      "                      and continue\n"
       "  tool-done T<n>      tool n, the one a program's M6 waits for, is in: go on\n"
       "  abort               stop the running program; returns once the machine is at rest\n"
       "  mdi LINE            execute one block; returns when it has finished\n"
@@ -256,7 +257,16 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
   if (command == "on") return simple("machine.on");
   if (command == "off") return simple("machine.off");
   if (command == "abort") return simple("program.abort");
-  if (command == "pause") return simple("program.pause");
+  if (command == "pause") {
+    // A hold during a thread or a tap takes effect at its end: the answer says so.
+    const json result = result_of(client.call("program.pause"));
+    if (json_output) {
+      std::printf("%s\n", result.dump().c_str());
+    } else if (result.contains("message")) {
+      std::printf("%s\n", printable(result.value("message", "")).c_str());
+    }
+    return kDone;
+  }
   if (command == "resume") return simple("program.resume");
   if (command == "tool-done") {
     // The tool is named: an answer meant for one change never lets another go on.
