@@ -253,6 +253,9 @@ std::string describe(const MachineConfig& c) {
   line(out, "cncd:");
   line(out, "  socket " + c.cncd.socket_path + ", read group " + or_none(c.cncd.read_group) +
                 ", control group " + or_none(c.cncd.control_group));
+  line(out, "  connections at most " + std::to_string(c.cncd.max_connections) + ", " +
+                std::to_string(c.cncd.max_connections_per_user) + " per user, the last " +
+                std::to_string(c.cncd.control_reserve) + " kept for control access");
   line(out, "  RT priority " + std::to_string(c.cncd.rt_priority) + ", RT CPU " +
                 (c.cncd.rt_cpu < 0 ? std::string("any") : std::to_string(c.cncd.rt_cpu)) +
                 ", log level " + c.cncd.log_level);

@@ -112,7 +112,8 @@ TEST(DescribeTest, SummarisesTheMachine) {
         "  2: axis Z, linear, driver sim",
         "     limits -100 .. 50 mm, max velocity 100 mm/s, max acceleration 1000 mm/s^2",
         "ferror 1 (standstill 0.25) mm", "home 0 mm, homes where it stands, sequence 0",
-        "socket /run/cncd/cncd.sock", "RT priority 80, RT CPU any, log level info"}) {
+        "socket /run/cncd/cncd.sock", "RT priority 80, RT CPU any, log level info",
+        "connections at most 1000, 128 per user, the last 8 kept for control access"}) {
     EXPECT_NE(text.find(expected), std::string::npos) << "missing: " << expected << "\n" << text;
   }
 }
