@@ -55,4 +55,18 @@ class LineSource {
   int line_number_ = 0;
 };
 
+// A line of blanks and one '%': the marks that may open and close a program.
+inline bool is_percent_line(const std::string& line) {
+  bool percent = false;
+  for (const char c : line) {
+    if (c == ' ' || c == '\t') continue;
+    if (c == '%' && !percent) {
+      percent = true;
+      continue;
+    }
+    return false;
+  }
+  return percent;
+}
+
 }  // namespace cncd::interp
