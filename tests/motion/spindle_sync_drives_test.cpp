@@ -15,6 +15,8 @@
 namespace cncd::test {
 namespace {
 
+using namespace spindle_sync;
+
 double told_rps(const drivers::IoCommand& command) {
   const auto& sp = command.spindle;
   return !sp.enable ? 0.0 : (sp.reverse ? -sp.rpm : sp.rpm) / 60.0;

@@ -12,7 +12,7 @@
 
 #include "machine_fixture.hpp"
 
-namespace cncd::test {
+namespace cncd::test::spindle_sync {
 
 using motion::Command;
 using motion::IoAction;
@@ -128,4 +128,4 @@ class SpindleSyncTest : public ::testing::Test {
   std::vector<Sample> samples_;
 };
 
-}  // namespace cncd::test
+}  // namespace cncd::test::spindle_sync

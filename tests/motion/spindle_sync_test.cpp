@@ -15,6 +15,8 @@
 namespace cncd::test {
 namespace {
 
+using namespace spindle_sync;
+
 TEST_F(SpindleSyncTest, RigidTapStaysOnTheHelixThroughTheReversalAndReturns) {
   start(mill_with_sim_spindle(3000));
   machine_->queue(synced(SpindleSync::tap, -10));
