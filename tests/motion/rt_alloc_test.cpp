@@ -7,15 +7,8 @@
 //
 // Sanitizer runtimes bring their own operator new and intercept the locks; the test is skipped
 // there.
-#include <dlfcn.h>
-#include <pthread.h>
-#include <semaphore.h>
-
-#include <atomic>
-#include <cstdlib>
 #include <memory>
 #include <mutex>
-#include <new>
 #include <shared_mutex>
 #include <string>
 #include <vector>
@@ -27,138 +20,9 @@
 #include "cncd/motion/servo_loop.hpp"
 #include "machine_fixture.hpp"
 #include "path_distance.hpp"
+#include "rt_alloc_hooks.hpp"
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define CNCD_RT_ALLOC_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define CNCD_RT_ALLOC_SANITIZED 1
-#endif
-#endif
-#ifndef CNCD_RT_ALLOC_SANITIZED
-#define CNCD_RT_ALLOC_SANITIZED 0
-#endif
-
-namespace {
-
-thread_local bool t_in_period = false;
-std::atomic<long> g_period_allocs{0};
-std::atomic<long> g_period_frees{0};
-std::atomic<long> g_period_locks{0};
-
-}  // namespace
-
-#if !CNCD_RT_ALLOC_SANITIZED
-namespace {
-
-void* counted_alloc(std::size_t size) {
-  if (t_in_period) g_period_allocs.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-
-void* counted_alloc(std::size_t size, std::align_val_t align) {
-  if (t_in_period) g_period_allocs.fetch_add(1, std::memory_order_relaxed);
-  const auto a = static_cast<std::size_t>(align);
-  return std::aligned_alloc(a, (size + a - 1) / a * a);
-}
-
-void counted_free(void* p) noexcept {
-  if (p != nullptr && t_in_period) g_period_frees.fetch_add(1, std::memory_order_relaxed);
-  std::free(p);
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  if (void* p = counted_alloc(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  return counted_alloc(size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  return counted_alloc(size);
-}
-void* operator new(std::size_t size, std::align_val_t align) {
-  if (void* p = counted_alloc(size, align)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size, std::align_val_t align) {
-  if (void* p = counted_alloc(size, align)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  counted_free(p);
-}
-void operator delete[](void* p) noexcept {
-  counted_free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  counted_free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  counted_free(p);
-}
-void operator delete(void* p, std::align_val_t) noexcept {
-  counted_free(p);
-}
-void operator delete[](void* p, std::align_val_t) noexcept {
-  counted_free(p);
-}
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
-  counted_free(p);
-}
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
-  counted_free(p);
-}
-
-namespace {
-
-// The C library's definition of `name`, looked up once.
-void* next_symbol(std::atomic<void*>& cache, const char* name) noexcept {
-  void* symbol = cache.load(std::memory_order_acquire);
-  if (symbol == nullptr) {
-    symbol = dlsym(RTLD_NEXT, name);
-    cache.store(symbol, std::memory_order_release);
-  }
-  return symbol;
-}
-
-}  // namespace
-
-// Each counts a call made in the servo period, then does what the C library does. Condition
-// waits need a mutex, which is counted already.
-#define CNCD_COUNTED_LOCK(name, params, args, spec)                          \
-  extern "C" int name params spec {                                          \
-    if (t_in_period) g_period_locks.fetch_add(1, std::memory_order_relaxed); \
-    static std::atomic<void*> next{nullptr};                                 \
-    return reinterpret_cast<decltype(&name)>(next_symbol(next, #name)) args; \
-  }
-CNCD_COUNTED_LOCK(pthread_mutex_lock, (pthread_mutex_t * m), (m), noexcept)
-CNCD_COUNTED_LOCK(pthread_mutex_trylock, (pthread_mutex_t * m), (m), noexcept)
-CNCD_COUNTED_LOCK(pthread_mutex_timedlock,
-                  (pthread_mutex_t* __restrict m, const timespec* __restrict t), (m, t), noexcept)
-CNCD_COUNTED_LOCK(pthread_mutex_clocklock,
-                  (pthread_mutex_t* __restrict m, clockid_t c, const timespec* __restrict t),
-                  (m, c, t), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_rdlock, (pthread_rwlock_t * l), (l), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_wrlock, (pthread_rwlock_t * l), (l), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_tryrdlock, (pthread_rwlock_t * l), (l), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_trywrlock, (pthread_rwlock_t * l), (l), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_timedrdlock,
-                  (pthread_rwlock_t* __restrict l, const timespec* __restrict t), (l, t), noexcept)
-CNCD_COUNTED_LOCK(pthread_rwlock_timedwrlock,
-                  (pthread_rwlock_t* __restrict l, const timespec* __restrict t), (l, t), noexcept)
-CNCD_COUNTED_LOCK(pthread_spin_lock, (pthread_spinlock_t * l), (l), noexcept)
-CNCD_COUNTED_LOCK(sem_wait, (sem_t * s), (s), )
-CNCD_COUNTED_LOCK(sem_trywait, (sem_t * s), (s), noexcept)
-CNCD_COUNTED_LOCK(sem_timedwait, (sem_t* __restrict s, const timespec* __restrict t), (s, t), )
-#undef CNCD_COUNTED_LOCK
-#endif
+namespace rt_hooks = cncd::test::rt_hooks;
 
 namespace cncd::motion {
 namespace {
@@ -178,9 +42,9 @@ class Rig {
 
   void cycles(int n) {
     for (int i = 0; i < n; ++i) {
-      t_in_period = true;
+      rt_hooks::in_period = true;
       loop_->cycle(0);
-      t_in_period = false;
+      rt_hooks::in_period = false;
       ++periods_;
       Event event;
       while (loop_->events().pop(event))
@@ -304,7 +168,8 @@ struct Counted {
   long locks;
 };
 Counted take_counts() {
-  return {g_period_allocs.exchange(0), g_period_frees.exchange(0), g_period_locks.exchange(0)};
+  return {rt_hooks::period_allocs.exchange(0), rt_hooks::period_frees.exchange(0),
+          rt_hooks::period_locks.exchange(0)};
 }
 
 #define EXPECT_PERIODS_RT_SAFE(phase)                                                         \
@@ -419,10 +284,10 @@ class RtAllocation : public ::testing::Test {
 TEST_F(RtAllocation, TheCountingHookSeesAnAllocationInThePeriod) {
   // The hook itself works: an allocation with the flag set is counted.
   take_counts();
-  t_in_period = true;
+  rt_hooks::in_period = true;
   auto* p = new std::vector<int>(3);
   delete p;
-  t_in_period = false;
+  rt_hooks::in_period = false;
   const Counted counted = take_counts();
   EXPECT_EQ(counted.allocs, 2);
   EXPECT_EQ(counted.frees, 2);
@@ -435,14 +300,14 @@ TEST_F(RtAllocation, TheCountingHookSeesALockInThePeriod) {
   sem_t semaphore;
   ASSERT_EQ(sem_init(&semaphore, 0, 2), 0);
   take_counts();
-  t_in_period = true;
+  rt_hooks::in_period = true;
   { const std::lock_guard guard(mutex); }
   if (mutex.try_lock()) mutex.unlock();
   { const std::shared_lock reading(shared); }
   { const std::unique_lock writing(shared); }
   sem_wait(&semaphore);
   sem_trywait(&semaphore);
-  t_in_period = false;
+  rt_hooks::in_period = false;
   sem_destroy(&semaphore);
   const Counted counted = take_counts();
   EXPECT_EQ(counted.locks, 6);
