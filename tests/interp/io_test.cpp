@@ -14,31 +14,14 @@
 #include <variant>
 #include <vector>
 
+#include "canon_recorder.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/interp/rs274_printer.hpp"
 
 namespace cncd::interp {
 namespace {
 
-struct Recorder final : CanonSink {
-  void emit(const CanonCommand& command) override { commands.push_back(command); }
-  template <class T>
-  std::vector<T> all() const {
-    std::vector<T> found;
-    for (const auto& c : commands) {
-      if (const auto* op = std::get_if<T>(&c.op)) found.push_back(*op);
-    }
-    return found;
-  }
-  // The messages of (DEBUG,...) comments, in order.
-  std::vector<std::string> messages() const {
-    std::vector<std::string> texts;
-    for (const auto& m : all<Message>())
-      texts.push_back(m.text);
-    return texts;
-  }
-  std::vector<CanonCommand> commands;
-};
+using Recorder = test_support::CanonRecorder;
 
 Recorder run(const std::string& program, InterpOptions options = {}) {
   Interpreter interp(std::move(options));

@@ -12,30 +12,16 @@
 #include <variant>
 #include <vector>
 
+#include "canon_recorder.hpp"
 #include "cncd/interp/interpreter.hpp"
 
 namespace cncd::interp {
 
-struct Recorder final : CanonSink {
+struct Recorder final : test_support::CanonRecorder {
   void emit(const CanonCommand& command) override {
-    commands.push_back(command);
+    CanonRecorder::emit(command);
     if (std::holds_alternative<StraightProbe>(command.op)) probed = true;
   }
-  template <class T>
-  std::vector<T> all() const {
-    std::vector<T> found;
-    for (const auto& c : commands) {
-      if (const auto* op = std::get_if<T>(&c.op)) found.push_back(*op);
-    }
-    return found;
-  }
-  std::vector<std::string> messages() const {
-    std::vector<std::string> texts;
-    for (const auto& m : all<Message>())
-      texts.push_back(m.text);
-    return texts;
-  }
-  std::vector<CanonCommand> commands;
   bool probed = false;  // a StraightProbe since the caller last looked
 };
 
