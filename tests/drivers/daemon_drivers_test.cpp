@@ -362,12 +362,9 @@ TEST(DriversEndToEnd, ARigidTapRunsOnAModbusServoSpindle) {
                                         "G1 X20 F600\nM5\nM2\n")
                                   .string();
   DaemonProcess daemon;
-  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
   daemon::Client client;
-  ASSERT_EQ(client.connect(daemon.socket()), "");
-  make_ready(client, daemon);
-  result(client.call("program.open", {{"path", program}}));
-  result(client.call("program.run"));
+  run_on_new_daemon(daemon, client, dir, ini, program);
+  if (::testing::Test::HasFatalFailure()) return;
   // Judged by the outcome and the drive, not status polls that a loaded machine may delay.
   const json end = wait_for(client, daemon, 60, [&](const json& s) {
     return s["exec"] == "idle" && s["program"]["result"] != "";

@@ -43,12 +43,9 @@ void feeds_wait_for_the_reversal(const VfdMap& map, const std::string& position_
                                         "M4 S800\nG1 X20 F600\nM5\nM2\n")
                                   .string();
   DaemonProcess daemon;
-  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
   daemon::Client client;
-  ASSERT_EQ(client.connect(daemon.socket()), "");
-  make_ready(client, daemon);
-  result(client.call("program.open", {{"path", program}}));
-  result(client.call("program.run"));
+  run_on_new_daemon(daemon, client, dir, ini, program);
+  if (::testing::Test::HasFatalFailure()) return;
   // The first status that shows the second feed under way, and when it was read: the feed
   // started before that.
   std::int64_t seen_moving_ns = 0;

@@ -60,6 +60,17 @@ inline void make_ready(daemon::Client& client, const DaemonProcess& daemon) {
   });
 }
 
+// cncd started on `ini` in `dir` with `client` connected, the machine made ready and
+// `program` running. A failure is reported (ASSERT); the caller checks HasFatalFailure().
+inline void run_on_new_daemon(DaemonProcess& daemon, daemon::Client& client, const TempDir& dir,
+                              const std::string& ini, const std::string& program) {
+  ASSERT_EQ(daemon.start(dir.path(), {"--ini", ini}), "");
+  ASSERT_EQ(client.connect(daemon.socket()), "");
+  make_ready(client, daemon);
+  result(client.call("program.open", {{"path", program}}));
+  result(client.call("program.run"));
+}
+
 // The example INI with its files redirected into `dir`.
 inline std::string adapt(const TempDir& dir, const std::string& name,
                          const std::vector<std::pair<std::string, std::string>>& replace) {
