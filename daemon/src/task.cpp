@@ -211,6 +211,7 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
   interp_->set_machine_position(position);
   feeder_->start_program(&status.commanded, mode == Mode::mdi);
+  feeder_->tool = interp_->state().tool_in_spindle;
   path_errors_base_ = status.path_errors;
   input_wait_pending_ = false;
   input_waits_seen_ = status.input_waits;
@@ -233,6 +234,7 @@ void Task::start_run(Mode mode, const motion::Status& status) {
 void Task::finish_program(const std::string& ended, const std::string& why) {
   user_m_.stop();
   user_m_hold_ = 0;
+  untake_tool_changes(ended == "done");
   // Offsets and tool data set by the program or MDI (G10, G92 ...) survive a crash or power
   // loss; those that cannot be saved are not kept, and the run says so.
   std::string result = ended;

@@ -96,6 +96,8 @@ class Task {
   // on. Throws TaskError: wrong_state when no tool change is waited for, bad_value when the
   // change waiting is for another tool.
   void tool_change_done(int tool);
+  // At the end of a run: the tool put back as the machine has it (task_io.cpp).
+  void untake_tool_changes(bool ended_as_written);
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 

@@ -1,5 +1,7 @@
 // The spindle, outputs and holds of a running program: tool changes the operator answers,
 // user M codes run for the path, and what status shows of them.
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -78,6 +80,30 @@ void Task::tool_change_done(int tool) {
   events_.add("info", "tool", fmt::format("tool T{} put in", wanted));
   motion_.release_hold(s.wait.hold_id);
   if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
+}
+
+// A run that ends before an M6 it read was carried out leaves in the spindle the tool that was
+// there before that change, whatever the interpreter read after it; so does one that ends
+// while it skips the lines before the one it runs from. A run that ended as written has made
+// every change it read.
+void Task::untake_tool_changes(bool ended_as_written) {
+  const auto first = std::find_if(feeder_->holds.begin(), feeder_->holds.end(), [](const auto& h) {
+    return h.second.kind == motion::IoAction::Hold::tool_change;
+  });
+  const int read = interp_->state().tool_in_spindle;
+  const int in_spindle = ended_as_written                ? read
+                         : first != feeder_->holds.end() ? first->second.tool_before
+                         : skip_to_line_ > 0             ? tool_at_start_
+                                                         : read;
+  for (auto it = feeder_->holds.begin(); it != feeder_->holds.end();) {
+    it = it->second.kind == motion::IoAction::Hold::tool_change ? feeder_->holds.erase(it)
+                                                                : std::next(it);
+  }
+  if (in_spindle == read) return;
+  interp_->set_tool_in_spindle(in_spindle);
+  events_.add("warning", "tool",
+              fmt::format("the run ended before its tool change was made: T{} is in the spindle",
+                          in_spindle));
 }
 
 bool Task::poll_holds(const motion::Status& s) {

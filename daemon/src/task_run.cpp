@@ -44,6 +44,7 @@ bool Task::skip_before_start(bool program_ended) {
       skip_moved_ = true;
     }
     feeder_->pending.clear();
+    feeder_->holds.clear();      // the tool changes and user M codes of the lines skipped
     feeder_->stop_seen = false;  // M0/M1 before the line do not stop a run from line
     return true;
   }
@@ -59,7 +60,8 @@ bool Task::skip_before_start(bool program_ended) {
   // A skipped M6 (or M61) left another tool in force than the one in the spindle: its length
   // is already in the line's positions, so the operator puts it in before anything moves.
   if (const int in_force = interp_->state().tool_in_spindle; in_force != tool_at_start_)
-    feeder_->change_tool_first(in_force, interp_->current_line(), motion_.status().commanded);
+    feeder_->change_tool_first(in_force, interp_->current_line(), motion_.status().commanded,
+                               tool_at_start_);
   skip_to_line_ = 0;
   return true;
 }

@@ -264,6 +264,7 @@ struct Interpreter::Impl {
   void load_coord_system(int index);
   void change_units(Units units);
   void apply_tool_length(int code);
+  Pose table_offset(const ToolEntry& entry) const;
   Pose machine_to_program(const Pose& machine) const;
   Pose program_to_machine(const Pose& program) const;
 
@@ -327,6 +328,7 @@ struct Interpreter::Impl {
   bool seen_percent_ = false;
   bool resend_g5x_ = false;  // set_coord_system_origin() changed the active system's origin
   bool resend_g92_ = false;  // restore_persistent_parameters() may have changed the G92 offset
+  bool resend_tool_offset_ = false;  // set_tool_in_spindle() changed the tool length offset
 
   ModalState modal_;
   int previous_motion_ = -1;  // the motion mode before the current block

@@ -165,7 +165,8 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
   sink_ = &sink;
   try {
     if (sources_.empty()) fail("No program open");
-    if (!preamble_done_) {
+    const bool first = !preamble_done_;
+    if (first) {
       emit_preamble();
       run_startup_code();
     } else if (resend_g5x_) {
@@ -174,8 +175,11 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
       if (resend_g92_) emit_g92();
       emit(SetXyRotation{rotation_deg_});
     }
+    // So is a tool length offset taken again for the tool in the spindle.
+    if (resend_tool_offset_ && !first) emit(UseToolLengthOffset{tool_offset_});
     resend_g5x_ = false;
     resend_g92_ = false;
+    resend_tool_offset_ = false;
     read_probe_result();  // LinuxCNC reads the probe's result before the input's
     read_input_result();
     LineSource& source = sources_.back();

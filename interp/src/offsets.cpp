@@ -124,6 +124,17 @@ void Interpreter::Impl::change_units(Units units) {
   emit(UseLengthUnits{units});
 }
 
+// The table's length offsets of `entry` in the program's units.
+Pose Interpreter::Impl::table_offset(const ToolEntry& entry) const {
+  Pose offset{};
+  const double factor = unit_factor(tool_table_units(), modal_.units);
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const double value = entry.offset[static_cast<std::size_t>(axis)];
+    offset[static_cast<std::size_t>(axis)] = is_linear_axis(axis) ? value * factor : value;
+  }
+  return offset;
+}
+
 void Interpreter::Impl::apply_tool_length(int code) {
   Pose offset{};
   if (code == 430) {
@@ -134,13 +145,7 @@ void Interpreter::Impl::apply_tool_length(int code) {
         fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
              block_.col('h'));
       }
-      if (entry != nullptr) {
-        const double factor = unit_factor(tool_table_units(), modal_.units);
-        for (int axis = 0; axis < kAxes; ++axis) {
-          const double value = entry->offset[static_cast<std::size_t>(axis)];
-          offset[static_cast<std::size_t>(axis)] = is_linear_axis(axis) ? value * factor : value;
-        }
-      }
+      if (entry != nullptr) offset = table_offset(*entry);
     }
   } else if (code == 431) {
     // G43.1 replaces the offsets of the axes it names and keeps the others.
@@ -227,6 +232,23 @@ void Interpreter::Impl::do_g92(int code) {
   for (std::size_t axis = 0; axis < kAxes; ++axis)
     pos_[axis] += old_offset[axis] - g92_offset_[axis];
   emit_g92();
+}
+
+void Interpreter::set_tool_in_spindle(int tool) {
+  Impl& s = *impl_;
+  const Pose machine = s.program_to_machine(s.pos_);
+  s.tool_in_spindle_ = tool;
+  if (s.modal_.tool_length_code == 430) {
+    const ToolEntry* entry = tool != 0 ? s.tools_.find(tool) : nullptr;
+    s.tool_offset_ = entry != nullptr ? s.table_offset(*entry) : Pose{};
+    s.resend_tool_offset_ = true;
+    for (int axis = 0; axis < kAxes; ++axis) {
+      const auto a = static_cast<std::size_t>(axis);
+      s.tool_offset_machine_[a] =
+          is_linear_axis(axis) ? s.to_machine_units(s.tool_offset_[a]) : s.tool_offset_[a];
+    }
+  }
+  s.pos_ = s.machine_to_program(machine);
 }
 
 }  // namespace cncd::interp

@@ -97,7 +97,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   };
   auto hold = [&](HoldInfo info) { add_hold(std::move(info), m.line); };
   auto tool_change = [&](int number) {
-    queue_tool_change(number, m.line);
+    queue_tool_change(number, m.line, tool);
     return false;
   };
   auto moving = [&](motion::Move& next) {

@@ -16,7 +16,7 @@ void ProgramFeeder::add_hold(HoldInfo info, int line) {
   add_action(a, line);
 }
 
-void ProgramFeeder::queue_tool_change(int number, int line) {
+void ProgramFeeder::queue_tool_change(int number, int line, int before) {
   tool = number;
   const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
   if (change != nullptr && change->has_position) {
@@ -37,10 +37,12 @@ void ProgramFeeder::queue_tool_change(int number, int line) {
   HoldInfo info;
   info.kind = motion::IoAction::Hold::tool_change;
   info.tool = number;
+  info.tool_before = before;
   add_hold(std::move(info), line);
 }
 
-void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPose& at) {
+void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPose& at,
+                                      int in_spindle) {
   std::deque<motion::Move> rest;
   rest.swap(pending);
   const motion::AxisPose end = end_;
@@ -50,7 +52,7 @@ void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPo
     stop.kind = motion::IoAction::Kind::spindle;
     add_action(stop, line);
   }
-  queue_tool_change(number, line);
+  queue_tool_change(number, line, in_spindle);
   end_ = end;
   pending.insert(pending.end(), rest.begin(), rest.end());
 }

@@ -196,6 +196,24 @@ TEST_F(ToolChange, RunFromLinePastAnM6ChangesToThatToolFirst) {
   EXPECT_EQ(done["position"]["commanded"]["z"], 26.0);
 }
 
+// The length G43 applies after an aborted run is that of the tool in the spindle, never of a
+// tool the run read of but never got: else the next move goes to the wrong height.
+TEST_F(ToolChange, AnAbortedRunFromLineLeavesTheToolThatIsIn) {
+  ready_machine();
+  mdi("G43");  // T0: no length
+  const auto path =
+      dir_.write("from.ngc", "G21 G90\nG0 X0 Y0 Z50\nT3 M6\nG43 H3\nG0 X10 Z1\nG0 X20\nM2\n");
+  result_of(call("program.open", {{"path", path.string()}}));
+  result_of(call("program.run", {{"from_line", 5}}));
+  wait_until([](const json& s) { return waiting_for_tool(s) || s["exec"] == "idle"; });
+  result_of(call("program.abort"));
+  const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["tool"]["number"], 0) << s["tool"].dump();
+  EXPECT_EQ(s["tool"]["length_offset"]["z"], 0.0) << s["tool"].dump();
+  mdi("G0 Z5");
+  EXPECT_EQ(status()["position"]["commanded"]["z"], 5.0);
+}
+
 TEST_F(ToolChange, AbortDuringTheWaitStopsCleanly) {
   ready_machine();
   start_program("change.ngc", kProgram);
@@ -208,6 +226,10 @@ TEST_F(ToolChange, AbortDuringTheWaitStopsCleanly) {
   EXPECT_EQ(s["coolant"]["flood"], false);
   EXPECT_EQ(s["position"]["commanded"]["x"], 0.0);
   EXPECT_EQ(error_code(call("tool.change_done", {{"tool", 3}})), 1001);
+  // T3 was never put in: the tool in the spindle, and the length G43 applies, are as before.
+  EXPECT_EQ(s["tool"]["number"], 0) << s["tool"].dump();
+  mdi("G43 G0 Z0");
+  EXPECT_EQ(status()["position"]["commanded"]["z"], 0.0);
 }
 
 TEST_F(ToolChange, CncctlRunPromptsAndEnterAnswers) {

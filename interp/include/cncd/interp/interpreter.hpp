@@ -219,6 +219,11 @@ class Interpreter {
   // (tool_entry_problem()): returns why, and nothing changes.
   std::optional<std::string> set_tool(const ToolEntry& entry);
 
+  // The tool the machine has in its spindle, when it is not the one the interpreter last read
+  // of (a run aborted before an M6 it had read ahead was carried out). A tool length offset
+  // from the table (G43) is taken again for that tool; G43.1 and G49 stay. The machine
+  // position stays where it is. Call between programs only.
+  void set_tool_in_spindle(int tool);
   // Replaces the whole tool table (a copy tools() gave), e.g. to put back what its file holds
   // when it could not be written. Call between programs only.
   void set_tools(const std::vector<ToolEntry>& tools);

@@ -41,6 +41,7 @@ struct HoldInfo {
   motion::IoAction::Hold kind = motion::IoAction::Hold::none;
   int line = 0;
   int tool = 0;            // tool_change: the tool to put in
+  int tool_before = 0;     // tool_change: the tool in force before it, until it is put in
   interp::UserMCode user;  // user_m: what to run
 };
 
@@ -80,8 +81,9 @@ class ProgramFeeder final : public interp::CanonSink {
   // Run from line: the tool the skipped lines left in force is not the one in the spindle.
   // Puts that tool change in front of the pending moves as an M6 makes it (the spindle
   // stopped unless TOOL_CHANGE_WITH_SPINDLE_ON, the traverse to TOOL_CHANGE_POSITION, the
-  // hold for the operator); `at` is where the machine stands (machine coordinates).
-  void change_tool_first(int number, int line, const motion::AxisPose& at);
+  // hold for the operator); `at` is where the machine stands (machine coordinates), `in_spindle`
+  // the tool it has.
+  void change_tool_first(int number, int line, const motion::AxisPose& at, int in_spindle);
   // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
   // planner is flushed there.
   static bool stop_point(const motion::Move& move) {
@@ -132,7 +134,7 @@ class ProgramFeeder final : public interp::CanonSink {
   // Queues a hold the task answers, remembering what it waits for under its id.
   void add_hold(HoldInfo info, int line);
   // Queues M6's tool change to `number`: the traverse to the tool change position, the hold.
-  void queue_tool_change(int number, int line);
+  void queue_tool_change(int number, int line, int before);
   // The spindle as the program sets it now.
   motion::IoAction spindle_action() const;
   const config::MachineConfig* machine_ = nullptr;
