@@ -97,8 +97,8 @@ class Server {
     std::size_t stop_scanned = 0;             // bytes of `in` already searched for a stop
     std::optional<RpcDispatcher::Line> line;  // a line served in part
     std::string out;
-    // Bytes of `out` the client asked for in one large answer (program.preview): they count
-    // against kMaxBacklogBytes only once the client has read them.
+    // Bytes of `out` the client asked for in one large answer (program.preview): the largest
+    // such answer may wait beyond kMaxBacklogBytes until the client has read it.
     std::size_t asked_bytes = 0;
     // Reads no more; closed once `out` is flushed and no deferred answer is owed, or when
     // `out` is still unsent at `close_by`.

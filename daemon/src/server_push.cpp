@@ -131,7 +131,9 @@ void Server::deliver_completions() {
         client.out += R"(,"jsonrpc":"2.0","result":)";
         client.out += *done.raw_result;
         client.out += "}\n";
-        client.asked_bytes += done.raw_result->size();
+        // One such answer may wait beyond the backlog, not one per ask: a client asking again
+        // and again without reading is cut off as any other.
+        client.asked_bytes = std::max(client.asked_bytes, done.raw_result->size());
         open.erase(it);
         write_client(client);
         break;

@@ -106,7 +106,7 @@ TEST_F(PreviewDaemon, ABatchMayNotAskForAPreview) {
 
 TEST_F(PreviewDaemon, AStopIsAnsweredWhileALargePreviewIsWorkedOut) {
   ready_machine();
-  open(dir_.write("surface.ngc", surface(200, 500)));
+  open(dir_.write("surface.ngc", surface(100, 200)));
   const int asker = ask_preview(daemon_.socket(), 7);
   ASSERT_GE(asker, 0);
   result_of(call("jog.start", {{"axis", "X"}, {"velocity", 20}}));
@@ -120,13 +120,13 @@ TEST_F(PreviewDaemon, AStopIsAnsweredWhileALargePreviewIsWorkedOut) {
   ASSERT_TRUE(reply.contains("result")) << reply.dump();
   const json preview = reply["result"];
   EXPECT_EQ(preview["complete"], true);
-  EXPECT_GT(preview["source_points"].get<int>(), 100'000);
-  EXPECT_LT(preview["points"].get<int>(), 50'000);
-  EXPECT_EQ(preview["extents"]["X"], json({0.0, 74.85}));
+  EXPECT_GT(preview["source_points"].get<int>(), 20'000);
+  EXPECT_LT(preview["points"].get<int>(), 20'000);
+  EXPECT_EQ(preview["extents"]["X"], json({0.0, 29.85}));
 }
 
 TEST_F(PreviewDaemon, OpeningAnotherProgramCancelsTheOneWaitedFor) {
-  open(dir_.write("surface.ngc", surface(200, 500)));
+  open(dir_.write("surface.ngc", surface(100, 200)));
   const int asker = ask_preview(daemon_.socket(), 8);
   ASSERT_GE(asker, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
