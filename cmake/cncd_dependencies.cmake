@@ -8,3 +8,6 @@ find_package(OpenSSL 3 REQUIRED)  # libcrypto: base64 of binary payloads
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
 pkg_check_modules(GPIOD REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
+# cncd-web: HTTP and WebSocket from Boost.Beast (header-only), passwords hashed with argon2id.
+find_package(Boost 1.81 REQUIRED)
+pkg_check_modules(ARGON2 REQUIRED IMPORTED_TARGET libargon2)

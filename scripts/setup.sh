@@ -4,11 +4,17 @@
 set -euo pipefail
 
 packages=(cmake ninja-build g++ pkg-config libmodbus-dev libgpiod-dev libspdlog-dev
-          nlohmann-json3-dev libssl-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache)
-if [[ "${1:-}" == "--with-oracle" ]]; then
-  # LinuxCNC's standalone interpreter, used by the differential tests when present.
-  packages+=(linuxcnc-uspace)
-fi
+          nlohmann-json3-dev libssl-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache
+          libboost1.81-dev libargon2-dev libjs-three)
+for option in "$@"; do
+  case "$option" in
+    # LinuxCNC's standalone interpreter, used by the differential tests when present.
+    --with-oracle) packages+=(linuxcnc-uspace) ;;
+    # The browser the web page's tests drive.
+    --with-browser) packages+=(chromium chromium-driver python3-selenium) ;;
+    *) echo "setup: unknown option '$option'" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

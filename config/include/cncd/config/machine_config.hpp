@@ -229,6 +229,28 @@ struct CncdConfig {
   std::filesystem::path probe_dir;
 };
 
+// [WEB]: cncd-web, the browser dashboard and WebSocket proxy (docs/web.md).
+struct WebConfig {
+  std::string listen = "127.0.0.1";  // address to bind; any other than loopback is explicit
+  int port = 8080;
+  // Where uploads go and programs are listed from; absolute, one of program_dirs. Default:
+  // the first of program_dirs.
+  std::filesystem::path program_dir;
+  std::int64_t max_upload_bytes = 64LL << 20;  // MAX_UPLOAD_MB
+  // Users, roles, password hashes and API key hashes; absolute. Default: web-users in the
+  // state directory.
+  std::filesystem::path users_file;
+  // TLS: both or neither; absolute.
+  std::filesystem::path tls_cert;
+  std::filesystem::path tls_key;
+  // Origins besides the page's own that a browser's WebSocket may come from (e.g. the address
+  // nginx serves the page at), "scheme://host[:port]".
+  std::vector<std::string> allowed_origins;
+  int session_hours = 12;       // a login's lifetime
+  int max_clients = 64;         // WebSocket connections at once
+  double jog_heartbeat_s = 0.25;  // a continuous jog stops this long after its last heartbeat
+};
+
 struct MachineConfig {
   std::filesystem::path path;  // the INI file as given
   std::string machine_name;    // [EMC] MACHINE
@@ -289,6 +311,7 @@ struct MachineConfig {
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
+  WebConfig web;
   SpindleConfig spindle;  // [SPINDLE_0]
   ToolChangeConfig tool_change;
   IoConfig io;
