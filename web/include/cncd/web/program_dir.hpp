@@ -4,6 +4,8 @@
 // unlinkat), so replacing the directory's path by a symlink later cannot redirect a write.
 #pragma once
 
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -85,6 +87,7 @@ class ProgramDir;
 // One upload in progress: an anonymous file in the program directory (O_TMPFILE; where the
 // filesystem has none, a hidden ".cncd-upload-*" file that list() skips), which becomes a
 // program only by commit(). Destroyed or aborted without commit, it leaves nothing behind.
+// It must not outlive the ProgramDir that started it.
 class Upload {
  public:
   ~Upload();
@@ -165,6 +168,10 @@ class ProgramDir {
 
  private:
   friend class Upload;
+  // lstat of `name` in the directory: not_found, io, or ok.
+  FileStatus lstat_entry(std::string_view name, struct stat& st) const;
+  // `running` when `name` is the running program, else ok.
+  FileStatus refuse_running(std::string_view name, const std::filesystem::path& running) const;
 
   std::filesystem::path path_;
   std::int64_t max_upload_bytes_;
