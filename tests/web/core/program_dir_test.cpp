@@ -256,6 +256,22 @@ TEST_P(ProgramDirTest, ASwappedDirectoryPathDoesNotRedirectWrites) {
   EXPECT_EQ(*resolved, fs::canonical(dir_ / "moved/p.ngc"));
 }
 
+TEST_P(ProgramDirTest, WhatACrashedUploadLeftIsRemovedAfterAnHour) {
+  const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(2);
+  for (const std::string name : {".cncd-upload-0011223344556677", ".cncd-upload-8899aabbccddeeff",
+                                 ".other-hidden", "program.ngc"}) {
+    write(programs_ / name, "x");
+  }
+  for (const std::string name : {".cncd-upload-0011223344556677", ".other-hidden", "program.ngc"}) {
+    fs::last_write_time(programs_ / name, old_time);
+  }
+  ProgramDir dir = open();
+  EXPECT_EQ(names(programs_), (std::set<std::string>{".cncd-upload-8899aabbccddeeff",
+                                                     ".other-hidden", "program.ngc"}));
+  EXPECT_EQ(dir.remove_stale_uploads(std::chrono::seconds(0)), 1);
+  EXPECT_EQ(names(programs_), (std::set<std::string>{".other-hidden", "program.ngc"}));
+}
+
 TEST(ProgramDirOpenTest, AMissingDirectorySaysSo) {
   ProgramDir dir("/nonexistent/programs", 10);
   EXPECT_FALSE(dir.ok());

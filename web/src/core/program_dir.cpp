@@ -40,7 +40,30 @@ ProgramDir::ProgramDir(std::filesystem::path dir, std::int64_t max_upload_bytes)
   dir_fd_.reset(::open(path_.c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC));
   if (!dir_fd_) {
     open_error_ = path_.string() + ": cannot open the program directory: " + errno_text(errno);
+    return;
   }
+  remove_stale_uploads(std::chrono::hours(1));
+}
+
+int ProgramDir::remove_stale_uploads(std::chrono::seconds age) const {
+  const int fd = dir_fd_ ? ::openat(dir_fd_.get(), ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC) : -1;
+  DIR* dir = fd >= 0 ? ::fdopendir(fd) : nullptr;
+  if (dir == nullptr) {
+    if (fd >= 0) ::close(fd);
+    return 0;
+  }
+  const auto now = std::chrono::system_clock::now();
+  int removed = 0;
+  while (const dirent* e = ::readdir(dir)) {
+    if (!std::string_view(e->d_name).starts_with(kUploadPrefix)) continue;
+    struct stat st {};
+    if (::fstatat(::dirfd(dir), e->d_name, &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(st.st_mode) &&
+        to_time_point(st.st_mtim) + age <= now && ::unlinkat(::dirfd(dir), e->d_name, 0) == 0) {
+      ++removed;
+    }
+  }
+  ::closedir(dir);
+  return removed;
 }
 
 FileStatus ProgramDir::lstat_entry(std::string_view name, struct stat& st) const {

@@ -11,6 +11,9 @@
 
 namespace cncd::web {
 
+// The start of the hidden names uploads are written under.
+inline constexpr std::string_view kUploadPrefix = ".cncd-upload-";
+
 std::string errno_text(int error);
 std::chrono::system_clock::time_point to_time_point(const struct timespec& ts);
 FileStatus fail(FileError error, std::string message);

@@ -13,7 +13,7 @@ namespace cncd::web {
 namespace {
 
 std::string hidden_name() {
-  return ".cncd-upload-" + crypto::hex(crypto::random_bytes(8));
+  return std::string(kUploadPrefix) + crypto::hex(crypto::random_bytes(8));
 }
 
 }  // namespace

@@ -127,6 +127,7 @@ struct ReadableFile {
 class ProgramDir {
  public:
   // Opens `dir` (which should be absolute and a directory); ok() says whether it could.
+  // Removes what uploads cut short by a crash left (remove_stale_uploads, an hour old).
   ProgramDir(std::filesystem::path dir, std::int64_t max_upload_bytes);
 
   // "" when the directory is open, else why not (the server refuses to start).
@@ -158,6 +159,10 @@ class ProgramDir {
   // with the name's real path, which must stay inside the directory (a symlink inside that
   // points outside is refused: outside) and be a regular file.
   std::optional<std::filesystem::path> resolve(std::string_view name, FileStatus& status) const;
+
+  // Removes the hidden files of uploads (".cncd-upload-*") not written to for `age`: what a
+  // crash between writing and renaming leaves. Returns how many.
+  int remove_stale_uploads(std::chrono::seconds age) const;
 
   // True when `name` in this directory is the `running` program: the same path, or the same
   // file (device and inode) reached another way.
