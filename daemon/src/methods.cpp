@@ -64,8 +64,13 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
   });
   dispatcher.add("system.info", [&config](const json&) {
     json axes = json::array();
+    json limits = json::object();
     for (std::size_t i = 0; i < config::kAxisLetters.size(); ++i) {
-      if (config.axes[i].present) axes.push_back(std::string(1, config::kAxisLetters[i]));
+      if (!config.axes[i].present) continue;
+      const std::string letter(1, config::kAxisLetters[i]);
+      axes.push_back(letter);
+      limits[std::string(1, static_cast<char>(config::kAxisLetters[i] - 'A' + 'a'))] = {
+          config.axes[i].min_limit, config.axes[i].max_limit};
     }
     json drivers = json::array();
     for (const auto& joint : config.joints)
@@ -79,7 +84,12 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                   {"axes", axes},
                   {"joints", config.joints.size()},
                   {"drivers", drivers},
-                  {"servo_period_ns", config.servo_period_ns}}}};
+                  {"servo_period_ns", config.servo_period_ns},
+                  {"soft_limits", limits},
+                  {"overrides",
+                   {{"max_feed", config.max_feed_override},
+                    {"min_spindle", config.min_spindle_override},
+                    {"max_spindle", config.max_spindle_override}}}}}};
   });
   const auto selected = [](const json& params, const json& status) {
     const auto fields = field_list(params);

@@ -153,6 +153,7 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
         {"actual", axes_object(config, s.work_actual)}}},
       {"velocity", s.velocity},
       {"distance_to_go", s.distance_to_go},
+      {"axes_to_go", axes_object(config, s.axes_to_go)},
       {"overrides",
        {{"feed", s.feed_override},
         {"rapid", s.rapid_override},

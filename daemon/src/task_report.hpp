@@ -149,6 +149,7 @@ struct TaskStatus {
   motion::AxisPose work_actual{};
   double velocity = 0;
   double distance_to_go = 0;
+  motion::AxisPose axes_to_go{};  // per axis, of the segment being executed
   double feed_override = 1.0;
   double rapid_override = 1.0;
   ProgramReport program;

@@ -215,6 +215,7 @@ TaskStatus Task::status() const {
   out.position_restored = position_restored_;
   out.velocity = s.velocity;
   out.distance_to_go = s.distance_to_go;
+  out.axes_to_go = s.axes_to_go;
   out.feed_override = s.feed_override;
   out.rapid_override = s.rapid_override;
 

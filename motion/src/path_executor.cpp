@@ -314,9 +314,9 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
     finish_front();
   }
   velocity_ = path_v_;
-  distance_to_go_ = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell
-                        ? window_at(head_seq_).length - path_s_
-                        : 0.0;
+  has_segment_end_ = has_active_ && window_at(head_seq_).kind != Segment::Kind::dwell;
+  distance_to_go_ = has_segment_end_ ? window_at(head_seq_).length - path_s_ : 0.0;
+  if (has_segment_end_) segment_end_ = window_at(head_seq_).end;
   if (abort_requested_ && at_rest(path_v_)) {
     flush();
     motion_ = MotionState::idle;

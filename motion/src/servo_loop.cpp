@@ -150,6 +150,7 @@ void ServoLoop::stop_now(MachineState next) noexcept {
   status_.motion = MotionState::idle;
   status_.velocity = 0;
   status_.distance_to_go = 0;
+  status_.axes_to_go = {};
 }
 
 void ServoLoop::apply(const Command& command) noexcept {
@@ -276,6 +277,9 @@ void ServoLoop::advance_path() noexcept {
   status_.line = path_.line();
   status_.velocity = path_.velocity();
   status_.distance_to_go = path_.distance_to_go();
+  const AxisPose* end = path_.segment_end();
+  for (std::size_t i = 0; i < status_.axes_to_go.size(); ++i)
+    status_.axes_to_go[i] = end != nullptr ? (*end)[i] - axis_pose_[i] : 0.0;
   status_.motion = path_.motion();
   if (result.fault == PathExecutor::Fault::joints_apart) {
     RtEvent fault;

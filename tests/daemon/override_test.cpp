@@ -108,11 +108,14 @@ TEST_F(MachineTest, ZeroFeedOverrideHoldsMotionUntilRaised) {
   EXPECT_EQ(s["exec"], "running");
   EXPECT_EQ(s["program"]["result"], "");
   EXPECT_GT(s["distance_to_go"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(s["axes_to_go"]["x"].get<double>(), 20.0 - held_at);
+  EXPECT_EQ(s["axes_to_go"]["y"], 0.0);
   result_of(call("override.feed", {{"value", 1.0}}));
   s = wait_until([](const json& st) { return st["exec"] == "idle"; });
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
   EXPECT_EQ(s["position"]["commanded"]["x"], 20.0);
   EXPECT_EQ(s["distance_to_go"], 0.0);
+  EXPECT_EQ(s["axes_to_go"]["x"], 0.0);
 }
 
 TEST_F(MachineTest, RapidOverrideCapsTraverses) {

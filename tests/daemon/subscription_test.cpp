@@ -157,6 +157,10 @@ TEST_F(SubscriptionTest, SystemInfoDescribesTheMachine) {
   EXPECT_EQ(info["protocol_version"], 1);
   EXPECT_EQ(info["machine"]["axes"], json({"X", "Y", "Z"}));
   EXPECT_EQ(info["machine"]["units"], "mm");
+  // The sim mill's [AXIS_X] MIN_LIMIT and MAX_LIMIT, and its override bounds.
+  const json& x_limits = info["machine"]["soft_limits"]["x"];
+  EXPECT_EQ(x_limits, json({-10.0, 300.0})) << info.dump();
+  EXPECT_EQ(info["machine"]["overrides"]["max_feed"], 1.5);
 }
 
 }  // namespace

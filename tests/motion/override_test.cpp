@@ -85,6 +85,8 @@ TEST(Override, LoweringItSlowsTheMoveUnderWayWithinTheAccelerationLimit) {
   EXPECT_EQ(held.motion, MotionState::moving);
   EXPECT_GT(held.distance_to_go, 0);
   EXPECT_NEAR(held.distance_to_go, 300 - held.commanded[0], 1e-9);
+  EXPECT_NEAR(held.axes_to_go[0], 300 - held.commanded[0], 1e-9);
+  EXPECT_EQ(held.axes_to_go[1], 0);
   m.cycles(100);
   EXPECT_EQ(m.status().commanded, held.commanded);
   set_override(m, Command::Kind::feed_override, 1.2);

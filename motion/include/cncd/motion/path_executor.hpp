@@ -74,6 +74,10 @@ class PathExecutor {
   // What the last advance() left; the line stays that of the last segment executed.
   CNCD_RT double velocity() const noexcept { return velocity_; }
   CNCD_RT double distance_to_go() const noexcept { return distance_to_go_; }
+  // Where the segment being executed ends; null between segments, in a dwell and at rest.
+  CNCD_RT const AxisPose* segment_end() const noexcept {
+    return has_segment_end_ ? &segment_end_ : nullptr;
+  }
   CNCD_RT MotionState motion() const noexcept { return motion_; }
   CNCD_RT std::int32_t line() const noexcept { return line_; }
   // Segments and programmed moves completed or dropped since the start.
@@ -182,6 +186,8 @@ class PathExecutor {
   // What advance() reports.
   double velocity_ = 0;
   double distance_to_go_ = 0;
+  AxisPose segment_end_{};
+  bool has_segment_end_ = false;
   MotionState motion_ = MotionState::idle;
   std::int32_t line_ = 0;
   std::uint64_t segments_done_ = 0;

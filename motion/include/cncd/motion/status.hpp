@@ -120,6 +120,7 @@ struct ServoStatus {
   JointArray joint_actual{};
   double velocity = 0;              // units/s along the path
   double distance_to_go = 0;        // path distance left in the segment being executed
+  AxisPose axes_to_go{};            // that segment's end less the commanded position, per axis
   double feed_override = 1.0;       // applied to feed moves, 0 .. [DISPLAY] MAX_FEED_OVERRIDE
   double rapid_override = 1.0;      // applied to traverses, 0 .. 1
   std::int32_t line = 0;            // source line of the segment being executed
