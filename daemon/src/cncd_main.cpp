@@ -181,6 +181,7 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   register_methods(dispatcher, task, config, events, completions, &status);
   // A command may change what the status shows: the next status.get sees its effect.
   dispatcher.after_command([&status] { status.invalidate(); });
+  dispatcher.record_to(&events);
   const ConnectionLimits limits{static_cast<std::size_t>(config.cncd.max_connections),
                                 static_cast<std::size_t>(config.cncd.max_connections_per_user),
                                 static_cast<std::size_t>(config.cncd.control_reserve)};
