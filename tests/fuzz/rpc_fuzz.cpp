@@ -54,6 +54,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "event_log.hpp"
+#include "jog_heartbeat.hpp"
 #include "methods.hpp"
 #include "rpc.hpp"
 #include "rpc_answers.hpp"
@@ -95,7 +96,7 @@ struct World {
   explicit World(const config::MachineConfig& config) : task(config, events, completions) {
     if (const auto error = task.load_files(); !error.empty()) setup_failure(error);
     if (const auto error = task.start(); !error.empty()) setup_failure(error);
-    daemon::register_methods(dispatcher, task, config, events, completions);
+    daemon::register_methods(dispatcher, task, config, events, completions, heartbeats);
   }
   // A jog or program stops at once rather than under control.
   ~World() { task.estop(); }
@@ -105,6 +106,7 @@ struct World {
   daemon::EventLog events;
   daemon::Completions completions;
   daemon::Task task;
+  daemon::JogHeartbeats heartbeats{task, events};
   daemon::RpcDispatcher dispatcher;
 };
 
