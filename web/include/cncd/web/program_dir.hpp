@@ -4,6 +4,8 @@
 // unlinkat), so replacing the directory's path by a symlink later cannot redirect a write.
 #pragma once
 
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -85,6 +87,7 @@ class ProgramDir;
 // One upload in progress: an anonymous file in the program directory (O_TMPFILE; where the
 // filesystem has none, a hidden ".cncd-upload-*" file that list() skips), which becomes a
 // program only by commit(). Destroyed or aborted without commit, it leaves nothing behind.
+// It must not outlive the ProgramDir that started it.
 class Upload {
  public:
   ~Upload();
@@ -124,6 +127,7 @@ struct ReadableFile {
 class ProgramDir {
  public:
   // Opens `dir` (which should be absolute and a directory); ok() says whether it could.
+  // Removes what uploads cut short by a crash left (remove_stale_uploads, an hour old).
   ProgramDir(std::filesystem::path dir, std::int64_t max_upload_bytes);
 
   // "" when the directory is open, else why not (the server refuses to start).
@@ -156,6 +160,10 @@ class ProgramDir {
   // points outside is refused: outside) and be a regular file.
   std::optional<std::filesystem::path> resolve(std::string_view name, FileStatus& status) const;
 
+  // Removes the hidden files of uploads (".cncd-upload-*") not written to for `age`: what a
+  // crash between writing and renaming leaves. Returns how many.
+  int remove_stale_uploads(std::chrono::seconds age) const;
+
   // True when `name` in this directory is the `running` program: the same path, or the same
   // file (device and inode) reached another way.
   bool is_running(std::string_view name, const std::filesystem::path& running) const;
@@ -165,6 +173,10 @@ class ProgramDir {
 
  private:
   friend class Upload;
+  // lstat of `name` in the directory: not_found, io, or ok.
+  FileStatus lstat_entry(std::string_view name, struct stat& st) const;
+  // `running` when `name` is the running program, else ok.
+  FileStatus refuse_running(std::string_view name, const std::filesystem::path& running) const;
 
   std::filesystem::path path_;
   std::int64_t max_upload_bytes_;

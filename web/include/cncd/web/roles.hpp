@@ -33,7 +33,7 @@ std::optional<Role> required_role(std::string_view method);
 // True when `method` moves the machine and so needs the control lease (machine.home,
 // jog.start, jog.increment, mdi.execute, program.run, program.step); stopping never does.
 bool needs_lease(std::string_view method);
-// Every method `role` may call, in table order; "override.*" stands for each override method.
+// Every method `role` may call, in table order.
 std::vector<std::string> methods(Role role);
 
 // "method X needs role Y; you are Z" (JSON-RPC error 1020's message).

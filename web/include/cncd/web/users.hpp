@@ -103,6 +103,8 @@ class UsersFile {
   const User* check_key(std::string_view key) const;
 
  private:
+  User* entry(std::string_view name);
+
   std::filesystem::path path_;
   PasswordCost cost_;
   std::vector<User> users_;
@@ -115,7 +117,7 @@ class UsersFile {
     std::int64_t mtime_ns = 0;
   };
   Stamp stamp_;
-  std::string dummy_hash_;  // verified against for unknown names
+  mutable std::string dummy_hash_;  // verified against for unknown names
 };
 
 }  // namespace cncd::web
