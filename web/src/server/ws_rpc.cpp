@@ -13,9 +13,8 @@ constexpr int kMethodNotFound = -32601;
 constexpr int kInvalidParams = -32602;
 
 bool is_web_method(std::string_view method) {
-  return method == "web.session" || method.starts_with("lease.") ||
-         method.starts_with("files.") || method.starts_with("users.") ||
-         (!kDaemonJogHeartbeat && method == "jog.heartbeat");
+  return method == "web.session" || method.starts_with("lease.") || method.starts_with("files.") ||
+         method.starts_with("users.") || (!kDaemonJogHeartbeat && method == "jog.heartbeat");
 }
 
 // Methods that only read: they go on without attribution, which cncd accepts only from
@@ -98,6 +97,7 @@ WsRpc::Handled WsRpc::handle(json request) {
       json forward;
       json result = web_method(method, params, forward);
       if (!forward.is_null()) {
+        if (!notification) forward["id"] = id;
         request = std::move(forward);  // files.open: becomes program.open
         params = request["params"];
       } else {
