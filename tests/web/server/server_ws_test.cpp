@@ -138,6 +138,26 @@ TEST_F(WebWsTest, ClosingMidJogStopsTheJog) {
   EXPECT_EQ(status()["position"]["commanded"]["x"], stopped["position"]["commanded"]["x"]);
 }
 
+TEST_F(WebWsTest, AJogWithoutHeartbeatsStopsWhileTheWebSocketStaysOpen) {
+  auto otto = ws("otto");
+  ASSERT_TRUE(has_result(otto->call("lease.take")));
+  ready_machine(*otto);
+  ASSERT_TRUE(has_result(otto->call("jog.start", {{"axis", "X"}, {"velocity", 5.0}})));
+  // Held: heartbeats every 100 ms keep it going past several heartbeat periods (0.25 s).
+  for (int i = 0; i < 10; ++i) {
+    const auto beat = otto->call("jog.heartbeat");
+    ASSERT_TRUE(has_result(beat)) << beat.dump();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_GT(status()["velocity"].get<double>(), 0.0);
+  // The page froze: no more heartbeats, the WebSocket still open.
+  const auto stopped = wait_until(
+      [](const json& s) { return s["velocity"].get<double>() == 0.0 && s["motion"] == "idle"; },
+      std::chrono::seconds(10));
+  EXPECT_LT(stopped["position"]["commanded"]["x"].get<double>(), 290.0);
+  EXPECT_TRUE(has_result(otto->call("status.get")));
+}
+
 TEST_F(WebWsTest, EstopWithoutTheLease) {
   auto otto = ws("otto");
   auto opal = ws("opal");

@@ -67,7 +67,6 @@ json WsRpc::web_method(const std::string& method, const json& params, json& forw
     return lease_holder_json(taken.holder);
   }
   if (method == "lease.release") return {{"released", app_.lease.release(who_.session.id)}};
-  if (method == "jog.heartbeat") return {{"ok", true}};  // cncd without jog heartbeats
   if (method == "files.list") {
     FileStatus status;
     const auto entries = app_.programs.list(status);

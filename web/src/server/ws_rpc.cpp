@@ -14,7 +14,7 @@ constexpr int kInvalidParams = -32602;
 
 bool is_web_method(std::string_view method) {
   return method == "web.session" || method.starts_with("lease.") || method.starts_with("files.") ||
-         method.starts_with("users.") || (!kDaemonJogHeartbeat && method == "jog.heartbeat");
+         method.starts_with("users.");
 }
 
 // Methods that only read: they go on without attribution, which cncd accepts only from
@@ -120,7 +120,9 @@ WsRpc::Handled WsRpc::handle(json request) {
   }
   if (sent == "jog.start" && params.is_object() && params.value("axis", json()).is_string()) {
     jogging_.insert(upper(params["axis"]));
-    if (kDaemonJogHeartbeat) request["params"]["heartbeat_s"] = app_.web.jog_heartbeat_s;
+    // A page that stops sending jog.heartbeat (tab closed, network lost, browser frozen) stops
+    // the jog this long after: cncd does it, also when cncd-web itself is gone.
+    request["params"]["heartbeat_s"] = app_.web.jog_heartbeat_s;
   }
   if (sent == "jog.stop" && params.is_object() && params.value("axis", json()).is_string())
     jogging_.erase(upper(params["axis"]));
