@@ -1,7 +1,12 @@
 #include "web_client.hpp"
 
+#include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <unistd.h>
+
 #include <sys/time.h>
+#include <chrono>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -73,6 +78,39 @@ HttpReply http_request(int port, const std::string& method, const std::string& t
 
 // Reads are asynchronous, run for at most the time asked: asio's blocking reads wait forever
 // whatever SO_RCVTIMEO says. A read that timed out stays pending and is picked up next time.
+RawReply raw_exchange(int port, const std::string& bytes, int timeout_ms) {
+  RawReply reply;
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    close(fd);
+    return reply;
+  }
+  // The server may close before taking it all (a refused request): that is an answer too.
+  (void)send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  char buffer[4096];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          deadline - std::chrono::steady_clock::now())
+                          .count();
+    if (left <= 0) break;
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, static_cast<int>(left)) <= 0) continue;
+    const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) {
+      reply.closed = true;
+      break;
+    }
+    reply.text.append(buffer, static_cast<std::size_t>(n));
+  }
+  close(fd);
+  return reply;
+}
+
 struct WsClient::Impl {
   asio::io_context io;
   websocket::stream<tcp::socket> ws{io};

@@ -91,6 +91,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (req.method() == http::verb::put)
       return send(error_response(req, http::status::method_not_allowed, "PUT only on programs"),
                   false);
+    // Beast checks a body limit against Content-Length only while parsing the header, which
+    // is done: a declared length is checked here, a chunked body while it is read.
+    if (const auto length = parser_->content_length(); length && *length > app_.limits.body_bytes)
+      return send(error_response(req, http::status::payload_too_large, "request body too large"),
+                  false);
     body_parser_.emplace(std::move(*parser_));
     body_parser_->body_limit(app_.limits.body_bytes);
     beast::get_lowest_layer(stream_).expires_after(body_time());

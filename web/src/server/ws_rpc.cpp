@@ -9,6 +9,41 @@ namespace {
 using json = nlohmann::json;
 
 constexpr int kParseError = -32700;
+constexpr int kInvalidRequest = -32600;
+// As cncd: printing or copying a value recurses once per level, and a 1 MiB frame of brackets
+// would exhaust the stack. Checked by a SAX pass that builds nothing and stops at the limit.
+constexpr std::size_t kMaxNesting = 64;
+
+class DepthCheck : public json::json_sax_t {
+ public:
+  bool too_deep = false;
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return open(); }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(); }
+  bool end_array() override { return close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  bool open() {
+    too_deep = ++depth_ > kMaxNesting;
+    return !too_deep;
+  }
+  bool close() {
+    --depth_;
+    return true;
+  }
+  std::size_t depth_ = 0;
+};
 constexpr int kMethodNotFound = -32601;
 constexpr int kInvalidParams = -32602;
 
@@ -44,6 +79,14 @@ WsRpc::WsRpc(App& app, Identity who, std::string address)
 
 WsRpc::Output WsRpc::on_client(std::string_view text) {
   Output out;
+  DepthCheck depth;
+  json::sax_parse(text, &depth);
+  if (depth.too_deep) {
+    out.to_client.push_back(
+        dump(rpc_error(nullptr, kInvalidRequest,
+                       "request nested deeper than " + std::to_string(kMaxNesting) + " levels")));
+    return out;
+  }
   json message = json::parse(text, nullptr, false);
   if (message.is_discarded()) {
     out.to_client.push_back(dump(rpc_error(nullptr, kParseError, "parse error: not valid JSON")));
