@@ -32,7 +32,7 @@ function showServo(rt) {
                el('span', {class: 'stat-value', dataset: {stat: name}}))));
   }
   rows.forEach(([, value], i) => setText(box.children[i].lastChild, value));
-  box.classList.toggle('warn', (rt.overruns ?? 0) > 0);
+  box.classList.toggle('has-overruns', (rt.overruns ?? 0) > 0);
 }
 
 const kFlags = [

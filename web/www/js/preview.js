@@ -81,7 +81,7 @@ class Preview {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.requestRender());
-    this.axes = new THREE.AxesHelper(10);
+    this.axes = new THREE.AxesHelper(1);
     this.scene.add(this.axes);
     this.tool = this.makeTool();
     this.tool.visible = false;
@@ -217,7 +217,7 @@ class Preview {
     this.show(result);
     let text = `ready ${result.points} points`;
     if (result.tolerance !== undefined)
-      text += ` · tolerance ${result.tolerance} ${result.units ?? ''}`;
+      text += ` · tolerance ${Number(result.tolerance.toPrecision(3))} ${result.units ?? ''}`;
     if (!result.complete) text += ` · incomplete: ${result.stopped ?? result.error ?? 'stopped'}`;
     setText(status, text);
     status.dataset.state = 'ready';
@@ -263,6 +263,11 @@ class Preview {
     const exec = status.exec ?? 'idle';
     const line = status.program?.line ?? 0;
     if (exec !== 'idle' && this.lastExec === 'idle') this.resetDone();
+    // A run that ended at its end has run every segment.
+    if (exec === 'idle' && this.lastExec !== 'idle' && status.program?.result === 'done') {
+      this.paint(this.doneUpTo, this.segLine.length, kDoneColor);
+      this.doneUpTo = this.segLine.length;
+    }
     this.lastExec = exec;
     if (exec === 'idle' || line === this.lastLine || line <= 0) return;
     this.lastLine = line;
