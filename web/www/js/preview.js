@@ -36,7 +36,10 @@ export function setupPreview(ctx) {
 
   let loadedPath = null;
   ctx.on('program-opened', () => (loadedPath = null));
-  ctx.on('connected', () => (loadedPath = null));
+  // Asked again after a reconnection (the daemon may have restarted), not at the first one.
+  ctx.on('connection', (up) => {
+    if (!up) loadedPath = null;
+  });
   ctx.on(
       'info',
       (info) => preview.setLimits(info?.machine?.limits ?? info?.machine?.soft_limits ?? null));
@@ -208,6 +211,11 @@ class Preview {
       result = await this.ctx.call('program.preview', {}, {quiet: true});
     } catch (e) {
       if (token !== this.token) return;
+      // 1009: another program was opened meanwhile; its preview is asked for once it is open.
+      if (e.code === 1009) {
+        setText(status, 'loading');
+        return;
+      }
       setText(status, `preview failed: ${e.message}`);
       status.dataset.state = 'error';
       return;

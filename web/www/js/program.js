@@ -64,12 +64,12 @@ export function setupProgram(ctx) {
     progress.dataset.ratio = ratio.toFixed(4);
     $('#progress-bar').style.width = `${(ratio * 100).toFixed(1)}%`;
     setText($('#elapsed'), fmtDuration(program.elapsed_s));
+    // Why there is no estimate (still working it out, a line the planner refused) goes in the
+    // tooltip: it can be a long message, and the side column has no room for it.
     const remaining = $('#remaining');
-    setText(
-        remaining,
-        program.remaining_s === null || program.remaining_s === undefined ?
-            (program.remaining_reason ? `— (${program.remaining_reason})` : '—') :
-                                        fmtDuration(program.remaining_s));
+    const known = typeof program.remaining_s === 'number';
+    setText(remaining, known ? fmtDuration(program.remaining_s) : '—');
+    remaining.title = known ? '' : (program.remaining_reason ?? '');
     setText($('#program-result'), program.result ? `last run: ${program.result}` : '');
     setText($('#program-error'), program.error ?? '');
     for (const [id, active] of [
