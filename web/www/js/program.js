@@ -158,10 +158,15 @@ class ProgramText {
   }
 
   draw() {
-    const first = Math.max(0, Math.floor(this.box.scrollTop / kLineHeight) - kOverscan);
+    // Lines drawn stay as they are while the visible ones are among them: rows are rebuilt
+    // once every few hundred lines of scrolling, not at each line the program runs.
+    const top = Math.floor(this.box.scrollTop / kLineHeight);
     const visible = Math.ceil(this.box.clientHeight / kLineHeight) + 1;
-    const last = Math.min(this.lines.length, first + visible + 2 * kOverscan);
-    if (first === this.drawn[0] && last === this.drawn[1]) return;
+    const bottom = Math.min(this.lines.length, top + visible);
+    if (this.drawn[1] > this.drawn[0] && top >= this.drawn[0] && bottom <= this.drawn[1]) return;
+    if (this.lines.length === 0 && this.drawn[1] === 0) return;
+    const first = Math.max(0, top - kOverscan);
+    const last = Math.min(this.lines.length, top + visible + kOverscan);
     this.drawn = [first, last];
     const rows = [];
     for (let i = first; i < last; ++i) {
