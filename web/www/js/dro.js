@@ -24,7 +24,7 @@ function buildAxes(ctx, axes) {
         el('td', {
           id: `dro-dtg-${a}`,
           class: 'dro-dtg',
-          title: 'distance to go: cncd reports it along the path (below), not per axis'
+          title: 'distance to go on this axis in the move under way (along the path: below)'
         },
            '—'));
   }));
@@ -33,11 +33,13 @@ function buildAxes(ctx, axes) {
 function showDro(ctx, status) {
   const work = status.work_position?.actual ?? {};
   const mach = status.position?.actual ?? {};
+  const toGo = status.axes_to_go ?? {};
   const digits = status.units === 'inch' ? 4 : 3;
   for (const letter of ctx.droAxes) {
     const a = letter.toLowerCase();
     setText($(`#dro-${a}`), fmt(work[a], digits));
     setText($(`#dro-mach-${a}`), fmt(mach[a], digits));
+    setText($(`#dro-dtg-${a}`), fmt(toGo[a], digits));
   }
   const homed = status.homed ?? [];
   for (const [i, row] of Array.from(document.querySelectorAll('.dro-row')).entries()) {
