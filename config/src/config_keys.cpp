@@ -126,6 +126,31 @@ constexpr std::array kKeys{
                  "A user M code (M100-M199) still running after this long is stopped and the "
                  "program with it"),
 
+    text_key("WEB", "LISTEN", "127.0.0.1",
+             "cncd-web: the IP address it listens on; 127.0.0.1 (this machine only), 0.0.0.0 or "
+             ":: (every address) or one interface's address"),
+    integer_key("WEB", "PORT", "8080", 1, 65535, "", "cncd-web: the TCP port of the page and /ws"),
+    path_key("WEB", "PROGRAM_DIR", "",
+             "cncd-web: where uploads go and programs are listed from; one of cncd's program "
+             "directories ([DISPLAY] PROGRAM_PREFIX, [CNCD] PROGRAM_DIRS); default: the first"),
+    integer_key("WEB", "MAX_UPLOAD_MB", "64", 1, 65536, "MiB",
+                "cncd-web: the largest program an upload may bring"),
+    path_key("WEB", "USERS_FILE", "",
+             "cncd-web: the users, roles and password and API key hashes (mode 0600), relative to "
+             "the state directory; default web-users in the state directory"),
+    path_key("WEB", "TLS_CERT", "",
+             "cncd-web: PEM certificate (chain) for HTTPS, with TLS_KEY; neither: plain HTTP"),
+    path_key("WEB", "TLS_KEY", "", "cncd-web: PEM private key of TLS_CERT"),
+    text_key("WEB", "ALLOWED_ORIGINS", "",
+             "cncd-web: origins besides the page's own that browsers may send state-changing "
+             "requests and WebSockets from, scheme://host[:port], separated by blanks or commas"),
+    integer_key("WEB", "SESSION_HOURS", "12", 1, 8760, "h", "cncd-web: how long a login lasts"),
+    integer_key("WEB", "MAX_CLIENTS", "64", 1, 100000, "",
+                "cncd-web: most WebSocket connections at once"),
+    real_key("WEB", "JOG_HEARTBEAT", "0.25", 0.05, 5, "s",
+             "cncd-web: a continuous jog from the page stops this long after the page's last "
+             "heartbeat (tab closed, network lost)"),
+
     choice_key("SPINDLE_0", "DRIVER", "sim", "none|sim|gpio|modbus",
                "What turns the spindle: none (the machine has none), sim (simulated), gpio "
                "(enable, direction and PWM lines), modbus (a VFD)"),

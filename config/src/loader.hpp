@@ -16,6 +16,8 @@ void load_general(TypedReader& reader, MachineConfig& config);
 void load_program_dirs(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
 // [CNCD] STATE_DIR and where the parameter, tool and position files live.
 void load_state_files(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
+// [WEB], cncd-web's keys (after load_program_dirs and load_state_files).
+void load_web(TypedReader& reader, MachineConfig& config);
 // [KINS], the joint map, [AXIS_L] and [JOINT_n]; fills the [TRAJ] limits left unset.
 void load_motion(TypedReader& reader, MachineConfig& config);
 // [SPINDLE_0] (and a warning for the [SPINDLE_n] cncd does not drive).
