@@ -135,9 +135,12 @@ def stop_time_after(m, browser, user, how):
     pids = browser.processes()
     assert pids, "no browser process found"
     at_wall, at = time.time(), time.monotonic()
-    signal_all(pids, signal.SIGSTOP if how == "frozen" else signal.SIGKILL)
-    m.status.wait(lambda s: s["velocity"] == 0 and s["motion"] == "idle", 30,
-                  f"the jog stopped after the browser was {how}")
+    try:
+        signal_all(pids, signal.SIGSTOP if how == "frozen" else signal.SIGKILL)
+        m.status.wait(lambda s: s["velocity"] == 0 and s["motion"] == "idle", 30,
+                      f"the jog stopped after the browser was {how}")
+    finally:
+        signal_all(pids, signal.SIGKILL)  # a frozen browser would hang chromedriver's quit
     with m.status.cond:
         before = [h for h in m.status.history if h[0] < at]
         after = [h for h in m.status.history if h[0] >= at]
@@ -147,7 +150,6 @@ def stop_time_after(m, browser, user, how):
     print(f"browser {how} mid-jog ({len(pids)} processes): velocity 0 after {elapsed:.3f} s "
           f"on the daemon's clock ({stop[0] - at:.3f} s as received), X {x0:.3f} -> "
           f"{stop[4]:.3f}")
-    signal_all(pids, signal.SIGKILL)
     browser.quit()
     return elapsed
 
