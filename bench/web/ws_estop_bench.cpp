@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
   const std::string ini_path = (dir / "sim_mm.ini").string();
   std::atexit(end_children);
   daemon_pid =
-      start_cncd(dir, sock, {"--state-dir", (dir / "state").string(), "--log-level", "warn"});
+      start_cncd(dir, sock, {"--state-dir", (dir / "state").string(), "--log-level", "error"});
   Conn c = connect_when_up(sock);
   const std::string key = make_user(ini_path);
   web_pid = start_web(ini_path, sock, (dir / "cncd-web.log").string());
