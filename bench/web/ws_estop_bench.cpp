@@ -301,10 +301,12 @@ int main(int argc, char** argv) {
   watched.frames = total;
   watched.frames_window_s = std::chrono::duration<double>(Clock::now() - frames_from).count();
 
+  const json rt = status(c, R"("rt")")["rt"];
   std::printf(
       "estop through cncd-web's /ws while a program runs: %d samples a phase; "
-      "overruns over %d s of the run\n",
-      samples, window_s);
+      "overruns over %d s of the run; servo thread realtime %s, memory locked %s\n",
+      samples, window_s, rt.value("realtime", false) ? "yes" : "no",
+      rt.value("memory_locked", false) ? "yes" : "no");
   std::printf("%-22s %12s %12s %12s %9s %11s %9s\n", "phase", "estop p50", "estop p99", "estop max",
               "overruns", "cycles", "frames/s");
   print(alone);
