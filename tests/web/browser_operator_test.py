@@ -248,7 +248,9 @@ def main():
     args = parse_args()
     require_browser()
     os.makedirs(args.out_dir, exist_ok=True)
-    m = Machine(args)
+    # Held buttons here are about the page, not about lost heartbeats (browser_access_test):
+    # a long heartbeat keeps a browser slowed by a busy machine from losing its jog.
+    m = Machine(args, {"JOG_HEARTBEAT": 1})
     browser = None
     try:
         m.add_user(USER, "setter", PASSWORD)

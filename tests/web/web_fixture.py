@@ -178,8 +178,9 @@ def work_xyz(status):
 class Machine:
     """cncd on a copy of config/examples/sim_mm.ini and cncd-web in front of it."""
 
-    def __init__(self, args):
+    def __init__(self, args, web_keys=None):
         self.args = args
+        self.web_keys = web_keys or {}
         self.dir = tempfile.mkdtemp(prefix="cncd-web-test-")
         self.programs = os.path.join(self.dir, "programs")
         self.state = os.path.join(self.dir, "state")
@@ -205,6 +206,7 @@ class Machine:
         text += ("\n[WEB]\nLISTEN = 127.0.0.1\n"
                  f"PORT = {self.port}\nPROGRAM_DIR = {self.programs}\n"
                  f"USERS_FILE = {self.users_file}\n")
+        text += "".join(f"{key} = {value}\n" for key, value in self.web_keys.items())
         with open(self.ini, "w") as f:
             f.write(text)
 
