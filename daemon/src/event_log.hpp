@@ -28,6 +28,7 @@ class EventLog {
   void add(std::string level, std::string kind, std::string message);
   // Who the entries added from now on are caused by ("" when by no request).
   void set_actor(std::string by) { actor_ = std::move(by); }
+  const std::string& actor() const { return actor_; }
   // Events with seq > since, oldest first.
   std::vector<Event> since(std::uint64_t since) const;
   std::uint64_t last_seq() const { return next_seq_ - 1; }

@@ -118,6 +118,12 @@ class RpcDispatcher {
   // request to a control method causes, and records each attributed request to a control
   // method (but those whose spec says not) as a "command" event.
   void record_to(EventLog* events) { events_ = events; }
+  // Calls `hook` for a connection that closes (once its peer has hung up or been cut off, and
+  // again each turn until it is gone): what it started to run only while it is there stops.
+  void on_close(std::function<void(const Session&)> hook) { on_close_ = std::move(hook); }
+  void closed(const Session& session) const {
+    if (on_close_) on_close_(session);
+  }
   // A method whose result the handler gives as serialized JSON: status.get hands out one
   // serialization of the status to every request of a turn instead of copying and printing it.
   using RawHandler = std::function<std::string(const nlohmann::json& params, Session& session)>;
@@ -173,6 +179,7 @@ class RpcDispatcher {
   std::map<std::string, Entry, std::less<>> handlers_;
   std::function<void()> after_command_;
   EventLog* events_ = nullptr;
+  std::function<void(const Session&)> on_close_;
 };
 
 }  // namespace cncd::daemon
