@@ -4,6 +4,7 @@
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -178,9 +179,13 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   }
   StatusCache status([&task, &config] { return status_json(task.status(), config); });
   RpcDispatcher dispatcher;
-  register_methods(dispatcher, task, config, events, completions, &status);
+  JogHeartbeats heartbeats(task, events);
+  register_methods(dispatcher, task, config, events, completions, heartbeats, &status);
+  dispatcher.on_close(
+      [&heartbeats](const Session& session) { heartbeats.closed(session.connection); });
   // A command may change what the status shows: the next status.get sees its effect.
   dispatcher.after_command([&status] { status.invalidate(); });
+  dispatcher.record_to(&events);
   const ConnectionLimits limits{static_cast<std::size_t>(config.cncd.max_connections),
                                 static_cast<std::size_t>(config.cncd.max_connections_per_user),
                                 static_cast<std::size_t>(config.cncd.control_reserve)};
@@ -209,8 +214,13 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
                              std::chrono::steady_clock::now(), task.servo_heartbeat());
   std::string last_summary;
   for (;;) {
-    server.poll_once(task.busy() ? 2 : 50, signal_fd);
+    // A jog's heartbeat falls due between turns too: the wait ends in time to stop it.
+    int timeout_ms = task.busy() ? 2 : 50;
+    if (const int due = heartbeats.ms_until_due(std::chrono::steady_clock::now()); due >= 0)
+      timeout_ms = std::min(timeout_ms, due);
+    server.poll_once(timeout_ms, signal_fd);
     const auto now = std::chrono::steady_clock::now();
+    heartbeats.expire(now);
     if (watchdog && watchdog_gate.feed(now, task.servo_heartbeat())) sd_notify(0, "WATCHDOG=1");
     if (std::string summary = task.summary(); summary != last_summary) {
       sd_notifyf(0, "STATUS=%s", summary.c_str());

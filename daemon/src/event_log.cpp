@@ -7,16 +7,19 @@
 namespace cncd::daemon {
 
 void EventLog::add(std::string level, std::string kind, std::string message) {
+  // The log line names who, unless the message does already.
+  const std::string by =
+      actor_.empty() || message.find(actor_) != std::string::npos ? "" : " (by " + actor_ + ")";
   if (level == "error") {
-    spdlog::error("{}: {}", kind, message);
+    spdlog::error("{}: {}{}", kind, message, by);
   } else if (level == "warning") {
-    spdlog::warn("{}: {}", kind, message);
+    spdlog::warn("{}: {}{}", kind, message, by);
   } else {
-    spdlog::info("{}: {}", kind, message);
+    spdlog::info("{}: {}{}", kind, message, by);
   }
   const auto wall = std::chrono::system_clock::now().time_since_epoch();
   events_.push_back(Event{next_seq_++, std::chrono::duration<double>(wall).count(),
-                          std::move(level), std::move(kind), std::move(message)});
+                          std::move(level), std::move(kind), std::move(message), actor_});
   if (events_.size() > kCapacity) events_.pop_front();
 }
 

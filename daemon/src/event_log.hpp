@@ -17,6 +17,7 @@ struct Event {
   std::string level;  // "error" | "warning" | "info"
   std::string kind;   // "program" | "fault" | "machine" | "message" ...
   std::string message;
+  std::string by;  // who caused it: the peer, or a person through it; empty when no request did
 };
 
 class EventLog {
@@ -25,6 +26,9 @@ class EventLog {
 
   // Records an event (and logs it through spdlog at the matching level).
   void add(std::string level, std::string kind, std::string message);
+  // Who the entries added from now on are caused by ("" when by no request).
+  void set_actor(std::string by) { actor_ = std::move(by); }
+  const std::string& actor() const { return actor_; }
   // Events with seq > since, oldest first.
   std::vector<Event> since(std::uint64_t since) const;
   std::uint64_t last_seq() const { return next_seq_ - 1; }
@@ -32,6 +36,7 @@ class EventLog {
  private:
   std::deque<Event> events_;
   std::uint64_t next_seq_ = 1;
+  std::string actor_;
 };
 
 }  // namespace cncd::daemon

@@ -29,19 +29,34 @@ json ok() {
 }  // namespace
 
 void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
-                          const config::MachineConfig& config) {
-  dispatcher.add("jog.start", [&task, &config](const json& params) {
+                          const config::MachineConfig& config, JogHeartbeats& heartbeats,
+                          const EventLog& events) {
+  dispatcher.add("jog.start",
+                 [&task, &config, &heartbeats, &events](const json& params, Session& session) {
+                   const int axis = axis_param(params, config);
+                   const double velocity = params["velocity"].get<double>();
+                   if (velocity == 0)
+                     throw RpcError(kInvalidParams, "parameter \"velocity\" must not be 0");
+                   task.jog_start(axis, velocity);
+                   heartbeats.started(axis, session.connection, params.value("heartbeat_s", 0.0),
+                                      events.actor().empty() ? session.peer : events.actor(),
+                                      JogHeartbeats::Clock::now());
+                   return ok();
+                 });
+  dispatcher.add("jog.stop", [&task, &config, &heartbeats](const json& params) {
     const int axis = axis_param(params, config);
-    const double velocity = params["velocity"].get<double>();
-    if (velocity == 0) throw RpcError(kInvalidParams, "parameter \"velocity\" must not be 0");
-    task.jog_start(axis, velocity);
+    heartbeats.forget(axis);
+    task.jog_stop(axis);
     return ok();
   });
-  dispatcher.add("jog.stop", [&task, &config](const json& params) {
-    task.jog_stop(axis_param(params, config));
-    return ok();
+  dispatcher.add("jog.heartbeat", [&config, &heartbeats](const json& params, Session& session) {
+    const int axis = params.contains("axis") ? axis_param(params, config) : -1;
+    json axes = json::array();
+    for (const int kept : heartbeats.beat(session.connection, axis, JogHeartbeats::Clock::now()))
+      axes.push_back(std::string(1, config::kAxisLetters[static_cast<std::size_t>(kept)]));
+    return json{{"ok", true}, {"axes", axes}};
   });
-  dispatcher.add("jog.increment", [&task, &config](const json& params) {
+  dispatcher.add("jog.increment", [&task, &config, &heartbeats](const json& params) {
     const int axis = axis_param(params, config);
     const double distance = params["distance"].get<double>();
     if (distance == 0) throw RpcError(kInvalidParams, "parameter \"distance\" must not be 0");
@@ -50,6 +65,7 @@ void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
         params.value("velocity", config.axes[static_cast<std::size_t>(axis)].max_velocity);
     if (velocity <= 0) throw RpcError(kInvalidParams, "parameter \"velocity\" must be above 0");
     task.jog_increment(axis, distance, velocity);
+    heartbeats.forget(axis);
     return ok();
   });
 }

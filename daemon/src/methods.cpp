@@ -56,7 +56,7 @@ void add_command(RpcDispatcher& dispatcher, Task& task, const char* method,
 }  // namespace
 
 void register_methods(RpcDispatcher& dispatcher, Task& task, const config::MachineConfig& config,
-                      const EventLog& events, Completions& completions,
+                      const EventLog& events, Completions& completions, JogHeartbeats& heartbeats,
                       StatusCache* shared_status) {
   dispatcher.add("errors.list", [&events](const json& params) {
     const auto since = params.value("since", std::uint64_t{0});
@@ -197,7 +197,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     return json();
   });
   register_setup_methods(dispatcher, task, config);
-  register_jog_methods(dispatcher, task, config);
+  register_jog_methods(dispatcher, task, config, heartbeats, events);
   register_override_methods(dispatcher, task, config);
   dispatcher.require_all_added();
 }

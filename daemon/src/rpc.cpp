@@ -8,6 +8,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "attribution.hpp"
+#include "event_log.hpp"
+
 namespace cncd::daemon {
 
 using nlohmann::json;
@@ -75,6 +78,8 @@ namespace {
 constexpr int kMaxNesting = 64;
 // A longer batch would be answered in one piece, holding up every other client meanwhile.
 constexpr std::size_t kMaxBatch = 256;
+// Of a command's parameters, as much is recorded in its event.
+constexpr std::size_t kRecordedParamsBytes = 200;
 
 bool nested_too_deep(const std::string& line) {
   int depth = 0;
@@ -137,6 +142,21 @@ std::optional<std::string> RpcDispatcher::handle_one(const json& request, Sessio
     return reply_error(kInvalidRequest, "\"method\" must be a string");
   }
   const std::string& name = method->get_ref<const std::string&>();
+  std::optional<Attribution> on_behalf;
+  if (const auto member = request.find("on_behalf_of"); member != request.end()) {
+    if (session.access != Access::control) {
+      return reply_error(kAttributionRefused,
+                         "permission denied: \"on_behalf_of\" is accepted only from root, cncd's "
+                         "own user or the control group, and " +
+                             (session.peer.empty() ? std::string("this peer") : session.peer) +
+                             " may only read");
+    }
+    auto parsed = parse_attribution(*member);
+    if (const auto* error = std::get_if<std::string>(&parsed)) {
+      return reply_error(kInvalidRequest, *error);
+    }
+    on_behalf = std::move(std::get<Attribution>(parsed));
+  }
   const auto handler = handlers_.find(name);
   if (handler == handlers_.end()) {
     return reply_error(kMethodNotFound, "unknown method " + quoted_text(name));
@@ -152,39 +172,64 @@ std::optional<std::string> RpcDispatcher::handle_one(const json& request, Sessio
     return reply_error(kInvalidParams, *error);
   }
   const json& params = std::get<json>(checked);
+  const bool command = entry.spec.needs == Access::control;
   // Also when the handler throws: a refused command may have changed the state on its way.
   struct AfterCommand {
     const std::function<void()>* hook;
+    EventLog* events;
     ~AfterCommand() {
+      if (events != nullptr) events->set_actor("");
       if (hook != nullptr && *hook) (*hook)();
     }
-  } after{entry.spec.needs == Access::control ? &after_command_ : nullptr};
-  try {
-    session.defer_token = 0;
-    if (entry.raw) {
-      std::string result = entry.raw(params, session);
-      if (notification) return std::nullopt;
-      return R"({"id":)" + text_of(id) + R"(,"jsonrpc":"2.0","result":)" + result + "}";
-    }
-    json result = entry.handler(params, session);
-    if (session.defer_token != 0) {
-      if (!notification) session.open_requests.emplace_back(session.defer_token, id);
+  } after{command ? &after_command_ : nullptr, command ? events_ : nullptr};
+  const std::string actor = on_behalf ? attribution_text(*on_behalf, session.peer) : session.peer;
+  if (after.events != nullptr) after.events->set_actor(actor);
+  std::string refused;  // the handler's error
+  auto outcome = [&]() -> std::optional<std::string> {
+    try {
       session.defer_token = 0;
-      return std::nullopt;
+      if (entry.raw) {
+        std::string result = entry.raw(params, session);
+        if (notification) return std::nullopt;
+        return R"({"id":)" + text_of(id) + R"(,"jsonrpc":"2.0","result":)" + result + "}";
+      }
+      json result = entry.handler(params, session);
+      if (session.defer_token != 0) {
+        if (!notification) session.open_requests.emplace_back(session.defer_token, id);
+        session.defer_token = 0;
+        return std::nullopt;
+      }
+      if (notification) return std::nullopt;
+      return text_of(json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}});
+    } catch (const RpcError& e) {
+      refused = e.what();
+      return reply_error(e.code(), e.what());
+    } catch (const TaskError& e) {
+      refused = e.what();
+      return reply_error(rpc_code(e.kind()), e.what());
+    } catch (const std::exception& e) {
+      // The params were checked against the table: what is left is a fault of cncd's own, to
+      // be found in the log rather than in a library's words to the client.
+      spdlog::error("{}: {}", name, e.what());
+      refused = "internal error";
+      return reply_error(kInternalError,
+                         "internal error in " + quoted_text(name) + "; see cncd's log");
     }
-    if (notification) return std::nullopt;
-    return text_of(json{{"jsonrpc", "2.0"}, {"id", id}, {"result", std::move(result)}});
-  } catch (const RpcError& e) {
-    return reply_error(e.code(), e.what());
-  } catch (const TaskError& e) {
-    return reply_error(rpc_code(e.kind()), e.what());
-  } catch (const std::exception& e) {
-    // The params were checked against the table: what is left is a fault of cncd's own, to be
-    // found in the log rather than in a library's words to the client.
-    spdlog::error("{}: {}", name, e.what());
-    return reply_error(kInternalError,
-                       "internal error in " + quoted_text(name) + "; see cncd's log");
+  }();
+  if (on_behalf && after.events != nullptr && entry.spec.recorded) {
+    // What a person did through a front end, as the front end vouches: the audit trail.
+    std::string what = name;
+    if (!params.empty()) {
+      std::string shown = text_of(params);
+      if (shown.size() > kRecordedParamsBytes)
+        shown = shown.substr(0, kRecordedParamsBytes) + "...";
+      what += " " + shown;
+    }
+    what += " by " + actor;
+    if (!refused.empty()) what += ": refused: " + refused;
+    after.events->add("info", "command", std::move(what));
   }
+  return outcome;
 }
 
 namespace {

@@ -17,6 +17,8 @@
 
 namespace cncd::daemon {
 
+class EventLog;
+
 // Stable error codes; docs/protocol.md lists them.
 enum RpcCode : int {
   kParseError = -32700,
@@ -34,6 +36,7 @@ enum RpcCode : int {
   kFault = 1008,      // the machine did not do it: a drive, its feedback or the estop input
   kCancelled = 1009,  // cancelled before it finished (program.open: a newer open, an estop)
   kTooManyConnections = 1010,  // refused at connect: the connection limits are reached
+  kAttributionRefused = 1011,  // "on_behalf_of" from a peer without control access
 };
 
 class RpcError : public std::runtime_error {
@@ -74,6 +77,8 @@ class Completions final : public TaskAnswers {
 // Per-connection state a method may read or change.
 struct Session {
   Access access = Access::control;
+  std::uint64_t connection = 0;     // which connection, for state kept per connection
+  std::string peer;                 // "uid 1000 pid 4242", as the event log names the peer
   int subscribe_interval_ms = 0;    // 0: not subscribed to status updates
   std::vector<std::string> fields;  // top-level status fields wanted; empty = all
   // Set by a handler whose answer comes later; the dispatcher then files the request's id
@@ -109,6 +114,16 @@ class RpcDispatcher {
   void add(const std::string& method, SimpleHandler handler, const std::vector<Range>& ranges = {});
   // Calls `hook` after each request to a method that needs control access has been handled.
   void after_command(std::function<void()> hook) { after_command_ = std::move(hook); }
+  // Names the peer (or the person and address of "on_behalf_of") as `by` of the events a
+  // request to a control method causes, and records each attributed request to a control
+  // method (but those whose spec says not) as a "command" event.
+  void record_to(EventLog* events) { events_ = events; }
+  // Calls `hook` for a connection that closes (once its peer has hung up or been cut off, and
+  // again each turn until it is gone): what it started to run only while it is there stops.
+  void on_close(std::function<void(const Session&)> hook) { on_close_ = std::move(hook); }
+  void closed(const Session& session) const {
+    if (on_close_) on_close_(session);
+  }
   // A method whose result the handler gives as serialized JSON: status.get hands out one
   // serialization of the status to every request of a turn instead of copying and printing it.
   using RawHandler = std::function<std::string(const nlohmann::json& params, Session& session)>;
@@ -163,6 +178,8 @@ class RpcDispatcher {
   std::map<std::string, MethodSpec, std::less<>> table_;
   std::map<std::string, Entry, std::less<>> handlers_;
   std::function<void()> after_command_;
+  EventLog* events_ = nullptr;
+  std::function<void(const Session&)> on_close_;
 };
 
 }  // namespace cncd::daemon

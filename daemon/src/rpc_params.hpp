@@ -41,6 +41,9 @@ struct MethodSpec {
   std::string_view name;
   Access needs = Access::control;  // read: queries; control: commands
   std::vector<ParamSpec> params;
+  // A request to a control method sent on behalf of someone is recorded in the event log; a
+  // method that changes nothing (jog.heartbeat) is not.
+  bool recorded = true;
 };
 
 // Every method cncd serves, with its parameters in the order errors list them.

@@ -349,6 +349,9 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   push_events();
   push_updates(Clock::now());
   requests_handled_ = false;
+  for (const auto& client : clients_) {
+    if (client.closing) dispatcher_.closed(client.session);
+  }
   now = Clock::now();
   std::erase_if(clients_, [now](const Client& client) {
     const bool done = client.out.empty() && client.session.open_requests.empty() &&

@@ -151,6 +151,7 @@ class Server {
   std::size_t next_client_ = 0;         // where the next turn's round starts
   std::size_t next_update_client_ = 0;  // where the next turn's status updates start
   bool requests_handled_ = false;       // a request was served in this poll_once
+  std::uint64_t last_connection_ = 0;   // the id of the last connection admitted
   LogLimiter accept_log_;
   LogLimiter refusal_log_;
   LogLimiter client_log_;

@@ -100,6 +100,8 @@ void Server::admit(int fd) {
   client.uid = uid;
   client.capped = capped;
   client.session.access = access;
+  client.session.peer = who;
+  client.session.connection = ++last_connection_;
   client.event_seq = events_.last_seq();
   clients_.push_back(std::move(client));
 }

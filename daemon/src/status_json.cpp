@@ -226,11 +226,13 @@ json offsets_json(const OffsetsReport& offsets, const config::MachineConfig& con
 }
 
 json event_json(const Event& event) {
-  return {{"seq", event.seq},
-          {"time", event.time},
-          {"level", event.level},
-          {"kind", event.kind},
-          {"message", event.message}};
+  json out = {{"seq", event.seq},
+              {"time", event.time},
+              {"level", event.level},
+              {"kind", event.kind},
+              {"message", event.message}};
+  if (!event.by.empty()) out["by"] = event.by;
+  return out;
 }
 
 json events_json(const std::vector<Event>& events) {

@@ -87,12 +87,16 @@ class PermissionTest : public ::testing::Test {
   }
 
   std::string call_as(const std::vector<gid_t>& groups, const std::string& method) {
+    return send_as(groups, {{"jsonrpc", "2.0"}, {"id", 1}, {"method", method}});
+  }
+  // Sends `request` (with id 1) as a peer in `groups`; its answer.
+  std::string send_as(const std::vector<gid_t>& groups, const json& request) {
     const std::string socket = daemon_.socket();
     return as_user(groups, [&] {
       daemon::Client client;
       if (const auto error = client.connect(socket); !error.empty()) return error;
       try {
-        client.send_raw(json{{"jsonrpc", "2.0"}, {"id", 1}, {"method", method}}.dump() + "\n");
+        client.send_raw(request.dump() + "\n");
       } catch (const std::exception&) {
         // A refused peer may find the connection closed before its request is out.
       }
@@ -139,6 +143,30 @@ TEST_F(PermissionTest, ReaderMayNotSetOverrides) {
 TEST_F(PermissionTest, ControlGroupMayCommand) {
   const json command = json::parse(call_as({group_id("dialout")}, "machine.reset"));
   EXPECT_TRUE(command.contains("result")) << command.dump();
+}
+
+// A read-only peer cannot pass its requests off as someone else's, whatever it asks; a peer of
+// the control group may, and the event log names the person through it.
+TEST_F(PermissionTest, OnlyTheControlGroupMaySendOnBehalfOfSomeone) {
+  const json alice = {{"user", "alice"}, {"address", "192.168.1.20"}, {"via", "web"}};
+  for (const char* method : {"status.get", "machine.reset"}) {
+    const json reply = json::parse(
+        send_as({group_id("users")},
+                {{"jsonrpc", "2.0"}, {"id", 1}, {"method", method}, {"on_behalf_of", alice}}));
+    EXPECT_EQ(reply.value("/error/code"_json_pointer, 0), 1011) << method << ": " << reply.dump();
+    EXPECT_NE(reply.dump().find("uid 65534"), std::string::npos) << reply.dump();
+  }
+  const json done = json::parse(send_as(
+      {group_id("dialout")},
+      {{"jsonrpc", "2.0"}, {"id", 1}, {"method", "machine.reset"}, {"on_behalf_of", alice}}));
+  EXPECT_TRUE(done.contains("result")) << done.dump();
+  daemon::Client reader;
+  ASSERT_EQ(reader.connect(daemon_.socket()), "");
+  const json events = reader.call("errors.list")["result"]["events"];
+  ASSERT_FALSE(events.empty());
+  const std::string by = events.back().value("by", "");
+  EXPECT_EQ(by.rfind("alice@192.168.1.20 (web) via uid 65534 pid ", 0), 0u) << events.dump();
+  EXPECT_EQ(events.back()["message"], "machine.reset by " + by);
 }
 
 }  // namespace
