@@ -26,8 +26,8 @@ TEST_F(WebTest, LoginSetsAStrictHttpOnlyCookie) {
   EXPECT_NE(set.find("SameSite=Strict"), std::string::npos) << set;
   EXPECT_NE(set.find("Path=/"), std::string::npos) << set;
   EXPECT_EQ(set.find("Secure"), std::string::npos) << "no TLS here: " << set;
-  const auto session = http_request(port_, "GET", "/api/session", "",
-                                    {{"Cookie", set.substr(0, set.find(';'))}});
+  const auto session =
+      http_request(port_, "GET", "/api/session", "", {{"Cookie", set.substr(0, set.find(';'))}});
   ASSERT_EQ(session.status, 200);
   EXPECT_EQ(session.json()["role"], "operator");
   EXPECT_FALSE(session.json()["methods"].empty());
@@ -54,9 +54,9 @@ TEST_F(WebTest, WithoutLoginOnlyTheLoginPage) {
   EXPECT_EQ(http_request(port_, "GET", "/api/programs").status, 401);
   EXPECT_EQ(http_request(port_, "GET", "/api/session").status, 401);
   EXPECT_EQ(http_request(port_, "PUT", "/api/programs/a.ngc", "G0 X1\n").status, 401);
-  EXPECT_EQ(http_request(port_, "GET", "/api/session", "", {{"Cookie", "cncd_session=forged"}})
-                .status,
-            401);
+  EXPECT_EQ(
+      http_request(port_, "GET", "/api/session", "", {{"Cookie", "cncd_session=forged"}}).status,
+      401);
   EXPECT_EQ(http_request(port_, "GET", "/", "", {{"Authorization", "Bearer cncd_forged"}}).status,
             303);
   WsClient ws;
@@ -86,8 +86,8 @@ TEST_F(WebTest, UploadListDownloadRenameDelete) {
   EXPECT_EQ(got.body, program);
 
   auto ws_sam = ws("sam");
-  EXPECT_TRUE(ws_sam->call("files.rename", {{"from", "part.ngc"}, {"to", "b.ngc"}})
-                  .contains("result"));
+  EXPECT_TRUE(
+      ws_sam->call("files.rename", {{"from", "part.ngc"}, {"to", "b.ngc"}}).contains("result"));
   EXPECT_EQ(names_in(programs_), std::vector<std::string>{"b.ngc"});
   const auto files = ws_sam->call("files.list");
   ASSERT_EQ(files["result"].size(), 1u) << files.dump();
@@ -100,11 +100,11 @@ TEST_F(WebTest, NamesOutsideTheProgramDirectoryAreRefused) {
   const auto sam = cookie("sam");
   std::ofstream(outside_ / "victim.ngc") << "G0 X0\n";
   std::filesystem::create_symlink(outside_ / "victim.ngc", programs_ / "link.ngc");
-  for (const std::string target :
-       {"/api/programs/../x", "/api/programs/%2e%2e%2fx", "/api/programs/%2E%2E%2Fx",
-        "/api/programs//abs", "/api/programs/" + outside_.string(), "/api/programs/a%00b",
-        "/api/programs/%00", "/api/programs/..", "/api/programs/.hidden",
-        "/api/programs/sub%2fx", "/api/programs/"}) {
+  for (const std::string& target : std::vector<std::string>{
+           "/api/programs/../x", "/api/programs/%2e%2e%2fx", "/api/programs/%2E%2E%2Fx",
+           "/api/programs//abs", "/api/programs/" + outside_.string(), "/api/programs/a%00b",
+           "/api/programs/%00", "/api/programs/..", "/api/programs/.hidden",
+           "/api/programs/sub%2fx", "/api/programs/"}) {
     const auto put = http_request(port_, "PUT", target, "G0 X9\n", {{"Cookie", sam}});
     EXPECT_TRUE(put.status == 400 || put.status == 404) << target << ": " << put.status << put.body;
     const auto get = http_request(port_, "GET", target, "", {{"Cookie", sam}});
@@ -121,9 +121,9 @@ TEST_F(WebTest, NamesOutsideTheProgramDirectoryAreRefused) {
   EXPECT_NE(code_of(ws_sam->call("program.open", {{"path", "../outside/victim.ngc"}})), 0);
   EXPECT_NE(code_of(ws_sam->call("files.rename", {{"from", "link.ngc"}, {"to", "../x"}})), 0);
   // Writing to the symlink's name replaces the link, never its target.
-  EXPECT_EQ(http_request(port_, "PUT", "/api/programs/link.ngc", "G0 X7\n", {{"Cookie", sam}})
-                .status,
-            201);
+  EXPECT_EQ(
+      http_request(port_, "PUT", "/api/programs/link.ngc", "G0 X7\n", {{"Cookie", sam}}).status,
+      201);
   EXPECT_EQ(slurp(outside_ / "victim.ngc"), "G0 X0\n");
   EXPECT_EQ(names_in(outside_), std::vector<std::string>{"victim.ngc"});
   EXPECT_EQ(names_in(programs_), std::vector<std::string>{"link.ngc"});
@@ -136,10 +136,11 @@ TEST_F(WebTest, TooLargeUploadIs413AndLeavesNoFile) {
   const std::string big((1 << 20) + 1, 'G');  // MAX_UPLOAD_MB = 1
   const auto put = http_request(port_, "PUT", "/api/programs/big.ngc", big, {{"Cookie", sam}});
   EXPECT_EQ(put.status, 413) << put.body;
-  // Announced small, sent big: stopped while reading.
-  const auto lying = http_request(port_, "PUT", "/api/programs/big.ngc", big,
-                                  {{"Cookie", sam}, {"Content-Length", "100"}});
-  EXPECT_NE(lying.status, 201);
+  // Of unknown length (chunked): stopped while reading, at the limit. Either the 413 arrives
+  // or the connection is cut while the rest is still being sent.
+  const auto chunked = http_request(port_, "PUT", "/api/programs/big.ngc", big,
+                                    {{"Cookie", sam}, {"Transfer-Encoding", "chunked"}});
+  EXPECT_TRUE(chunked.status == 413 || chunked.status == 0) << chunked.status;
   EXPECT_TRUE(names_in(programs_).empty());
   const std::string fits(1 << 20, ';');
   EXPECT_EQ(http_request(port_, "PUT", "/api/programs/fits.ngc", fits, {{"Cookie", sam}}).status,
@@ -153,10 +154,10 @@ TEST_F(WebTest, WrongOriginAndObserversCannotUpload) {
                          {{"Cookie", sam}, {"Origin", "http://evil.example"}})
                 .status,
             403);
-  EXPECT_EQ(http_request(port_, "PUT", "/api/programs/a.ngc", "G0 X1\n",
-                         {{"Cookie", cookie("olga")}})
-                .status,
-            403);
+  EXPECT_EQ(
+      http_request(port_, "PUT", "/api/programs/a.ngc", "G0 X1\n", {{"Cookie", cookie("olga")}})
+          .status,
+      403);
   EXPECT_EQ(http_request(port_, "PUT", "/api/programs/a.ngc", "G0 X1\n",
                          {{"Cookie", cookie("otto")}, {"Origin", origin()}})
                 .status,

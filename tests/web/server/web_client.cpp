@@ -1,7 +1,12 @@
 #include "web_client.hpp"
 
+#include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <unistd.h>
+
 #include <sys/time.h>
+#include <chrono>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -39,9 +44,8 @@ HttpReply http_request(int port, const std::string& method, const std::string& t
   asio::io_context io;
   tcp::socket socket(io);
   beast::error_code ec;
-  socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"),
-                               static_cast<unsigned short>(port)),
-                 ec);
+  socket.connect(
+      tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)), ec);
   if (ec) return reply;
   set_timeout(socket, 30000);
   http::request<http::string_body> req{http::string_to_verb(method), target, 11};
@@ -49,9 +53,13 @@ HttpReply http_request(int port, const std::string& method, const std::string& t
   for (const auto& [name, value] : headers)
     req.set(name, value);
   req.body() = body;
-  if (!body.empty() || method == "PUT" || method == "POST") req.prepare_payload();
-  for (const auto& [name, value] : headers) {
-    if (lower(name) == "content-length") req.set(http::field::content_length, value);
+  bool chunked = false;
+  for (const auto& [name, value] : headers)
+    chunked |= lower(name) == "transfer-encoding";
+  if (chunked) {
+    req.chunked(true);
+  } else if (!body.empty() || method == "PUT" || method == "POST") {
+    req.prepare_payload();
   }
   http::write(socket, req, ec);
   // A server refusing a body it will not read may answer before all of it is sent.
@@ -68,10 +76,49 @@ HttpReply http_request(int port, const std::string& method, const std::string& t
   return reply;
 }
 
+// Reads are asynchronous, run for at most the time asked: asio's blocking reads wait forever
+// whatever SO_RCVTIMEO says. A read that timed out stays pending and is picked up next time.
+RawReply raw_exchange(int port, const std::string& bytes, int timeout_ms) {
+  RawReply reply;
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    close(fd);
+    return reply;
+  }
+  // The server may close before taking it all (a refused request): that is an answer too.
+  (void)send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  char buffer[4096];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          deadline - std::chrono::steady_clock::now())
+                          .count();
+    if (left <= 0) break;
+    pollfd p{fd, POLLIN, 0};
+    if (poll(&p, 1, static_cast<int>(left)) <= 0) continue;
+    const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) {
+      reply.closed = true;
+      break;
+    }
+    reply.text.append(buffer, static_cast<std::size_t>(n));
+  }
+  close(fd);
+  return reply;
+}
+
 struct WsClient::Impl {
   asio::io_context io;
   websocket::stream<tcp::socket> ws{io};
   bool open = false;
+  bool reading = false;
+  bool read_done = false;
+  beast::error_code read_ec;
+  beast::flat_buffer buffer;
 };
 
 WsClient::WsClient() : impl_(std::make_unique<Impl>()) {}
@@ -83,9 +130,8 @@ WsClient::~WsClient() {
 int WsClient::open(int port, const Headers& headers) {
   beast::error_code ec;
   auto& socket = impl_->ws.next_layer();
-  socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"),
-                               static_cast<unsigned short>(port)),
-                 ec);
+  socket.connect(
+      tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)), ec);
   if (ec) return 0;
   set_timeout(socket, 30000);
   impl_->ws.set_option(websocket::stream_base::decorator([headers](websocket::request_type& req) {
@@ -100,9 +146,14 @@ int WsClient::open(int port, const Headers& headers) {
 }
 
 void WsClient::send_text(const std::string& text) {
-  beast::error_code ec;
+  if (!impl_->open) return;
+  bool written = false;
   impl_->ws.text(true);
-  impl_->ws.write(asio::buffer(text), ec);
+  impl_->ws.async_write(asio::buffer(text),
+                        [&](beast::error_code, std::size_t) { written = true; });
+  impl_->io.restart();
+  while (!written && impl_->io.run_one_for(std::chrono::seconds(30)) > 0) {
+  }
 }
 
 void WsClient::send(const nlohmann::json& message) {
@@ -111,17 +162,28 @@ void WsClient::send(const nlohmann::json& message) {
 
 std::optional<nlohmann::json> WsClient::read(int timeout_ms) {
   if (!impl_->open) return std::nullopt;
-  set_timeout(impl_->ws.next_layer(), timeout_ms);
-  beast::flat_buffer buffer;
-  beast::error_code ec;
-  impl_->ws.read(buffer, ec);
-  if (ec) {
-    if (ec != beast::error::timeout && ec != asio::error::would_block &&
-        ec != asio::error::try_again)
-      impl_->open = false;
+  auto& impl = *impl_;
+  if (!impl.reading) {
+    impl.reading = true;
+    impl.read_done = false;
+    impl.ws.async_read(impl.buffer, [&impl](beast::error_code ec, std::size_t) {
+      impl.read_done = true;
+      impl.read_ec = ec;
+    });
+  }
+  impl.io.restart();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (!impl.read_done && impl.io.run_one_until(deadline) > 0) {
+  }
+  if (!impl.read_done) return std::nullopt;
+  impl.reading = false;
+  if (impl.read_ec) {
+    impl.open = false;
     return std::nullopt;
   }
-  return nlohmann::json::parse(beast::buffers_to_string(buffer.data()), nullptr, false);
+  auto frame = nlohmann::json::parse(beast::buffers_to_string(impl.buffer.data()), nullptr, false);
+  impl.buffer.consume(impl.buffer.size());
+  return frame;
 }
 
 nlohmann::json WsClient::answer_to(int id) {
@@ -149,15 +211,20 @@ nlohmann::json WsClient::call(const std::string& method, const nlohmann::json& p
 
 void WsClient::drop() {
   beast::error_code ec;
+  impl_->open = false;
   impl_->ws.next_layer().shutdown(tcp::socket::shutdown_both, ec);
   impl_->ws.next_layer().close(ec);
   impl_->open = false;
 }
 
 void WsClient::close() {
-  beast::error_code ec;
-  set_timeout(impl_->ws.next_layer(), 5000);
-  impl_->ws.close(websocket::close_code::normal, ec);
+  if (!impl_->open) return;
+  bool closed = false;
+  impl_->ws.async_close(websocket::close_code::normal, [&](beast::error_code) { closed = true; });
+  impl_->io.restart();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!closed && impl_->io.run_one_until(deadline) > 0) {
+  }
   drop();
 }
 

@@ -29,6 +29,14 @@ struct HttpReply {
 HttpReply http_request(int port, const std::string& method, const std::string& target,
                        const std::string& body = "", const Headers& headers = {});
 
+// Sends `bytes` on a new connection and returns what comes back until the server closes it or
+// `timeout_ms` passes; `closed` tells which.
+struct RawReply {
+  std::string text;
+  bool closed = false;
+};
+RawReply raw_exchange(int port, const std::string& bytes, int timeout_ms);
+
 class WsClient {
  public:
   WsClient();

@@ -109,14 +109,17 @@ class WebTest : public ::testing::Test {
     std::ofstream(ini_, std::ios::trunc) << text;
     ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini_.string()}), "");
     ASSERT_EQ(client_.connect(daemon_.socket()), "");
-    for (const auto& [name, role] : {std::pair{"olga", "observer"}, {"otto", "operator"},
-                                     {"opal", "operator"}, {"sam", "setter"}, {"ada", "admin"}}) {
+    for (const auto& [name, role] : {std::pair{"olga", "observer"},
+                                     {"otto", "operator"},
+                                     {"opal", "operator"},
+                                     {"sam", "setter"},
+                                     {"ada", "admin"}}) {
       ASSERT_EQ(add_user(name, role), 0);
     }
-    ASSERT_EQ(web_.start({"--ini", ini_.string(), "--socket", daemon_.socket(), "--www",
-                          www_.string()},
-                         dir_.path() / "cncd-web.log", port_),
-              "");
+    ASSERT_EQ(
+        web_.start({"--ini", ini_.string(), "--socket", daemon_.socket(), "--www", www_.string()},
+                   dir_.path() / "cncd-web.log", port_),
+        "");
   }
 
   void TearDown() override {
@@ -126,8 +129,8 @@ class WebTest : public ::testing::Test {
 
   // `cncd-web user add NAME --role ROLE`, the password (NAME + "-pw") on standard input.
   int add_user(const std::string& name, const std::string& role) {
-    BackgroundCommand add({CNCD_WEB_BINARY, "--ini", ini_.string(), "user", "add", name,
-                           "--role", role});
+    BackgroundCommand add(
+        {CNCD_WEB_BINARY, "--ini", ini_.string(), "user", "add", name, "--role", role});
     add.write_stdin(password(name) + "\n");
     const auto result = add.wait();
     EXPECT_EQ(result.exit_status, 0) << result.err;

@@ -24,9 +24,10 @@ std::string prepare(App& app) {
   if (!app.programs.ok()) return "[WEB] PROGRAM_DIR: " + app.programs.open_error();
   if (auto problem = app.users.load(); !problem.empty()) return problem;
   if (app.users.users().empty()) {
-    spdlog::warn("no users in {}: nobody can log in; add one with cncd-web --ini {} user add "
-                 "NAME --role admin",
-                 app.web.users_file.string(), app.machine.path.string());
+    spdlog::warn(
+        "no users in {}: nobody can log in; add one with cncd-web --ini {} user add "
+        "NAME --role admin",
+        app.web.users_file.string(), app.machine.path.string());
   }
   if (!std::filesystem::exists(app.www_dir / "index.html"))
     spdlog::warn("no index.html in {}: the page is missing (--www DIR)", app.www_dir.string());
@@ -37,8 +38,8 @@ std::string prepare(App& app) {
     try {
       auto& tls = app.tls.emplace(ssl::context::tls_server);
       tls.set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 |
-                      ssl::context::no_sslv3 | ssl::context::no_tlsv1 |
-                      ssl::context::no_tlsv1_1 | ssl::context::single_dh_use);
+                      ssl::context::no_sslv3 | ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 |
+                      ssl::context::single_dh_use);
       tls.use_certificate_chain_file(app.web.tls_cert.string());
       tls.use_private_key_file(app.web.tls_key.string(), ssl::context::pem);
     } catch (const boost::system::system_error& e) {

@@ -51,9 +51,8 @@ App::App(boost::asio::io_context& io_context, config::MachineConfig machine_conf
       programs(web.program_dir, web.max_upload_bytes),
       estimates(check, machine.path) {
   lease.set_observer([this](const std::optional<LeaseHolder>& holder, std::uint64_t) {
-    broadcast(nlohmann::json{{"jsonrpc", "2.0"},
-                             {"method", "lease.changed"},
-                             {"params", lease_holder_json(holder)}}
+    broadcast(nlohmann::json{
+        {"jsonrpc", "2.0"}, {"method", "lease.changed"}, {"params", lease_holder_json(holder)}}
                   .dump());
   });
 }
@@ -78,8 +77,8 @@ std::optional<Identity> App::identify(std::string_view cookie, std::string_view 
         !sessions.find_id(found->second.id)) {
       // A session of its own for the key's user, so that a WebSocket on a key can hold the
       // lease like one on a cookie; its token is never handed out.
-      found = key_sessions.insert_or_assign(user->name,
-                                            sessions.create(user->name, user->role, "api-key"))
+      found = key_sessions
+                  .insert_or_assign(user->name, sessions.create(user->name, user->role, "api-key"))
                   .first;
     }
     return Identity{user->name, user->role, found->second, true};

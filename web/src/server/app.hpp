@@ -49,12 +49,12 @@ class WsPeer {
 
 struct ServerLimits {
   std::size_t header_bytes = 16 * 1024;
-  std::size_t body_bytes = 1024 * 1024;              // any request but an upload
-  std::size_t ws_message_bytes = 1024 * 1024;        // one frame from a client
-  std::size_t ws_queue_bytes = 64 * 1024 * 1024;     // queued to one slow client, then closed
+  std::size_t body_bytes = 1024 * 1024;                 // any request but an upload
+  std::size_t ws_message_bytes = 1024 * 1024;           // one frame from a client
+  std::size_t ws_queue_bytes = 64 * 1024 * 1024;        // queued to one slow client, then closed
   std::size_t upstream_line_bytes = 256 * 1024 * 1024;  // one answer from cncd (a preview)
-  int header_seconds = 10;  // a request's header must arrive within this (slowloris)
-  int body_idle_seconds = 30;  // an upload or body that stalls this long is dropped
+  int header_seconds = 10;          // a request's header must arrive within this (slowloris)
+  int body_idle_seconds = 30;       // an upload or body that stalls this long is dropped
   std::size_t max_connections = 0;  // HTTP connections at once; 0 = 4 x MAX_CLIENTS + 16
 };
 
@@ -67,8 +67,8 @@ struct App {
   boost::asio::io_context& io;
   config::MachineConfig machine;
   config::WebConfig& web;
-  std::string socket_path;          // cncd's control socket
-  std::filesystem::path www_dir;    // the page's files
+  std::string socket_path;        // cncd's control socket
+  std::filesystem::path www_dir;  // the page's files
   std::optional<boost::asio::ssl::context> tls;
   ServerLimits limits;
 

@@ -106,8 +106,8 @@ void Estimates::run() {
     const Key key = queue_.front();
     lock.unlock();
     std::optional<double> seconds;
-    if (const auto out = output_of({check_.string(), "--plan", "--json", "--ini", ini_.string(),
-                                    std::get<0>(key)})) {
+    if (const auto out = output_of(
+            {check_.string(), "--plan", "--json", "--ini", ini_.string(), std::get<0>(key)})) {
       const auto json = nlohmann::json::parse(*out, nullptr, false);
       if (json.is_object() && json.value("cycle_time_s", nlohmann::json()).is_number())
         seconds = json["cycle_time_s"].get<double>();

@@ -4,11 +4,11 @@
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <map>
-#include <condition_variable>
 #include <mutex>
 #include <optional>
 #include <string>

@@ -7,9 +7,8 @@
 #include <chrono>
 #include <utility>
 
-#include <boost/asio/post.hpp>
 #include <spdlog/spdlog.h>
-
+#include <boost/asio/post.hpp>
 
 namespace cncd::web {
 namespace {
@@ -62,8 +61,9 @@ std::string http_date(std::chrono::system_clock::time_point t) {
 }
 
 std::string cookie(const std::string& value, bool tls, long max_age) {
-  return "cncd_session=" + value + "; HttpOnly; SameSite=Strict; Path=/; Max-Age=" +
-         std::to_string(max_age) + (tls ? "; Secure" : "");
+  return "cncd_session=" + value +
+         "; HttpOnly; SameSite=Strict; Path=/; Max-Age=" + std::to_string(max_age) +
+         (tls ? "; Secure" : "");
 }
 
 double unix_seconds(std::chrono::system_clock::time_point t) {
@@ -74,6 +74,7 @@ http::message_generator redirect(const RequestHeader& req, std::string_view to) 
   http::response<http::empty_body> res{http::status::see_other, req.version()};
   res.set(http::field::location, to);
   res.set(http::field::cache_control, "no-store");
+  res.prepare_payload();  // Content-Length: 0, or the client waits for the connection to end
   res.keep_alive(keeps_alive(req));
   return res;
 }
@@ -92,6 +93,7 @@ http::message_generator serve_file(App& app, const RequestHeader& req,
     res.set(http::field::cache_control, "no-cache");
     res.set(http::field::last_modified, modified);
     res.keep_alive(keeps_alive(req));
+    // 304 has no body by definition: no Content-Length needed.
     return res;
   }
   http::file_body::value_type body;
@@ -147,20 +149,20 @@ void login(App& app, StringRequest&& req, const Peer& peer,
   }
   const std::string user = body["user"];
   if (const auto wait = app.limiter.retry_after(peer.address, user); wait.count() > 0) {
-    auto res = error_response(req, http::status::too_many_requests,
-                              "too many failed logins; try again in " +
-                                  std::to_string(wait.count()) + " s");
+    auto res = error_response(
+        req, http::status::too_many_requests,
+        "too many failed logins; try again in " + std::to_string(wait.count()) + " s");
     res.set(http::field::retry_after, std::to_string(wait.count()));
     return done(std::move(res));
   }
-  if (const auto problem = app.refresh_users(); !problem.empty())
-    spdlog::error("{}", problem);
+  if (const auto problem = app.refresh_users(); !problem.empty()) spdlog::error("{}", problem);
   const User* known = app.users.find(user);
   std::string hash = known != nullptr ? known->password_hash : app.dummy_hash;
   const Role role = known != nullptr ? known->role : Role::observer;
   // argon2 takes a tenth of a second by design: never on the thread that forwards estops.
   boost::asio::post(app.workers, [&app, req = std::move(req), peer, user, role, known = !!known,
-                                  hash = std::move(hash), password = body["password"].get<std::string>(),
+                                  hash = std::move(hash),
+                                  password = body["password"].get<std::string>(),
                                   done = std::move(done)]() mutable {
     const bool ok = known && verify_password(hash, password);
     boost::asio::post(app.io, [&app, req = std::move(req), peer, user, role, ok,
@@ -173,8 +175,7 @@ void login(App& app, StringRequest&& req, const Peer& peer,
       app.limiter.succeeded(user);
       const Session session = app.sessions.create(user, role, peer.address);
       spdlog::info("{} ({}) logged in from {}", user, role_name(role), peer.address);
-      auto res = json_response(req, http::status::ok,
-                               {{"user", user}, {"role", role_name(role)}});
+      auto res = json_response(req, http::status::ok, {{"user", user}, {"role", role_name(role)}});
       res.set(http::field::set_cookie,
               cookie(session.token, peer.tls, static_cast<long>(app.web.session_hours) * 3600));
       done(std::move(res));
@@ -283,9 +284,9 @@ void handle_request(App& app, StringRequest&& req, const Peer& peer,
   const auto verb = req.method();
   const bool changes = verb != http::verb::get && verb != http::verb::head;
   if (changes && !origin_allowed(app, req, peer))
-    return done(error_response(req, http::status::forbidden,
-                               "origin " + std::string(req[http::field::origin]) +
-                                   " may not change anything here"));
+    return done(error_response(
+        req, http::status::forbidden,
+        "origin " + std::string(req[http::field::origin]) + " may not change anything here"));
   if (path == "/api/login") {
     if (verb != http::verb::post)
       return done(error_response(req, http::status::method_not_allowed, "POST only"));
@@ -307,8 +308,7 @@ void handle_request(App& app, StringRequest&& req, const Peer& peer,
     if (!who) return done(error_response(req, http::status::unauthorized, "log in first"));
     if (path == "/api/session" && verb == http::verb::get)
       return done(json_response(req, http::status::ok, session_json(*who)));
-    if (path == "/api/programs" && verb == http::verb::get)
-      return done(programs_list(app, req));
+    if (path == "/api/programs" && verb == http::verb::get) return done(programs_list(app, req));
     if (path.starts_with("/api/programs/") && verb == http::verb::get)
       return done(download(app, req, path.substr(std::string_view("/api/programs/").size())));
     return done(error_response(req, http::status::not_found, "no such API: " + std::string(path)));
@@ -321,18 +321,19 @@ void handle_request(App& app, StringRequest&& req, const Peer& peer,
   }
   const auto relative = static_path(path);
   if (!relative) return done(error_response(req, http::status::not_found, "no such file"));
-  const bool is_public = std::find(kPublicFiles.begin(), kPublicFiles.end(), *relative) !=
-                         kPublicFiles.end();
-  if (!is_public && !who) return done(error_response(req, http::status::unauthorized, "log in first"));
+  const bool is_public =
+      std::find(kPublicFiles.begin(), kPublicFiles.end(), *relative) != kPublicFiles.end();
+  if (!is_public && !who)
+    return done(error_response(req, http::status::unauthorized, "log in first"));
   done(serve_file(app, req, *relative));
 }
 
 UploadCheck check_upload(App& app, const RequestHeader& req, const Peer& peer) {
   UploadCheck check;
   if (!origin_allowed(app, req, peer)) {
-    check.refusal = error_response(req, http::status::forbidden,
-                                   "origin " + std::string(req[http::field::origin]) +
-                                       " may not upload here");
+    check.refusal =
+        error_response(req, http::status::forbidden,
+                       "origin " + std::string(req[http::field::origin]) + " may not upload here");
     return check;
   }
   const auto who = app.identify(req[http::field::cookie], req[http::field::authorization]);
@@ -355,10 +356,10 @@ UploadCheck check_upload(App& app, const RequestHeader& req, const Peer& peer) {
   if (const auto length = req[http::field::content_length]; !length.empty()) {
     const auto bytes = std::strtoll(std::string(length).c_str(), nullptr, 10);
     if (bytes > app.programs.max_upload_bytes()) {
-      check.refusal = error_response(
-          req, http::status::payload_too_large,
-          "the program is over the limit of " +
-              std::to_string(app.programs.max_upload_bytes() >> 20) + " MB ([WEB] MAX_UPLOAD_MB)");
+      check.refusal = error_response(req, http::status::payload_too_large,
+                                     "the program is over the limit of " +
+                                         std::to_string(app.programs.max_upload_bytes() >> 20) +
+                                         " MB ([WEB] MAX_UPLOAD_MB)");
       return check;
     }
   }
@@ -370,9 +371,9 @@ UploadCheck check_upload(App& app, const RequestHeader& req, const Peer& peer) {
 UpgradeCheck check_upgrade(App& app, const RequestHeader& req, const Peer& peer) {
   UpgradeCheck check;
   if (!origin_allowed(app, req, peer)) {
-    check.refusal = error_response(req, http::status::forbidden,
-                                   "origin " + std::string(req[http::field::origin]) +
-                                       " may not open a WebSocket here");
+    check.refusal = error_response(
+        req, http::status::forbidden,
+        "origin " + std::string(req[http::field::origin]) + " may not open a WebSocket here");
     return check;
   }
   auto who = app.identify(req[http::field::cookie], req[http::field::authorization]);

@@ -10,11 +10,11 @@
 #include <optional>
 #include <type_traits>
 
+#include <spdlog/spdlog.h>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
-#include <spdlog/spdlog.h>
 
 #include "http_handlers.hpp"
 #include "ws_session.hpp"
@@ -58,15 +58,21 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   void read_header() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(app_.limits.header_bytes));
+    // The body's limit depends on the request (an upload's is MAX_UPLOAD_MB): set once the
+    // header says which, not the parser's default 1 MiB checked against Content-Length here.
+    parser_->body_limit(boost::none);
     beast::get_lowest_layer(stream_).expires_after(header_time());
-    http::async_read_header(
-        stream_, buffer_, *parser_,
-        [self = this->shared_from_this()](beast::error_code ec, std::size_t) {
-          self->on_header(ec);
-        });
+    http::async_read_header(stream_, buffer_, *parser_,
+                            [self = this->shared_from_this()](beast::error_code ec, std::size_t) {
+                              self->on_header(ec);
+                            });
   }
 
   void on_header(beast::error_code ec) {
+    if (ec == http::error::body_limit)
+      return send(
+          error_response(parser_->get(), http::status::payload_too_large, "request body too large"),
+          false);
     if (ec == http::error::header_limit)
       return send(error_response(parser_->get(), http::status::request_header_fields_too_large,
                                  "request header too large"),
@@ -84,6 +90,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       return start_upload();
     if (req.method() == http::verb::put)
       return send(error_response(req, http::status::method_not_allowed, "PUT only on programs"),
+                  false);
+    // Beast checks a body limit against Content-Length only while parsing the header, which
+    // is done: a declared length is checked here, a chunked body while it is read.
+    if (const auto length = parser_->content_length(); length && *length > app_.limits.body_bytes)
+      return send(error_response(req, http::status::payload_too_large, "request body too large"),
                   false);
     body_parser_.emplace(std::move(*parser_));
     body_parser_->body_limit(app_.limits.body_bytes);
@@ -134,12 +145,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       // curl -T waits for this before it sends a large body.
       auto go_on = std::make_shared<http::response<http::empty_body>>(
           http::status::continue_, upload_parser_->get().version());
-      return http::async_write(stream_, *go_on,
-                               [self = this->shared_from_this(), go_on](beast::error_code ec,
-                                                                        std::size_t) {
-                                 if (ec) return self->close();
-                                 self->read_chunk();
-                               });
+      return http::async_write(
+          stream_, *go_on,
+          [self = this->shared_from_this(), go_on](beast::error_code ec, std::size_t) {
+            if (ec) return self->close();
+            self->read_chunk();
+          });
     }
     read_chunk();
   }
@@ -182,7 +193,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     const auto size = upload_->size();
     const auto status = upload_->commit(name_, app_.running());
     upload_.reset();
-    if (!status.ok()) return send(error_response(req, status_of(status.error), status.message), true);
+    if (!status.ok())
+      return send(error_response(req, status_of(status.error), status.message), true);
     spdlog::info("{} at {} uploaded program {} ({} bytes)", user_, peer_.address, name_, size);
     send(json_response(req, http::status::created, {{"name", name_}, {"size", size}}), true);
   }

@@ -9,7 +9,7 @@ namespace cncd::web {
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
 
-Listener::Listener(App& app) : app_(app), acceptor_(app.io) {
+Listener::Listener(App& app) : app_(app), acceptor_(app.io), retry_(app.io) {
   const tcp::endpoint where(asio::ip::make_address(app.web.listen),
                             static_cast<unsigned short>(app.web.port));
   acceptor_.open(where.protocol());
@@ -25,6 +25,7 @@ void Listener::start() {
 void Listener::stop() {
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  retry_.cancel();
 }
 
 void Listener::accept_next() {
@@ -51,7 +52,12 @@ void Listener::accept_next() {
             ->run();
       }
     } else {
-      spdlog::warn("accept: {}", ec.message());
+      // Out of descriptors, most likely: wait rather than spin until some close.
+      spdlog::warn("accept: {}; pausing 100 ms", ec.message());
+      retry_.expires_after(std::chrono::milliseconds(100));
+      return retry_.async_wait([this](boost::system::error_code wait_ec) {
+        if (!wait_ec) accept_next();
+      });
     }
     accept_next();
   });

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "app.hpp"
 
@@ -21,6 +22,7 @@ class Listener {
 
   App& app_;
   boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer retry_;
 };
 
 }  // namespace cncd::web

@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
-#include <spdlog/spdlog.h>
 
 #include "admin_entry.hpp"
-#include "cncd/web/admin_cli.hpp"
 #include "app.hpp"
+#include "cncd/web/admin_cli.hpp"
 #include "listener.hpp"
 #include "logging.hpp"
 #include "status_watch.hpp"
@@ -108,9 +108,9 @@ int main(int argc, char** argv) {
     cncd::web::StatusWatch watch(app);
     listener.start();
     watch.start();
-    spdlog::info("cncd-web {} serving {}://{}:{} for cncd at {} (programs in {})",
-                 cncd::kVersion, app.tls ? "https" : "http", app.web.listen,
-                 listener.endpoint().port(), app.socket_path, app.programs.path().string());
+    spdlog::info("cncd-web {} serving {}://{}:{} for cncd at {} (programs in {})", cncd::kVersion,
+                 app.tls ? "https" : "http", app.web.listen, listener.endpoint().port(),
+                 app.socket_path, app.programs.path().string());
     boost::asio::signal_set signals(io, SIGTERM, SIGINT);
     signals.async_wait([&](const boost::system::error_code& ec, int signal) {
       if (ec) return;

@@ -11,17 +11,20 @@ void StatusWatch::start() {
   upstream_->start([this](std::string line) { on_line(line); },
                    [this](const std::string& why) {
                      app_.program_running = false;
-                     spdlog::warn("{}; trying again in 2 s", why);
+                     // Once per outage, not every 2 s while cncd is away.
+                     if (!away_) spdlog::warn("{}; trying again every 2 s", why);
+                     away_ = true;
                      retry_.expires_after(std::chrono::seconds(2));
                      retry_.async_wait([this](boost::system::error_code ec) {
                        if (!ec) start();
                      });
                    });
-  upstream_->send(nlohmann::json{{"jsonrpc", "2.0"},
-                                 {"id", 1},
-                                 {"method", "status.subscribe"},
-                                 {"params", {{"interval_ms", 200}, {"fields", {"program", "exec"}}}}}
-                      .dump());
+  upstream_->send(
+      nlohmann::json{{"jsonrpc", "2.0"},
+                     {"id", 1},
+                     {"method", "status.subscribe"},
+                     {"params", {{"interval_ms", 200}, {"fields", {"program", "exec"}}}}}
+          .dump());
 }
 
 void StatusWatch::stop() {
@@ -32,6 +35,8 @@ void StatusWatch::stop() {
 
 void StatusWatch::on_line(const std::string& line) {
   const auto message = nlohmann::json::parse(line, nullptr, false);
+  if (away_) spdlog::info("connected to cncd at {}", app_.socket_path);
+  away_ = false;
   if (!message.is_object() || message.value("method", "") != "status.update") return;
   const auto& params = message["params"];
   if (!params.is_object() || !params.value("changed", nlohmann::json()).is_object()) return;

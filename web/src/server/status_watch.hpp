@@ -27,6 +27,7 @@ class StatusWatch {
   boost::asio::steady_timer retry_;
   nlohmann::json status_;
   bool stopped_ = false;
+  bool away_ = false;  // cncd could not be reached last time
 };
 
 }  // namespace cncd::web

@@ -15,15 +15,14 @@ Upstream::Upstream(asio::io_context& io, std::string socket_path, std::size_t ma
 void Upstream::start(LineHandler on_line, CloseHandler on_close) {
   on_line_ = std::move(on_line);
   on_close_ = std::move(on_close);
-  socket_.async_connect(Protocol::endpoint(path_),
-                        [self = shared_from_this()](const boost::system::error_code& ec) {
-                          if (self->closed_) return;
-                          if (ec) return self->fail("cannot connect to cncd at " + self->path_ +
-                                                    ": " + ec.message());
-                          self->connected_ = true;
-                          self->write_next();
-                          self->read_next();
-                        });
+  socket_.async_connect(
+      Protocol::endpoint(path_), [self = shared_from_this()](const boost::system::error_code& ec) {
+        if (self->closed_) return;
+        if (ec) return self->fail("cannot connect to cncd at " + self->path_ + ": " + ec.message());
+        self->connected_ = true;
+        self->write_next();
+        self->read_next();
+      });
 }
 
 void Upstream::send(std::string line) {
@@ -60,8 +59,9 @@ void Upstream::read_next() {
         if (ec == asio::error::not_found) return self->fail("cncd sent a line over the limit");
         if (ec == asio::error::eof) return self->fail("cncd closed the connection");
         if (ec) return self->fail("reading from cncd: " + ec.message());
-        std::string line(asio::buffers_begin(self->in_.data()),
-                         asio::buffers_begin(self->in_.data()) + static_cast<std::ptrdiff_t>(n - 1));
+        std::string line(
+            asio::buffers_begin(self->in_.data()),
+            asio::buffers_begin(self->in_.data()) + static_cast<std::ptrdiff_t>(n - 1));
         self->in_.consume(n);
         self->on_line_(std::move(line));
         if (!self->closed_) self->read_next();

@@ -58,16 +58,15 @@ json WsRpc::web_method(const std::string& method, const json& params, json& forw
     const auto taken = app_.lease.take(session, force);
     if (!taken.ok) {
       const auto& h = taken.holder;
-      throw WebError{kLeaseRefused,
-                     "the control lease is held by " + (h ? h->user + " at " + h->address : "") +
-                         "; take it over with {\"force\": true}"};
+      throw WebError{kLeaseRefused, "the control lease is held by " +
+                                        (h ? h->user + " at " + h->address : "") +
+                                        "; take it over with {\"force\": true}"};
     }
     spdlog::info("{} at {} took the control lease{}", who_.user, address_,
                  force ? " (forced)" : "");
     return lease_holder_json(taken.holder);
   }
   if (method == "lease.release") return {{"released", app_.lease.release(who_.session.id)}};
-  if (method == "jog.heartbeat") return {{"ok", true}};  // cncd without jog heartbeats
   if (method == "files.list") {
     FileStatus status;
     const auto entries = app_.programs.list(status);

@@ -9,13 +9,47 @@ namespace {
 using json = nlohmann::json;
 
 constexpr int kParseError = -32700;
+constexpr int kInvalidRequest = -32600;
+// As cncd: printing or copying a value recurses once per level, and a 1 MiB frame of brackets
+// would exhaust the stack. Checked by a SAX pass that builds nothing and stops at the limit.
+constexpr std::size_t kMaxNesting = 64;
+
+class DepthCheck : public json::json_sax_t {
+ public:
+  bool too_deep = false;
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return open(); }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(); }
+  bool end_array() override { return close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  bool open() {
+    too_deep = ++depth_ > kMaxNesting;
+    return !too_deep;
+  }
+  bool close() {
+    --depth_;
+    return true;
+  }
+  std::size_t depth_ = 0;
+};
 constexpr int kMethodNotFound = -32601;
 constexpr int kInvalidParams = -32602;
 
 bool is_web_method(std::string_view method) {
-  return method == "web.session" || method.starts_with("lease.") ||
-         method.starts_with("files.") || method.starts_with("users.") ||
-         (!kDaemonJogHeartbeat && method == "jog.heartbeat");
+  return method == "web.session" || method.starts_with("lease.") || method.starts_with("files.") ||
+         method.starts_with("users.");
 }
 
 // Methods that only read: they go on without attribution, which cncd accepts only from
@@ -45,6 +79,14 @@ WsRpc::WsRpc(App& app, Identity who, std::string address)
 
 WsRpc::Output WsRpc::on_client(std::string_view text) {
   Output out;
+  DepthCheck depth;
+  json::sax_parse(text, &depth);
+  if (depth.too_deep) {
+    out.to_client.push_back(
+        dump(rpc_error(nullptr, kInvalidRequest,
+                       "request nested deeper than " + std::to_string(kMaxNesting) + " levels")));
+    return out;
+  }
   json message = json::parse(text, nullptr, false);
   if (message.is_discarded()) {
     out.to_client.push_back(dump(rpc_error(nullptr, kParseError, "parse error: not valid JSON")));
@@ -98,6 +140,7 @@ WsRpc::Handled WsRpc::handle(json request) {
       json forward;
       json result = web_method(method, params, forward);
       if (!forward.is_null()) {
+        if (!notification) forward["id"] = id;
         request = std::move(forward);  // files.open: becomes program.open
         params = request["params"];
       } else {
@@ -120,7 +163,9 @@ WsRpc::Handled WsRpc::handle(json request) {
   }
   if (sent == "jog.start" && params.is_object() && params.value("axis", json()).is_string()) {
     jogging_.insert(upper(params["axis"]));
-    if (kDaemonJogHeartbeat) request["params"]["heartbeat_s"] = app_.web.jog_heartbeat_s;
+    // A page that stops sending jog.heartbeat (tab closed, network lost, browser frozen) stops
+    // the jog this long after: cncd does it, also when cncd-web itself is gone.
+    request["params"]["heartbeat_s"] = app_.web.jog_heartbeat_s;
   }
   if (sent == "jog.stop" && params.is_object() && params.value("axis", json()).is_string())
     jogging_.erase(upper(params["axis"]));

@@ -19,11 +19,6 @@ namespace cncd::web {
 inline constexpr int kRoleRefused = 1020;
 inline constexpr int kLeaseRefused = 1021;
 
-// cncd takes "heartbeat_s" in jog.start and serves jog.heartbeat (the daemon's jog
-// heartbeat). Without it a continuous jog from the web still stops when its WebSocket closes,
-// as cncd-web then sends jog.stop.
-inline constexpr bool kDaemonJogHeartbeat = false;
-
 class WsRpc {
  public:
   struct Output {

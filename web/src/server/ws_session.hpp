@@ -9,13 +9,13 @@
 #include <memory>
 #include <string>
 
+#include <spdlog/spdlog.h>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
 #include <boost/beast/websocket/ssl.hpp>
-#include <spdlog/spdlog.h>
 
 #include "app.hpp"
 #include "upstream.hpp"
@@ -44,8 +44,9 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
     namespace websocket = boost::beast::websocket;
     req_ = std::move(req);
     ws_.set_option(websocket::stream_base::timeout::suggested(boost::beast::role_type::server));
-    ws_.set_option(websocket::stream_base::decorator(
-        [](websocket::response_type& res) { res.set(boost::beast::http::field::server, "cncd-web"); }));
+    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
+      res.set(boost::beast::http::field::server, "cncd-web");
+    }));
     ws_.read_message_max(app_.limits.ws_message_bytes);
     ws_.async_accept(req_, [self = this->shared_from_this()](boost::beast::error_code ec) {
       if (ec) return;
@@ -65,7 +66,8 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
     app_.peers.insert(this);
     spdlog::info("{} ({}) connected from {}", rpc_.identity().user, role_name(rpc_.identity().role),
                  address_);
-    upstream_ = std::make_shared<Upstream>(app_.io, app_.socket_path, app_.limits.upstream_line_bytes);
+    upstream_ =
+        std::make_shared<Upstream>(app_.io, app_.socket_path, app_.limits.upstream_line_bytes);
     std::weak_ptr<WsSession> weak = this->shared_from_this();
     upstream_->start(
         [weak](std::string line) {
@@ -78,17 +80,18 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
   }
 
   void read_next() {
-    ws_.async_read(in_, [self = this->shared_from_this()](boost::beast::error_code ec, std::size_t) {
-      if (ec) return self->cleanup();
-      const std::string text = boost::beast::buffers_to_string(self->in_.data());
-      self->in_.consume(self->in_.size());
-      auto out = self->rpc_.on_client(text);
-      for (auto& line : out.to_daemon)
-        self->upstream_->send(std::move(line));
-      for (auto& frame : out.to_client)
-        self->queue(frame);
-      if (!self->closing_) self->read_next();
-    });
+    ws_.async_read(in_,
+                   [self = this->shared_from_this()](boost::beast::error_code ec, std::size_t) {
+                     if (ec) return self->cleanup();
+                     const std::string text = boost::beast::buffers_to_string(self->in_.data());
+                     self->in_.consume(self->in_.size());
+                     auto out = self->rpc_.on_client(text);
+                     for (auto& line : out.to_daemon)
+                       self->upstream_->send(std::move(line));
+                     for (auto& frame : out.to_client)
+                       self->queue(frame);
+                     if (!self->closing_) self->read_next();
+                   });
   }
 
   void queue(const std::string& text) {
@@ -139,7 +142,7 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
   // was its session's last.
   void cleanup() {
     if (closing_) return;
-    closing_ = true;  // out_ stays: a write may still be reading its front
+    closing_ = true;                      // out_ stays: a write may still be reading its front
     if (!app_.peers.erase(this)) return;  // never accepted
     if (upstream_) {
       for (auto& line : rpc_.on_close())
