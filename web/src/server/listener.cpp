@@ -38,6 +38,10 @@ void Listener::accept_next() {
       boost::system::error_code peer_ec;
       const auto remote = socket.remote_endpoint(peer_ec);
       Peer peer{peer_ec ? std::string("?") : remote.address().to_string(), app_.tls.has_value()};
+      // Answers are small frames: without this an estop's answer waits for the client's
+      // delayed ACK (about 40 ms) behind the status update sent before it.
+      boost::system::error_code nodelay_ec;
+      socket.set_option(tcp::no_delay(true), nodelay_ec);
       if (app_.connections >= limit) {
         spdlog::warn("connection from {} refused: {} connections open", peer.address,
                      app_.connections);
