@@ -184,5 +184,30 @@ TEST_F(WebWsTest, ProgramOpenTakesANameInTheProgramDirectory) {
   EXPECT_EQ(code_of(sam->call("program.open", {{"path", "missing.ngc"}})), -32602);
 }
 
+TEST_F(WebWsTest, AnAdminAddsAUserAndChangesAPasswordAlone) {
+  auto ada = ws("ada");
+  // Hashed away from the thread that serves the WebSockets; answered when done.
+  const auto added =
+      ada->call("users.add", {{"name", "nina"}, {"role", "operator"}, {"password", "nina-pw"}});
+  ASSERT_TRUE(has_result(added)) << added.dump();
+  EXPECT_EQ(login("nina", "nina-pw").status, 200);
+  EXPECT_EQ(code_of(ada->call("users.add",
+                              {{"name", "nina"}, {"role", "operator"}, {"password", "x-pw-x"}})),
+            -32602);
+  const auto changed = ada->call("users.passwd", {{"name", "nina"}, {"password", "nina-new"}});
+  ASSERT_TRUE(has_result(changed)) << changed.dump();
+  EXPECT_EQ(login("nina", "nina-pw").status, 401);
+  EXPECT_EQ(login("nina", "nina-new").status, 200);
+  // Not inside a batch, where its answer could not wait for the hash.
+  ada->send(json::array({{{"jsonrpc", "2.0"},
+                          {"id", 7},
+                          {"method", "users.passwd"},
+                          {"params", {{"name", "nina"}, {"password", "nina-x"}}}}}));
+  const auto batch = ada->read();
+  ASSERT_TRUE(batch && batch->is_array()) << (batch ? batch->dump() : "no answer");
+  EXPECT_EQ(code_of((*batch)[0]), -32600) << batch->dump();
+  EXPECT_EQ(login("nina", "nina-new").status, 200);
+}
+
 }  // namespace
 }  // namespace cncd::test

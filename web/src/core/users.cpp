@@ -215,6 +215,20 @@ std::string UsersFile::add(std::string_view name, Role role, std::string_view pa
   return "";
 }
 
+std::string UsersFile::add(std::string_view name, Role role, HashedPassword hash) {
+  if (auto why = check_user_name(name); !why.empty()) return why;
+  if (find(name) != nullptr) return "user '" + std::string(name) + "' exists already";
+  users_.push_back(User{std::string(name), role, std::move(hash.encoded), {}});
+  return "";
+}
+
+std::string UsersFile::set_password(std::string_view name, HashedPassword hash) {
+  User* user = entry(name);
+  if (user == nullptr) return "no user '" + std::string(name) + "'";
+  user->password_hash = std::move(hash.encoded);
+  return "";
+}
+
 std::string UsersFile::remove(std::string_view name) {
   const auto it =
       std::find_if(users_.begin(), users_.end(), [&](const User& u) { return u.name == name; });

@@ -93,9 +93,24 @@ WsRpc::Output WsRpc::on_client(std::string_view text) {
     return out;
   }
   if (!message.is_array() || message.empty()) {
+    const json id = message.is_object() ? message.value("id", json()) : json();
+    const bool notification = !message.is_object() || !message.contains("id");
     Handled h = handle(std::move(message));
     if (!h.answer.is_null()) out.to_client.push_back(dump(h.answer));
     if (!h.forward.is_null()) out.to_daemon.push_back(dump(h.forward));
+    if (later_finish_) {
+      out.later = Later{std::move(later_work_),
+                        [finish = std::move(*later_finish_), id, notification](std::string done) {
+                          json answer;
+                          try {
+                            answer = {{"jsonrpc", "2.0"}, {"id", id}, {"result", finish(done)}};
+                          } catch (const WebError& e) {
+                            answer = rpc_error(id, e.code, e.message);
+                          }
+                          return notification ? std::string() : dump(answer);
+                        }};
+      later_finish_.reset();
+    }
     return out;
   }
   // A batch: each request checked on its own. Those answered here come back as one batch,
@@ -103,6 +118,13 @@ WsRpc::Output WsRpc::on_client(std::string_view text) {
   json answers = json::array();
   json forward = json::array();
   for (auto& request : message) {
+    if (request.is_object() && (request.value("method", json()) == "users.add" ||
+                                request.value("method", json()) == "users.passwd")) {
+      answers.push_back(rpc_error(
+          request.value("id", json()), kInvalidRequest,
+          "send " + request["method"].get<std::string>() + " on its own, not in a batch"));
+      continue;
+    }
     Handled h = handle(std::move(request));
     if (!h.answer.is_null()) answers.push_back(std::move(h.answer));
     if (!h.forward.is_null()) forward.push_back(std::move(h.forward));
@@ -139,6 +161,7 @@ WsRpc::Handled WsRpc::handle(json request) {
     try {
       json forward;
       json result = web_method(method, params, forward);
+      if (later_finish_) return h;  // answered when the worker is done
       if (!forward.is_null()) {
         if (!notification) forward["id"] = id;
         request = std::move(forward);  // files.open: becomes program.open

@@ -4,6 +4,8 @@
 // web user and address ("on_behalf_of") and, for jog.start, the heartbeat.
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -21,9 +23,16 @@ inline constexpr int kLeaseRefused = 1021;
 
 class WsRpc {
  public:
+  // A request whose slow part (argon2) runs on a worker: `work` there, then `finish` back on
+  // the I/O thread with work's result; finish gives the answer frame ("" for a notification).
+  struct Later {
+    std::function<std::string()> work;
+    std::function<std::string(std::string)> finish;
+  };
   struct Output {
     std::vector<std::string> to_client;  // frames
     std::vector<std::string> to_daemon;  // lines
+    std::optional<Later> later;
   };
 
   WsRpc(App& app, Identity who, std::string address);
@@ -46,6 +55,10 @@ class WsRpc {
   Handled handle(nlohmann::json request);
   nlohmann::json web_method(const std::string& method, const nlohmann::json& params,
                             nlohmann::json& forward);
+
+  // Set by web_method for a request answered later (users.add, users.passwd).
+  std::optional<std::function<nlohmann::json(std::string)>> later_finish_;
+  std::function<std::string()> later_work_;
 
   App& app_;
   Identity who_;

@@ -90,8 +90,23 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
                        self->upstream_->send(std::move(line));
                      for (auto& frame : out.to_client)
                        self->queue(frame);
+                     if (out.later) self->run_later(std::move(*out.later));
                      if (!self->closing_) self->read_next();
                    });
+  }
+
+  // The slow part on a worker; the answer back on the I/O thread, to this socket while open
+  // (the change itself is made either way).
+  void run_later(WsRpc::Later later) {
+    boost::asio::post(app_.workers, [&app = app_, later = std::move(later),
+                                     weak = this->weak_from_this()]() mutable {
+      std::string done = later.work();
+      boost::asio::post(app.io, [later = std::move(later), done = std::move(done),
+                                 weak = std::move(weak)]() mutable {
+        const std::string frame = later.finish(std::move(done));
+        if (auto self = weak.lock(); self && !frame.empty()) self->queue(frame);
+      });
+    });
   }
 
   void queue(const std::string& text) {

@@ -61,12 +61,19 @@ struct NewApiKey {
   std::string key;
 };
 
+// A password already hashed by hash_password() (with the file's cost()), so that the slow
+// hashing can run away from the thread that owns the file.
+struct HashedPassword {
+  std::string encoded;
+};
+
 // The users file in memory. Not thread-safe: the owner serialises access.
 class UsersFile {
  public:
   explicit UsersFile(std::filesystem::path path, PasswordCost cost = {});
 
   const std::filesystem::path& path() const { return path_; }
+  const PasswordCost& cost() const { return cost_; }
 
   // Reads the file, replacing what is in memory. A missing file is no users (""). Refused
   // (the message names the file and, where it applies, the line or the mode): a file that the
@@ -90,6 +97,9 @@ class UsersFile {
   std::string add(std::string_view name, Role role, std::string_view password);
   std::string remove(std::string_view name);
   std::string set_password(std::string_view name, std::string_view password);
+  // The same with the hash made beforehand (the password's rules were checked then).
+  std::string add(std::string_view name, Role role, HashedPassword hash);
+  std::string set_password(std::string_view name, HashedPassword hash);
   std::string set_role(std::string_view name, Role role);
   // A new key for `name` (the key itself is never stored); nullopt with `error` set when the
   // user is unknown.
