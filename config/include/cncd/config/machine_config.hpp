@@ -246,8 +246,8 @@ struct WebConfig {
   // Origins besides the page's own that a browser's WebSocket may come from (e.g. the address
   // nginx serves the page at), "scheme://host[:port]".
   std::vector<std::string> allowed_origins;
-  int session_hours = 12;       // a login's lifetime
-  int max_clients = 64;         // WebSocket connections at once
+  int session_hours = 12;         // a login's lifetime
+  int max_clients = 64;           // WebSocket connections at once
   double jog_heartbeat_s = 0.25;  // a continuous jog stops this long after its last heartbeat
 };
 
