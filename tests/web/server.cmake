@@ -2,7 +2,7 @@
 add_executable(cncd_web_server_test server/web_client.cpp server/server_http_test.cpp
                                     server/server_ws_test.cpp server/server_robustness_test.cpp)
 target_include_directories(cncd_web_server_test PRIVATE server)
-target_link_libraries(cncd_web_server_test PRIVATE cncd_client cncd_test_support Boost::headers
+target_link_libraries(cncd_web_server_test PRIVATE cncd_client cncd_test_support cncd_asio
                                                    nlohmann_json::nlohmann_json GTest::gtest_main)
 target_compile_definitions(cncd_web_server_test PRIVATE
   CNCD_WEB_BINARY="$<TARGET_FILE:cncd-web>")
