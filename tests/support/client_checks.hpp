@@ -23,4 +23,19 @@ inline void expect_stopped_short_of_x200(daemon::Client& client, const nlohmann:
   EXPECT_LT(x, 200.0);
 }
 
+// Reads the status with `status` every 10 ms until `done` holds for it (returned) or `limit`
+// has passed (a test failure, with the last status read).
+template <typename Read, typename Predicate>
+nlohmann::json poll_status(Read status, Predicate done, std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  nlohmann::json s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    s = status();
+    if (done(s)) return s;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ADD_FAILURE() << "condition not reached; last status: " << s.dump();
+  return s;
+}
+
 }  // namespace cncd::test

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "client.hpp"
+#include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "web_client.hpp"
 
@@ -165,15 +166,7 @@ class WebTest : public ::testing::Test {
   }
   template <typename Predicate>
   nlohmann::json wait_until(Predicate done, std::chrono::seconds limit = std::chrono::seconds(60)) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    nlohmann::json s;
-    while (std::chrono::steady_clock::now() < deadline) {
-      s = status();
-      if (done(s)) return s;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ADD_FAILURE() << "condition not reached; last status: " << s.dump();
-    return s;
+    return poll_status([this] { return status(); }, done, limit);
   }
 
   TempDir dir_;
