@@ -189,6 +189,10 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     task.tool_change_done(params["tool"].get<int>());
     return ok();
   });
+  dispatcher.add("wait.done", [&task](const json& params) {
+    task.wait_done(params["kind"].get<std::string>());
+    return ok();
+  });
   dispatcher.add("program.abort", [&task, &completions](const json&, Session& session) {
     if (session.in_batch) {
       task.abort();

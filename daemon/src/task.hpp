@@ -96,6 +96,9 @@ class Task {
   // on. Throws TaskError: wrong_state when no tool change is waited for, bad_value when the
   // change waiting is for another tool.
   void tool_change_done(int tool);
+  // The operator ends the program's wait of `kind` ("input": an M66 goes on as on its
+  // timeout; "spindle_at_speed": the feed goes on while the spindle turns as told).
+  void wait_done(const std::string& kind);
   // At the end of a run: the tool put back as the machine has it (task_io.cpp).
   void untake_tool_changes(bool ended_as_written);
   // Executes one MDI block; the answer under `token` is posted when it has finished.

@@ -82,6 +82,29 @@ void Task::tool_change_done(int tool) {
   if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
 }
 
+void Task::wait_done(const std::string& kind) {
+  const auto s = motion_.status();
+  const bool input = kind == "input";
+  if (!input && kind != "spindle_at_speed") {
+    throw TaskError(TaskErrorKind::bad_value,
+                    fmt::format("wait kind '{}' is not input or spindle_at_speed", kind));
+  }
+  const auto wanted =
+      input ? motion::WaitStatus::Kind::input : motion::WaitStatus::Kind::spindle_at_speed;
+  if (exec_ == ExecState::idle || s.wait.kind != wanted)
+    throw TaskError(TaskErrorKind::wrong_state, fmt::format("no {} wait is under way", kind));
+  if (!input && (!s.spindle.enabled || s.spindle.actual_rpm <= 0)) {
+    throw TaskError(TaskErrorKind::wrong_state,
+                    "the spindle is not turning: it cannot be taken as at speed");
+  }
+  events_.add("warning", "program",
+              input ? fmt::format("the wait for {} input {} was ended: #5399 = -1",
+                                  s.wait.digital ? "digital" : "analog", s.wait.index)
+                    : fmt::format("the wait for the spindle at speed was ended at {:.0f} rpm",
+                                  s.spindle.actual_rpm));
+  motion_.end_wait(wanted, s.wait.since);
+}
+
 // A run that ends before an M6 it read was carried out leaves in the spindle the tool that was
 // there before that change, whatever the interpreter read after it; so does one that ends
 // while it skips the lines before the one it runs from. A run that ended as written has made

@@ -349,6 +349,13 @@ void MotionController::release_hold(std::uint32_t hold_id) {
   command.id = hold_id;
   impl_->send(command);
 }
+void MotionController::end_wait(WaitStatus::Kind kind, std::uint64_t since) {
+  Command command;
+  command.kind = Command::Kind::end_wait;
+  command.id = static_cast<std::uint32_t>(kind);
+  command.since = since;
+  impl_->send(command);
+}
 
 namespace {
 // Why a jog cannot start now (checked before the servo thread sees it), or "".

@@ -96,11 +96,14 @@ bool MachineIo::wait_at_speed(bool first) noexcept {
     wait_ = {};
     wait_.kind = WaitStatus::Kind::spindle_at_speed;
     wait_.since = cycle_;
+    wait_ended_ = false;
   }
-  if (!spindle_.enabled || at_speed()) {
+  if (!spindle_.enabled || at_speed() || (wait_ended_ && turning_as_told())) {
     wait_ = {};
+    wait_ended_ = false;
     return true;
   }
+  wait_ended_ = false;
   ++waited_;
   if (static_cast<double>(waited_) * period_s_ >= config_.at_speed_timeout_s) {
     not_at_speed();
@@ -130,6 +133,7 @@ bool MachineIo::wait_input(const IoAction& action, bool first) noexcept {
     wait_.index = action.index;
     wait_.digital = action.digital;
     wait_.since = cycle_;
+    wait_ended_ = false;
   }
   // LinuxCNC's modes: 0 read at once, 1 rising edge, 2 falling edge, 3 high, 4 low.
   bool met = false;
@@ -151,8 +155,9 @@ bool MachineIo::wait_input(const IoAction& action, bool first) noexcept {
       break;
   }
   last_input_ = high;
-  const bool timed_out =
-      !met && static_cast<double>(waited_) * period_s_ >= std::max(0.0, action.timeout_s);
+  const bool timed_out = !met && (wait_ended_ || static_cast<double>(waited_) * period_s_ >=
+                                                     std::max(0.0, action.timeout_s));
+  wait_ended_ = false;
   ++waited_;
   if (!met && !timed_out) return false;
   input_result_ = met ? value : -1.0;
@@ -190,6 +195,12 @@ void MachineIo::stop_all() noexcept {
 void MachineIo::cancel_wait() noexcept {
   wait_ = {};
   released_ = false;
+  wait_ended_ = false;
+}
+
+void MachineIo::end_wait(WaitStatus::Kind kind, std::uint64_t since) noexcept {
+  if (kind != WaitStatus::Kind::none && wait_.kind == kind && wait_.since == since)
+    wait_ended_ = true;
 }
 
 void MachineIo::release(std::uint32_t hold_id) noexcept {

@@ -198,4 +198,10 @@ bool MachineIo::at_speed() const noexcept {
   return std::abs(have - want) <= config_.at_speed_tolerance * want;
 }
 
+bool MachineIo::turning_as_told() const noexcept {
+  if (!spindle_.enabled) return false;
+  if (ideal_ || !spindle_.present || !in_.spindle.present) return true;
+  return acknowledged() && !reversing_ && spindle_.actual_rpm > stopped_rpm();
+}
+
 }  // namespace cncd::motion

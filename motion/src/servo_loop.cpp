@@ -206,6 +206,9 @@ void ServoLoop::apply(const Command& command) noexcept {
     case Command::Kind::release:
       io_.release(command.id);
       break;
+    case Command::Kind::end_wait:
+      io_.end_wait(static_cast<WaitStatus::Kind>(command.id), command.since);
+      break;
     case Command::Kind::feed_override:
       // The controller clamps; a NaN would stall every later move.
       if (std::isfinite(command.velocity))

@@ -30,14 +30,13 @@ inline int error_code(const nlohmann::json& response) {
 // RpcParams.TableListsEveryServedMethod.
 inline const std::vector<std::string>& served_methods() {
   static const std::vector<std::string> methods = {
-      "status.get",      "status.subscribe", "status.unsubscribe", "errors.list",
-      "system.info",     "machine.estop",    "machine.reset",      "machine.on",
-      "machine.off",     "machine.home",     "jog.start",          "jog.stop",
-      "jog.increment",   "program.open",     "program.run",        "program.step",
-      "program.pause",   "program.resume",   "program.abort",      "mdi.execute",
-      "override.feed",   "override.rapid",   "override.spindle",   "tool.list",
-      "tool.set",        "offsets.get",      "offsets.set",        "tool.change_done",
-      "program.preview", "jog.heartbeat"};
+      "status.get",    "status.subscribe", "status.unsubscribe", "errors.list",     "system.info",
+      "machine.estop", "machine.reset",    "machine.on",         "machine.off",     "machine.home",
+      "jog.start",     "jog.stop",         "jog.increment",      "program.open",    "program.run",
+      "program.step",  "program.pause",    "program.resume",     "program.abort",   "mdi.execute",
+      "override.feed", "override.rapid",   "override.spindle",   "tool.list",       "tool.set",
+      "offsets.get",   "offsets.set",      "tool.change_done",   "program.preview", "jog.heartbeat",
+      "wait.done"};
   return methods;
 }
 

@@ -157,6 +157,51 @@ TEST(MachineIo, WaitForAnInputHighOrTimeOut) {
   EXPECT_EQ(m.status().input_result, -1);
 }
 
+TEST(MachineIo, TheOperatorEndsOnlyTheWaitUnderWay) {
+  Rig rig(mill_with_spindle(100, 600));
+  auto& m = rig.m;
+  IoAction wait = of_kind(IoAction::Kind::wait_input);
+  wait.index = 2;
+  wait.mode = 3;
+  wait.timeout_s = 100;
+  m.queue(action(wait));
+  m.flush();
+  m.cycles(50);
+  const WaitStatus waiting = m.status().wait;
+  ASSERT_EQ(waiting.kind, WaitStatus::Kind::input);
+  Command end;
+  end.kind = Command::Kind::end_wait;
+  end.id = static_cast<std::uint32_t>(WaitStatus::Kind::input);
+  end.since = waiting.since - 1;  // an answer to an earlier wait
+  m.send(end);
+  m.cycles(50);
+  EXPECT_EQ(m.status().wait.kind, WaitStatus::Kind::input);
+  end.since = waiting.since;
+  m.send(end);
+  m.run_until_idle();
+  EXPECT_EQ(m.status().input_waits, 1u);
+  EXPECT_EQ(m.status().input_result, -1) << "as on its timeout";
+
+  // At 100 rpm/s the spindle takes 30 s to 3000 rpm: ended while it stands, the wait goes on;
+  // ended while it turns, the path goes on below speed.
+  m.queue(action(spindle(1, 3000)));
+  m.queue(action(of_kind(IoAction::Kind::wait_at_speed)));
+  m.flush();
+  m.cycles(3);
+  const WaitStatus at_speed = m.status().wait;
+  ASSERT_EQ(at_speed.kind, WaitStatus::Kind::spindle_at_speed);
+  end.id = static_cast<std::uint32_t>(WaitStatus::Kind::spindle_at_speed);
+  end.since = at_speed.since;
+  m.send(end);
+  m.cycles(50);
+  EXPECT_EQ(m.status().wait.kind, WaitStatus::Kind::spindle_at_speed) << "not turning yet";
+  m.cycles(1000);
+  m.send(end);
+  m.run_until_idle();
+  EXPECT_EQ(m.status().wait.kind, WaitStatus::Kind::none);
+  EXPECT_LT(rig.drive.rpm(), 500);
+}
+
 TEST(MachineIo, WaitForARisingEdgeAndReadAnAnalogInput) {
   Rig rig(mill_with_spindle());
   auto& m = rig.m;

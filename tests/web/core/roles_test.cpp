@@ -19,7 +19,7 @@ const std::vector<std::string> kOperator{
     "jog.stop",      "jog.increment", "jog.heartbeat",  "program.open",     "files.open",
     "program.run",   "program.step",  "program.pause",  "program.resume",   "program.abort",
     "mdi.execute",   "override.feed", "override.rapid", "override.spindle", "tool.change_done",
-    "lease.take",    "lease.release"};
+    "wait.done",     "lease.take",    "lease.release"};
 const std::vector<std::string> kSetter{"tool.set", "offsets.set", "files.rename", "files.delete",
                                        "upload"};
 const std::vector<std::string> kAdmin{"users.list", "users.add", "users.delete", "users.passwd"};

@@ -46,6 +46,7 @@ constexpr std::array kRules{
     MethodRule{"override.rapid", Role::operator_},
     MethodRule{"override.spindle", Role::operator_},
     MethodRule{"tool.change_done", Role::operator_},
+    MethodRule{"wait.done", Role::operator_},
     MethodRule{"lease.take", Role::operator_},
     MethodRule{"lease.release", Role::operator_},
     MethodRule{"tool.set", Role::setter},

@@ -38,6 +38,8 @@ export function setupProgram(ctx) {
   $('#wait-done').addEventListener('click', () => {
     const wait = ctx.store.status.wait;
     if (wait?.kind === 'tool_change') ctx.run('tool.change_done', {tool: wait.tool});
+    else if (wait?.kind === 'input' || wait?.kind === 'spindle_at_speed')
+      ctx.run('wait.done', {kind: wait.kind});
   });
 
   let shownPath = null;
@@ -87,9 +89,16 @@ function showWait(wait) {
   box.hidden = !wait;
   if (!wait) return;
   setText($('#wait-message'), wait.message || wait.kind);
+  // A user M code ends by itself; the other waits can be answered.
   const done = $('#wait-done');
-  done.hidden = wait.kind !== 'tool_change';
-  setText(done, wait.kind === 'tool_change' ? `T${wait.tool} is in` : 'Done');
+  const labels = {
+    tool_change: `T${wait.tool} is in`,
+    input: 'Go on without the input',
+    spindle_at_speed: 'Go on below speed',
+  };
+  done.hidden = !(wait.kind in labels);
+  done.dataset.method = wait.kind === 'tool_change' ? 'tool.change_done' : 'wait.done';
+  setText(done, labels[wait.kind] ?? 'Done');
 }
 
 async function loadText(view, path) {

@@ -78,6 +78,9 @@ class MotionController {
   // Ends the hold the path waits in (Status::wait, an IoAction::Kind::hold) when its id is
   // `hold_id`: the tool is changed, the user M code has finished.
   void release_hold(std::uint32_t hold_id);
+  // Ends the wait Status::wait shows (`kind`, begun in servo cycle `since`), when it is still
+  // that one: an M66 wait as on its timeout, an at-speed wait while the spindle turns.
+  void end_wait(WaitStatus::Kind kind, std::uint64_t since);
 
   // Jogs of one axis (config::axis_index), run by the servo thread within the axis's
   // MAX_VELOCITY (speeds above it are capped) and MAX_ACCELERATION; on a homed axis up to its

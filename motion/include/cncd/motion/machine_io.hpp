@@ -67,6 +67,10 @@ class MachineIo final : public ActionGate {
   CNCD_RT void cancel_wait() noexcept;
   // The task's answer to a hold (tool change done, a user M code finished).
   CNCD_RT void release(std::uint32_t hold_id) noexcept;
+  // The operator ends the wait of `kind` that began in cycle `since` (an answer meant for an
+  // earlier wait is ignored): an M66 wait ends as on its timeout (#5399 = -1); an at-speed
+  // wait goes on only while the spindle turns the way it is told.
+  CNCD_RT void end_wait(WaitStatus::Kind kind, std::uint64_t since) noexcept;
   CNCD_RT void set_override(double ratio) noexcept;
   // Pause and resume with [SPINDLE_0] STOP_ON_PAUSE: the spindle stops once the path rests,
   // and restarts on resume; resumed() says when the path may go on (the spindle at speed).
@@ -90,6 +94,8 @@ class MachineIo final : public ActionGate {
   // The commanded speed from the programmed one, the override and the limits.
   CNCD_RT void update_command() noexcept;
   CNCD_RT bool at_speed() const noexcept;
+  // Turning the way it is told (not at rest, not reversing), whatever its speed.
+  CNCD_RT bool turning_as_told() const noexcept;
   // What the drive is told: a change takes the next sequence number.
   CNCD_RT void command_spindle(bool enable, bool reverse, double rpm) noexcept;
   // This period's reading was taken after the latest spindle command reached the drive.
@@ -118,6 +124,7 @@ class MachineIo final : public ActionGate {
   std::uint64_t waited_ = 0;  // periods the current wait has been asked
   bool released_ = false;
   std::uint32_t released_id_ = 0;
+  bool wait_ended_ = false;  // end_wait() for the wait under way
   bool last_input_ = false;  // M66 edges: the input in the previous period
   double input_result_ = 0;
   std::uint64_t input_waits_ = 0;

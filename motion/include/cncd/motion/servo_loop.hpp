@@ -39,14 +39,16 @@ struct Command {
     feed_override,     // velocity = the new ratio
     rapid_override,    // velocity = the new ratio
     spindle_override,  // velocity = the new ratio
-    release            // id: the hold the task answers (tool change done, user M code ended)
+    release,           // id: the hold the task answers (tool change done, user M code ended)
+    end_wait           // id: the WaitStatus::Kind the operator ends, since: that wait's `since`
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
-  int axis = 0;          // jogs: axis index
-  double velocity = 0;   // jog_start: units/s, signed; jog_increment: speed
-  double distance = 0;   // jog_increment: units, signed
-  std::uint32_t id = 0;  // release
+  int axis = 0;             // jogs: axis index
+  double velocity = 0;      // jog_start: units/s, signed; jog_increment: speed
+  double distance = 0;      // jog_increment: units, signed
+  std::uint32_t id = 0;     // release, end_wait
+  std::uint64_t since = 0;  // end_wait
 };
 
 // Something the servo thread tells the non-RT side (which logs it), as that side reads it.
