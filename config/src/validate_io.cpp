@@ -49,6 +49,8 @@ std::string identity(const SignalAddress& a) {
     }
     case SignalAddress::Kind::sim:
       return "sim signal " + a.name;
+    case SignalAddress::Kind::evdev:
+      return "input device " + a.device + " " + a.code;
     case SignalAddress::Kind::none:
       break;
   }

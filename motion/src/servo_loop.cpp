@@ -206,6 +206,9 @@ void ServoLoop::apply(const Command& command) noexcept {
     case Command::Kind::release:
       io_.release(command.id);
       break;
+    case Command::Kind::panel_lights:
+      status_.panel.lights = command.id;
+      break;
     case Command::Kind::end_wait:
       io_.end_wait(static_cast<WaitStatus::Kind>(command.id), command.since);
       break;

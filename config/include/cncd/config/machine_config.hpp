@@ -12,6 +12,9 @@
 #include <string_view>
 #include <vector>
 
+#include "cncd/config/panel_config.hpp"
+#include "cncd/config/signal_address.hpp"
+
 namespace cncd::config {
 
 class IniFile;
@@ -20,6 +23,7 @@ class IniFile;
 inline constexpr std::string_view kAxisLetters = "XYZABCUVW";
 inline constexpr int kMaxAxes = 9;
 inline constexpr int kMaxJoints = 16;
+static_assert(kPanelAxes == kMaxAxes);
 
 // Index of an axis letter (either case) in kAxisLetters, or -1.
 int axis_index(char letter);
@@ -30,12 +34,6 @@ enum class JointType { linear, angular };
 // How programs are read ([RS274NGC] DIALECT): LinuxCNC's RS274NGC or the Numeryx drilling
 // dialect (the interpreter's Dialect; config depends on no other part of cncd).
 enum class Dialect { linuxcnc, numeryx };
-
-// Where a value came from, for messages in the form FILE:LINE.
-struct SourceRef {
-  std::string file;
-  int line = 0;
-};
 
 struct AxisConfig {
   bool present = false;      // letter appears in [TRAJ] COORDINATES
@@ -88,37 +86,6 @@ struct JointConfig {
 // Digital and analog signals a program can reach: M62-M65 / M66 digital, M66-M68 analog.
 inline constexpr int kMaxDigitalIo = 32;
 inline constexpr int kMaxAnalogIo = 16;
-
-// A signal named in an INI key by its address (docs/drivers.md, "Signal addresses"):
-//   gpio:LINE                    a line of [GPIO] CHIP, by offset or name; "gpio:!LINE" is
-//                                active low
-//   modbus:BUS:SLAVE:coil:N      a coil of slave SLAVE on the [MODBUS_BUS] bus
-//   modbus:BUS:SLAVE:hr:N        a holding register
-//   modbus:BUS:SLAVE:di:N        a discrete input
-//   modbus:BUS:SLAVE:ir:N        an input register
-//   sim:NAME                     a simulated signal (tests and demos set and read it)
-// The kind and the table may be written in any case. BUS is 0..99, SLAVE 0..247, N 0..65535;
-// LINE and NAME have no blanks and no ':'. An empty INI value means "not connected".
-struct SignalAddress {
-  enum class Kind : std::uint8_t { none, gpio, modbus, sim };
-  enum class Table : std::uint8_t { coil, holding, discrete, input };
-  Kind kind = Kind::none;
-  std::string line;         // gpio: offset or name of the line
-  bool active_low = false;  // gpio: written with a '!' before the line
-  int bus = 0;              // modbus: n of [MODBUS_n]
-  int slave = 0;            // modbus: slave id
-  Table table = Table::coil;
-  int address = 0;   // modbus: coil or register number (0-based, the protocol's address)
-  std::string name;  // sim: the signal's name
-  std::string text;  // the address as written, for messages
-  SourceRef source;  // the key that named it
-  bool given() const { return kind != Kind::none; }
-};
-
-// Parses a signal address (the syntax above) into `out`, keeping `text` as written (trimmed);
-// `source` is left to the caller. Returns "" when it parsed, else what is wrong (then `out` is
-// unchanged). Any thread may call it.
-std::string parse_signal_address(std::string_view text, SignalAddress& out);
 
 enum class SpindleDriver { none, sim, gpio, modbus };
 
@@ -315,6 +282,7 @@ struct MachineConfig {
   SpindleConfig spindle;  // [SPINDLE_0]
   ToolChangeConfig tool_change;
   IoConfig io;
+  PanelConfig panel;  // [PANEL]
   // Every key of the file with its source, for lookups of keys this struct does not type
   // and to list unused keys. Null when built by hand.
   std::shared_ptr<const IniFile> ini;

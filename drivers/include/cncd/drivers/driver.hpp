@@ -76,6 +76,7 @@ struct IoCommand {
   bool mist = false;
   std::uint32_t digital = 0;                  // bit n: DIGITAL_OUTPUT_n
   std::array<double, kMaxAnalogIo> analog{};  // ANALOG_OUTPUT_n
+  std::uint32_t panel = 0;                    // bit (1 << config::PanelLight): lit
 };
 
 // The spindle as its driver reports it.
@@ -102,10 +103,22 @@ struct SpindleFeedback {
   std::uint64_t acknowledged = 0;
 };
 
+// The panel's inputs ([PANEL], config::PanelConfig) as the drivers read them this period,
+// before debouncing; a driver sets or clears the bits and values of the signals it owns.
+struct PanelFeedback {
+  std::uint64_t inputs = 0;  // bit (1 << config::PanelInput): the level, active-low applied
+  // config::PanelCounter: the counter as it stands, wrapping at counter_bits (16 for a Modbus
+  // register, 32 for a decoded encoder or a sim signal; 0: no driver owns it).
+  std::array<std::uint32_t, config::kPanelCounters> counts{};
+  std::array<std::uint8_t, config::kPanelCounters> counter_bits{};
+  std::array<double, config::kPanelAnalogs> analog{};  // config::PanelAnalog, as read
+};
+
 // The machine's inputs as the drivers report them each period; a driver fills in the signals
 // the config gives it and leaves the others alone.
 struct IoFeedback {
   SpindleFeedback spindle;
+  PanelFeedback panel;
   std::uint32_t digital = 0;                  // bit n: DIGITAL_INPUT_n
   std::array<double, kMaxAnalogIo> analog{};  // ANALOG_INPUT_n
 };

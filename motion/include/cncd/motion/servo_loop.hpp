@@ -40,14 +40,15 @@ struct Command {
     rapid_override,    // velocity = the new ratio
     spindle_override,  // velocity = the new ratio
     release,           // id: the hold the task answers (tool change done, user M code ended)
-    end_wait           // id: the WaitStatus::Kind the operator ends, since: that wait's `since`
+    end_wait,          // id: the WaitStatus::Kind the operator ends, since: that wait's `since`
+    panel_lights       // id: bits (1 << config::PanelLight) to light; red also lights in estop
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
   int axis = 0;             // jogs: axis index
   double velocity = 0;      // jog_start: units/s, signed; jog_increment: speed
   double distance = 0;      // jog_increment: units, signed
-  std::uint32_t id = 0;     // release, end_wait
+  std::uint32_t id = 0;     // release, end_wait, panel_lights
   std::uint64_t since = 0;  // end_wait
 };
 

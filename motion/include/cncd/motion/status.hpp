@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 
+#include "cncd/config/panel_config.hpp"
 #include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/types.hpp"
 
@@ -105,6 +106,21 @@ struct SyncStatus {
   std::uint64_t done = 0;  // synchronized segments ended since the start
 };
 
+// The panel ([PANEL]) as the servo thread sees it: what the task acts on.
+struct PanelStatus {
+  std::uint64_t inputs = 0;  // debounced levels, bit (1 << config::PanelInput)
+  // Debounced presses (rising edges) of each input since the start: the task compares them
+  // with those it has acted on, so no press between two of its cycles is lost.
+  std::array<std::uint32_t, config::kPanelInputs> presses{};
+  // The counters (config::PanelCounter) unwrapped, from 0 at the start.
+  std::array<std::int64_t, config::kPanelCounters> counts{};
+  std::array<double, config::kPanelAnalogs> analog{};  // as read
+  std::int8_t mpg_axis = -1;  // the axis the selector picks, -1: none (or more than one)
+  double mpg_step = 0;        // machine units a detent moves, by the step selector
+  bool mpg_jogging = false;   // the MPG moves an axis now
+  std::uint32_t lights = 0;   // bit (1 << config::PanelLight), as told to the drivers
+};
+
 // What the servo thread publishes every period.
 struct ServoStatus {
   std::uint64_t sequence = 0;  // servo cycle count at publication
@@ -141,6 +157,7 @@ struct ServoStatus {
   std::uint64_t path_errors = 0;
   ProbeStatus probe;
   SyncStatus sync;
+  PanelStatus panel;
   RtStats rt;
 };
 
