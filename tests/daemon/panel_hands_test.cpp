@@ -123,6 +123,28 @@ TEST_F(DISABLED_PanelTest, AJogButtonWhileAClientJogsIsRefusedNamingTheClient) {
   EXPECT_GT(commanded(rest, "x"), 0.0);
 }
 
+// G0 X123.4 Y56.7: 200 mm/s reached after 100 ms; the hold is pressed as soon as X moves.
+TEST_F(DISABLED_PanelTest, AHoldPressedDuringTheRapidsAccelerationRestsAndResumeEndsThere) {
+  ready_machine();
+  open_program("rapid.ngc", "G21 G90 G0 X0 Y0 Z0\nG0 X123.4 Y56.7\nM2\n");
+  ASSERT_NO_FATAL_FAILURE(press("CYCLE_START"));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (commanded(status(), "x") <= 0)
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the rapid did not start";
+  ASSERT_NO_FATAL_FAILURE(set("feed_hold", 1));
+  json s = wait_until([](const json& st) { return st["motion"] == "paused"; });
+  EXPECT_EQ(s["velocity"], 0.0);
+  const double held = commanded(s, "x");
+  EXPECT_LT(held, 123.4);
+  ASSERT_NO_FATAL_FAILURE(set("feed_hold", 0));
+  EXPECT_EQ(commanded(status(), "x"), held);
+  ASSERT_NO_FATAL_FAILURE(press("CYCLE_START"));
+  s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done");
+  EXPECT_DOUBLE_EQ(commanded(s, "x"), 123.4);
+  EXPECT_DOUBLE_EQ(commanded(s, "y"), 56.7);
+}
+
 // Many holds and resumes from the panel, each acted on, while a second client asks for the
 // status as fast as it can; the first hold comes during the rapid's acceleration.
 TEST_F(DISABLED_PanelTest, EveryPressActsWhileAnotherClientFloodsStatusRequests) {
