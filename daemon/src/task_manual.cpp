@@ -72,6 +72,7 @@ void Task::jog_increment(int axis, double distance, double velocity) {
 }
 
 void Task::jog_stop(int axis) {
+  if (axis >= 0 && axis < 32) client_jog_axes_ &= ~(1u << axis);
   motion_.jog_stop(axis);
 }
 
