@@ -23,6 +23,7 @@ namespace {
 // works again at once to a person, rarely enough to cost nothing while it stays away.
 constexpr std::int64_t kReopenDelayNs = 250'000'000;
 constexpr std::size_t kBufferEvents = 64;
+constexpr std::uint16_t kContourDesign = 0x0b33;  // USB vendor of the Shuttle jog wheels
 
 std::string error_text(int error) {
   return std::strerror(error);
@@ -161,10 +162,14 @@ bool EvdevReader::open_device(std::int64_t now) {
   absent_reported_ = false;
   have_ = 0;
   dropping_ = false;
+  dial_positions_ = false;
+  dial_last_.fill(-1);
   std::string what = "a FIFO";
   if (!fifo_) {
     std::array<char, 256> name{};
     what = ::ioctl(fd_, EVIOCGNAME(name.size() - 1), name.data()) >= 0 ? name.data() : "";
+    input_id id{};
+    dial_positions_ = ::ioctl(fd_, EVIOCGID, &id) == 0 && id.vendor == kContourDesign;
     // A pendant's keys are the machine's: they must not type into a console or a desktop too.
     if (::ioctl(fd_, EVIOCGRAB, 1) != 0) {
       notices_.add(DriverNotice::Level::warning, "input device " + path_ + ": cannot be grabbed (" +
@@ -271,11 +276,15 @@ void EvdevReader::apply(const input_event& event, std::int64_t now) {
           held_ &= ~(std::uint64_t{1} << b.index);
         }
         break;
-      case EvdevBinding::Target::counter:
+      case EvdevBinding::Target::counter: {
+        const std::int32_t step = dial_positions_ && event.code == REL_DIAL
+                                      ? evdev_dial_step(dial_last_[i], event.value)
+                                      : event.value;
         counts_[i].store(
-            counts_[i].load(std::memory_order_relaxed) + static_cast<std::uint32_t>(event.value),
+            counts_[i].load(std::memory_order_relaxed) + static_cast<std::uint32_t>(step),
             std::memory_order_release);
         break;
+      }
       case EvdevBinding::Target::analog:
         analog_[i].store(event.value, std::memory_order_release);
         break;

@@ -15,6 +15,7 @@
 
 #include "cncd/config/panel_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/evdev_driver.hpp"
 #include "cncd/drivers/rt.hpp"
 
 struct input_event;
@@ -94,6 +95,8 @@ class EvdevReader {
   // The reader thread's own.
   int fd_ = -1;
   bool fifo_ = false;
+  bool dial_positions_ = false;  // a Contour Shuttle: REL_DIAL values are positions
+  std::array<int, config::kPanelCounters> dial_last_{};
   std::uint64_t held_ = 0;  // keys down as the device last said
   std::uint64_t shown_bits_ = 0;
   std::array<std::int64_t, config::kPanelInputs> pressed_at_{};

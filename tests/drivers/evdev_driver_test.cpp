@@ -189,6 +189,19 @@ TEST(EvdevCodes, NamesComeFromTheKernelHeader) {
     EXPECT_FALSE(config::evdev_code(bad)) << bad;
 }
 
+TEST(EvdevDialStep, ShuttlePositionsBecomeSteps) {
+  int last = -1;
+  EXPECT_EQ(evdev_dial_step(last, 17), 0);  // the counter's start is unknown: no step
+  EXPECT_EQ(evdev_dial_step(last, 18), 1);
+  EXPECT_EQ(evdev_dial_step(last, 20), 2);
+  EXPECT_EQ(evdev_dial_step(last, 19), -1);
+  last = 254;
+  EXPECT_EQ(evdev_dial_step(last, 255), 1);
+  EXPECT_EQ(evdev_dial_step(last, 1), 2);  // 0 never comes: its step arrives with 1
+  EXPECT_EQ(evdev_dial_step(last, 255), -2);
+  EXPECT_EQ(last, 255);
+}
+
 TEST_F(EvdevDriverTest, ButtonsDialAndKnobReachReadIo) {
   make_fifo();
   ASSERT_EQ(configure(pendant_config(fifo_.string())), "");

@@ -1,7 +1,8 @@
 // Panel inputs from Linux input event devices (`evdev:DEVICE:CODE`, docs/drivers.md, "USB
 // pendants (evdev)"): a USB pendant, jog wheel or keypad read as evtest shows it, with no
 // kernel driver of ours. KEY_* and BTN_* codes are buttons (1 or 2 pressed, 0 released),
-// REL_* codes add their values to a 32-bit counter that wraps, ABS_* codes are analog values.
+// REL_* codes add their values to a 32-bit counter that wraps (a Contour Shuttle's REL_DIAL,
+// which gives positions, its steps: evdev_dial_step()), ABS_* codes are analog values.
 //
 // Each device has its own reader thread (non-RT) that opens it without blocking, reads whole
 // `struct input_event` records (a FIFO may split one across writes) and publishes the result
@@ -27,6 +28,19 @@ class EvdevNotices;
 
 // Whether a [PANEL] signal is an `evdev:` address (then make_drivers adds an evdev driver).
 bool uses_evdev(const config::MachineConfig& config);
+
+// Contour Design's ShuttleXpress and ShuttlePRO send where the 8-bit counter of their jog dial
+// stands as REL_DIAL, not a step; this turns one such position into the step since `last`
+// (-1: none yet, and then no step: where the counter stood before is unknown). The difference
+// wraps, so a position of 0, which the kernel never passes on (a relative value of 0 says
+// nothing), only delays its step to the next position.
+inline std::int32_t evdev_dial_step(int& last, std::int32_t value) {
+  const int position = value & 0xff;
+  const int previous = last;
+  last = position;
+  if (previous < 0) return 0;
+  return static_cast<std::int8_t>(static_cast<std::uint8_t>(position - previous));
+}
 
 class EvdevDriver final : public Driver {
  public:
