@@ -246,6 +246,21 @@ TEST_F(EvdevDriverTest, PressAndReleaseInOneWriteIsStillSeen) {
   EXPECT_TRUE(wait_for([](const PanelFeedback& p) { return p.inputs == 0; }));
 }
 
+TEST_F(EvdevDriverTest, StopPressedAsTheDeviceIsLostIsStillSeen) {
+  make_fifo();
+  config::MachineConfig c = pendant_config(fifo_.string(), 1000);
+  c.panel.inputs[static_cast<std::size_t>(PanelInput::stop)] = evdev(fifo_.string(), "KEY_ESC");
+  ASSERT_EQ(configure(c), "");
+  driver_.enable();
+  {
+    Writer writer(fifo_);
+    ASSERT_TRUE(writer.write(key(KEY_ESC, 1)));
+  }  // and the cable comes out
+  EXPECT_TRUE(wait_for([](const PanelFeedback& p) { return p.inputs == bit(PanelInput::stop); }));
+  EXPECT_TRUE(wait_losses(1));
+  EXPECT_TRUE(wait_for([](const PanelFeedback& p) { return p.inputs == 0; }));
+}
+
 TEST_F(EvdevDriverTest, WriterClosingReleasesButtonsAndReconnects) {
   make_fifo();
   ASSERT_EQ(configure(pendant_config(fifo_.string())), "");
