@@ -75,6 +75,7 @@ EvdevReader::EvdevReader(std::string path, std::vector<EvdevBinding> bindings, s
     }
   }
   wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  if (wake_fd_ < 0) wake_error_ = errno;
 }
 
 EvdevReader::~EvdevReader() {
@@ -111,7 +112,7 @@ void EvdevReader::publish(PanelFeedback& out) const noexcept {
 void EvdevReader::run() {
   if (wake_fd_ < 0) {
     notices_.add(DriverNotice::Level::warning,
-                 "input device " + path_ + ": not read (eventfd: " + error_text(errno) + ")");
+                 "input device " + path_ + ": not read (eventfd: " + error_text(wake_error_) + ")");
     return;
   }
   for (;;) {

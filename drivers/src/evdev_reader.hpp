@@ -107,6 +107,7 @@ class EvdevReader {
   std::int64_t next_open_ = 0;
 
   int wake_fd_ = -1;  // an eventfd: stop() writes it to end poll()
+  int wake_error_ = 0;
   std::thread thread_;
 };
 
