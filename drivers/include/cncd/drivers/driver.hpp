@@ -130,6 +130,14 @@ enum Capability : std::uint32_t {
   kCapEstopInput = 1u << 3,
 };
 
+// Something that happened to a driver's devices off the servo thread (a pendant unplugged, or
+// back), for the daemon to log.
+struct DriverNotice {
+  enum class Level : std::uint8_t { info, warning };
+  Level level = Level::info;
+  std::string text;
+};
+
 class Driver {
  public:
   virtual ~Driver() = default;
@@ -166,6 +174,9 @@ class Driver {
   // answers may have been written; 0 when feedback always answers the latest command. The
   // servo loop keeps that many periods of commands to compare late feedback with.
   virtual std::int64_t feedback_deadline_ns() const noexcept { return 0; }
+  // Non-RT, any thread but the servo thread: takes the oldest notice not yet taken; false
+  // when there is none.
+  virtual bool take_notice(DriverNotice& /*out*/) { return false; }
   virtual std::uint32_t capabilities() const noexcept = 0;
   virtual const char* name() const noexcept = 0;
 };
