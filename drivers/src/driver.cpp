@@ -5,6 +5,7 @@
 #include "cncd/drivers/gpio_driver.hpp"
 #include "cncd/drivers/modbus_driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
+#include "panel_wiring.hpp"
 
 namespace cncd::drivers {
 
@@ -41,6 +42,7 @@ std::vector<const char*> io_driver_names(const config::MachineConfig& config) {
     note(a);
   for (const auto& a : io.analog_inputs)
     note(a);
+  for_each_panel_address(config.panel, note);
   std::vector<const char*> out;
   if (gpio) out.push_back("gpio");
   if (modbus) out.push_back("modbus");
@@ -55,6 +57,12 @@ std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, st
   // Drivers that only drive the spindle or signals get no joints.
   for (const char* name : io_driver_names(config))
     by_name.try_emplace(name);
+  // `evdev:` addresses (a USB pendant) go to the driver of that name, where there is one.
+  bool evdev = false;
+  for_each_panel_address(config.panel, [&](const config::SignalAddress& a) {
+    evdev |= a.kind == config::SignalAddress::Kind::evdev;
+  });
+  if (std::string unknown; evdev && make_driver("evdev", unknown)) by_name.try_emplace("evdev");
   std::vector<DriverInstance> out;
   for (const auto& [name, joints] : by_name) {
     auto driver = make_driver(name, error);

@@ -185,7 +185,9 @@ struct DriverInstance {
 // ("driver 'modbus': ...") when one cannot be made or configured.
 std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, std::string& error);
 
-// The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside.
+// The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside:
+// the panel's addresses count too. `evdev:` addresses are not among them: make_drivers hands
+// them to a driver named "evdev" when make_driver() knows one, and leaves them unserved else.
 std::vector<const char*> io_driver_names(const config::MachineConfig& config);
 
 }  // namespace cncd::drivers
