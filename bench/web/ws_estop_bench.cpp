@@ -4,9 +4,13 @@
 // WebSockets each subscribed to the whole status every 50 ms. Between samples the machine is
 // reset, turned on and the program run again. For each phase also the servo thread's overruns
 // (status rt.overruns, read on cncd's Unix socket) while the program runs for WINDOW seconds.
-// Prints figures; never fails on timing.
+// The phases alternate ROUNDS times (alone, watched, alone, ...), so that a drift of the
+// host's noise falls on both. With RT_CPU >= 0 the servo thread is pinned there ([CNCD]
+// RT_CPU) and everything else (cncd's other threads, cncd-web, this bench) kept off it, as a
+// machine with a CPU set aside for the servo thread runs. Prints figures; never fails on timing.
 //
-//   cncd_ws_estop_bench [SAMPLES=100] [WINDOW_S=10] [CLIENTS=50]
+//   cncd_ws_estop_bench [SAMPLES=100] [WINDOW_S=10] [CLIENTS=50] [ROUNDS=3] [RT_CPU=-1]
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 
@@ -17,6 +21,7 @@
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -162,17 +167,18 @@ struct Phase {
   double frames_window_s = 0;
 };
 
-void measure(Phase& phase, WsClient& control, Conn& c, int samples, int window_s) {
+// Adds one window of overruns and `samples` estops to `phase`.
+void measure(Phase& phase, WsClient& control, Conn& c, int samples, int window_s, int round) {
   start_run(control, c);
   const json before = status(c, R"("rt")")["rt"];
   const auto t0 = Clock::now();
   std::this_thread::sleep_for(std::chrono::seconds(window_s));
   const json after = status(c, R"("rt","exec")");
-  phase.window_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  phase.overruns = after["rt"]["overruns"].get<long>() - before["overruns"].get<long>();
-  phase.cycles = after["rt"]["cycles"].get<long>() - before["cycles"].get<long>();
+  phase.window_s += std::chrono::duration<double>(Clock::now() - t0).count();
+  phase.overruns += after["rt"]["overruns"].get<long>() - before["overruns"].get<long>();
+  phase.cycles += after["rt"]["cycles"].get<long>() - before["cycles"].get<long>();
   if (after["exec"] != "running") fail("the program ended within the window: make it longer");
-  std::mt19937 random(24);  // the same delays in both phases
+  std::mt19937 random(24 + round);  // the same delays in both phases of a round
   std::uniform_int_distribution<int> delay_ms(10, 60);
   for (int i = 0; i < samples; ++i) {
     if (i > 0) start_run(control, c);
@@ -232,6 +238,8 @@ int main(int argc, char** argv) {
   const int samples = argc > 1 ? std::atoi(argv[1]) : 100;
   const int window_s = argc > 2 ? std::atoi(argv[2]) : 10;
   const int clients = argc > 3 ? std::atoi(argv[3]) : 50;
+  const int rounds = std::max(1, argc > 4 ? std::atoi(argv[4]) : 3);
+  const int rt_cpu = argc > 5 ? std::atoi(argv[5]) : -1;
   namespace fs = std::filesystem;
   const fs::path dir = bench_dir({".var", ".tbl"});
   const fs::path programs = dir / "programs";
@@ -245,6 +253,19 @@ int main(int argc, char** argv) {
     ini.replace(at + 1, ini.find('\n', at + 1) - at - 1, "PROGRAM_PREFIX = " + programs.string());
   ini += "\n[WEB]\nPORT = " + std::to_string(port) + "\nPROGRAM_DIR = " + programs.string() +
          "\nUSERS_FILE = " + (dir / "web-users").string() + "\n";
+  if (rt_cpu >= 0) {
+    const std::string section = "[CNCD]\n";
+    const auto at = ini.find(section);
+    if (at == std::string::npos) fail("sim_mm.ini has no [CNCD] section");
+    ini.insert(at + section.size(), "RT_CPU = " + std::to_string(rt_cpu) + "\n");
+    // Children inherit the mask; the servo thread pins itself to RT_CPU.
+    cpu_set_t others;
+    CPU_ZERO(&others);
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+      if (cpu != rt_cpu) CPU_SET(cpu, &others);
+    }
+    if (sched_setaffinity(0, sizeof others, &others) != 0) fail("cannot keep off CPU RT_CPU");
+  }
   std::ofstream(dir / "sim_mm.ini") << ini;
   // 1 mm moves at 50 mm/s: some 20 ms a line, an hour in all; never ends within the bench.
   write_program(programs / "bench.ngc", 200'000);
@@ -274,39 +295,47 @@ int main(int argc, char** argv) {
       [](const json& s) { return s["program"]["path"] != "" && s["program"]["opening"] == ""; },
       "the program open", 120);
 
-  Phase alone;
-  alone.name = "alone";
-  measure(alone, *control, c, samples, window_s);
-
-  // The watchers: each its own WebSocket and upstream connection, read on one thread.
+  // The watchers: each its own WebSocket and upstream connection, read on one thread that
+  // runs only while they are subscribed (the main thread subscribes them in between).
   net::io_context watch_io;
   std::vector<std::unique_ptr<WsClient>> watchers;
   std::vector<long> frames(static_cast<std::size_t>(clients), 0);
   for (int i = 0; i < clients; ++i) {
     watchers.push_back(std::make_unique<WsClient>(watch_io, port, key));
-    watchers.back()->send("status.subscribe", {{"interval_ms", 50}});
     watchers.back()->read_forever(frames[static_cast<std::size_t>(i)]);
   }
-  std::thread watch_thread([&] { watch_io.run(); });
-  std::this_thread::sleep_for(std::chrono::seconds(1));
+  Phase alone;
+  alone.name = "alone";
   Phase watched;
   watched.name = std::to_string(clients) + " subscribers";
-  const auto frames_from = Clock::now();
-  measure(watched, *control, c, samples, window_s);
-  long total = 0;
-  for (const long f : frames)
-    total += f;
-  watch_io.stop();
-  watch_thread.join();
-  watched.frames = total;
-  watched.frames_window_s = std::chrono::duration<double>(Clock::now() - frames_from).count();
+  const int per_round = std::max(1, samples / rounds);
+  for (int round = 0; round < rounds; ++round) {
+    measure(alone, *control, c, per_round, window_s, round);
+    for (auto& w : watchers)
+      w->send("status.subscribe", {{"interval_ms", 50}});
+    // The counts are read while the watchers' thread is not running.
+    const long frames_before = std::accumulate(frames.begin(), frames.end(), 0L);
+    const auto frames_from = Clock::now();
+    watch_io.restart();
+    std::thread watch_thread([&] { watch_io.run(); });
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    measure(watched, *control, c, per_round, window_s, round);
+    watch_io.stop();
+    watch_thread.join();
+    watched.frames += std::accumulate(frames.begin(), frames.end(), 0L) - frames_before;
+    watched.frames_window_s += std::chrono::duration<double>(Clock::now() - frames_from).count();
+    for (auto& w : watchers)
+      w->send("status.unsubscribe");
+  }
 
   const json rt = status(c, R"("rt")")["rt"];
   std::printf(
-      "estop through cncd-web's /ws while a program runs: %d samples a phase; "
-      "overruns over %d s of the run; servo thread realtime %s, memory locked %s\n",
-      samples, window_s, rt.value("realtime", false) ? "yes" : "no",
-      rt.value("memory_locked", false) ? "yes" : "no");
+      "estop through cncd-web's /ws while a program runs: %d rounds of %d samples a phase; "
+      "overruns over %d s of the run a round; servo thread realtime %s, memory locked %s, "
+      "CPU %s\n",
+      rounds, per_round, window_s, rt.value("realtime", false) ? "yes" : "no",
+      rt.value("memory_locked", false) ? "yes" : "no",
+      rt_cpu >= 0 ? std::to_string(rt_cpu).c_str() : "any");
   std::printf("%-22s %12s %12s %12s %9s %11s %9s\n", "phase", "estop p50", "estop p99", "estop max",
               "overruns", "cycles", "frames/s");
   print(alone);

@@ -2,6 +2,7 @@
 
 #include <map>
 
+#include "cncd/drivers/evdev_driver.hpp"
 #include "cncd/drivers/gpio_driver.hpp"
 #include "cncd/drivers/modbus_driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
@@ -13,6 +14,7 @@ std::unique_ptr<Driver> make_driver(const std::string& name, std::string& error)
   if (name == "sim") return std::make_unique<SimDriver>();
   if (name == "gpio") return std::make_unique<GpioDriver>();
   if (name == "modbus") return std::make_unique<ModbusDriver>();
+  if (name == "evdev") return std::make_unique<EvdevDriver>();
   error = "unknown driver '" + name + "'";
   return nullptr;
 }
@@ -57,12 +59,7 @@ std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, st
   // Drivers that only drive the spindle or signals get no joints.
   for (const char* name : io_driver_names(config))
     by_name.try_emplace(name);
-  // `evdev:` addresses (a USB pendant) go to the driver of that name, where there is one.
-  bool evdev = false;
-  for_each_panel_address(config.panel, [&](const config::SignalAddress& a) {
-    evdev |= a.kind == config::SignalAddress::Kind::evdev;
-  });
-  if (std::string unknown; evdev && make_driver("evdev", unknown)) by_name.try_emplace("evdev");
+  if (uses_evdev(config)) by_name.try_emplace("evdev");
   std::vector<DriverInstance> out;
   for (const auto& [name, joints] : by_name) {
     auto driver = make_driver(name, error);

@@ -81,6 +81,7 @@ class WebProcess {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
   std::string log() const { return slurp(log_); }
+  pid_t pid() const { return pid_; }
 
  private:
   pid_t pid_ = -1;

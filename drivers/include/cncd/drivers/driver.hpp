@@ -130,6 +130,14 @@ enum Capability : std::uint32_t {
   kCapEstopInput = 1u << 3,
 };
 
+// Something that happened to a driver's devices off the servo thread (a pendant unplugged, or
+// back), for the daemon to log.
+struct DriverNotice {
+  enum class Level : std::uint8_t { info, warning };
+  Level level = Level::info;
+  std::string text;
+};
+
 class Driver {
  public:
   virtual ~Driver() = default;
@@ -166,6 +174,9 @@ class Driver {
   // answers may have been written; 0 when feedback always answers the latest command. The
   // servo loop keeps that many periods of commands to compare late feedback with.
   virtual std::int64_t feedback_deadline_ns() const noexcept { return 0; }
+  // Non-RT, any thread but the servo thread: takes the oldest notice not yet taken; false
+  // when there is none.
+  virtual bool take_notice(DriverNotice& /*out*/) { return false; }
   virtual std::uint32_t capabilities() const noexcept = 0;
   virtual const char* name() const noexcept = 0;
 };
@@ -186,8 +197,8 @@ struct DriverInstance {
 std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, std::string& error);
 
 // The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside:
-// the panel's addresses count too. `evdev:` addresses are not among them: make_drivers hands
-// them to a driver named "evdev" when make_driver() knows one, and leaves them unserved else.
+// the panel's addresses count too. `evdev:` addresses are not among them: make_drivers adds the
+// evdev driver for them (uses_evdev()).
 std::vector<const char*> io_driver_names(const config::MachineConfig& config);
 
 }  // namespace cncd::drivers
