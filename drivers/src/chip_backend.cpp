@@ -39,7 +39,7 @@ class ChipBackend final : public GpioBackend {
   }
 
   std::string request(const std::vector<GpioOutput>& outputs,
-                      const std::vector<int>& inputs) override {
+                      const std::vector<GpioLine>& inputs) override {
     if (outputs.size() > GPIOD_LINE_BULK_MAX_LINES || inputs.size() > GPIOD_LINE_BULK_MAX_LINES) {
       return "more than " + std::to_string(GPIOD_LINE_BULK_MAX_LINES) + " lines on one chip";
     }
@@ -50,9 +50,9 @@ class ChipBackend final : public GpioBackend {
       if (line == nullptr) return "cannot get line " + std::to_string(out.line);
       gpiod_line_bulk_add(&output_bulk_, line);
     }
-    for (const int offset : inputs) {
-      gpiod_line* line = gpiod_chip_get_line(chip_, static_cast<unsigned>(offset));
-      if (line == nullptr) return "cannot get line " + std::to_string(offset);
+    for (const GpioLine& in : inputs) {
+      gpiod_line* line = gpiod_chip_get_line(chip_, static_cast<unsigned>(in.line));
+      if (line == nullptr) return "cannot get line " + std::to_string(in.line);
       gpiod_line_bulk_add(&input_bulk_, line);
     }
     if (!outputs.empty()) {
@@ -79,7 +79,7 @@ class ChipBackend final : public GpioBackend {
     gpiod_line_set_value_bulk(&output_bulk_, values);
   }
 
-  void read_inputs(std::uint8_t* levels) noexcept override {
+  void read_inputs(std::uint8_t* levels, std::int64_t /*time_ns*/) noexcept override {
     if (inputs_.empty()) return;
     int values[GPIOD_LINE_BULK_MAX_LINES] = {};
     if (gpiod_line_get_value_bulk(&input_bulk_, values) != 0) return;
@@ -92,7 +92,7 @@ class ChipBackend final : public GpioBackend {
   gpiod_line_bulk output_bulk_{};
   gpiod_line_bulk input_bulk_{};
   std::vector<GpioOutput> outputs_;
-  std::vector<int> inputs_;
+  std::vector<GpioLine> inputs_;
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "cncd/drivers/gpio_driver.hpp"
 #include "cncd/drivers/modbus_driver.hpp"
 #include "cncd/drivers/sim_driver.hpp"
+#include "panel_wiring.hpp"
 
 namespace cncd::drivers {
 
@@ -43,6 +44,7 @@ std::vector<const char*> io_driver_names(const config::MachineConfig& config) {
     note(a);
   for (const auto& a : io.analog_inputs)
     note(a);
+  for_each_panel_address(config.panel, note);
   std::vector<const char*> out;
   if (gpio) out.push_back("gpio");
   if (modbus) out.push_back("modbus");

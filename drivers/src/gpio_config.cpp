@@ -6,6 +6,7 @@
 
 #include "cncd/drivers/gpio_driver.hpp"
 #include "ini_lookup.hpp"
+#include "panel_wiring.hpp"
 #include "pwm_encoder.hpp"
 #include "stepgen.hpp"
 
@@ -27,7 +28,7 @@ bool is_gpio(const config::SignalAddress& a) {
 
 std::string GpioDriver::configure_io(const config::MachineConfig& machine,
                                      std::vector<GpioOutput>& outputs,
-                                     std::vector<int>& input_lines,
+                                     std::vector<GpioLine>& input_lines,
                                      std::vector<std::pair<bool, int>>& input_specs,
                                      std::set<int>& used) {
   std::string problem;
@@ -59,11 +60,11 @@ std::string GpioDriver::configure_io(const config::MachineConfig& machine,
     return out;
   };
   // Raw input levels (the encoder) and debounced ones (digital inputs) both come from here.
-  const auto input = [&](const config::SignalAddress& a) -> int {
+  const auto input = [&](const config::SignalAddress& a, const std::string& name) -> int {
     if (!is_gpio(a)) return -1;
     const int offset = claim(a);
     if (offset < 0) return -1;
-    input_lines.push_back(offset);
+    input_lines.push_back(GpioLine{offset, name});
     input_specs.emplace_back(a.active_low, offset);
     return static_cast<int>(input_lines.size()) - 1;
   };
@@ -73,13 +74,17 @@ std::string GpioDriver::configure_io(const config::MachineConfig& machine,
   for (std::size_t n = 0; n < digital_out_.size(); ++n)
     digital_out_[n] = output(io.digital_outputs[n], "dout" + std::to_string(n));
   for (std::size_t n = 0; n < digital_in_.size(); ++n)
-    digital_in_[n] = input(io.digital_inputs[n]);
+    digital_in_[n] = input(io.digital_inputs[n], "din" + std::to_string(n));
   for (const auto* analog : {&io.analog_outputs, &io.analog_inputs}) {
     for (const auto& a : *analog) {
       if (is_gpio(a) && problem.empty()) {
         problem = where(a) + "a GPIO line carries no analog value (use modbus:BUS:SLAVE:hr:N)";
       }
     }
+  }
+
+  if (auto why = configure_panel(machine, input, output); !why.empty() && problem.empty()) {
+    problem = why;
   }
 
   const config::SpindleConfig& sp = machine.spindle;
@@ -116,11 +121,62 @@ std::string GpioDriver::configure_io(const config::MachineConfig& machine,
         problem.empty()) {
       problem = section + "an encoder needs ENCODER_A and ENCODER_B on gpio lines and ENCODER_PPR";
     }
-    encoder_a_ = input(sp.encoder_a);
-    encoder_b_ = input(sp.encoder_b);
-    encoder_index_ = input(sp.encoder_index);
+    encoder_a_ = input(sp.encoder_a, "spindle_a");
+    encoder_b_ = input(sp.encoder_b, "spindle_b");
+    encoder_index_ = input(sp.encoder_index, "spindle_index");
     encoder_ = std::make_unique<QuadratureDecoder>();
     encoder_->setup(4 * std::max(1, sp.encoder_ppr));
+  }
+  return problem;
+}
+
+std::string GpioDriver::configure_panel(
+    const config::MachineConfig& machine,
+    const std::function<int(const config::SignalAddress&, const std::string&)>& input,
+    const std::function<OutputLine(const config::SignalAddress&, const std::string&)>& output) {
+  std::string problem;
+  const auto note = [&](const std::string& why) {
+    if (problem.empty()) problem = why;
+  };
+  const config::PanelConfig& panel = machine.panel;
+  for (std::size_t i = 0; i < panel_in_.size(); ++i) {
+    const auto which = static_cast<config::PanelInput>(i);
+    panel_in_[i] = input(panel.inputs[i], panel_signal_name(config::panel_input_key(which)));
+  }
+  for (int c = 0; c < config::kPanelCounters; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    PanelEncoder& encoder = panel_encoders_[k];
+    encoder = PanelEncoder{};
+    panel_counts_[k].store(0);
+    panel_errors_[k].store(0);
+    const config::PanelCounterWiring& w = panel_counter_wiring(panel, c);
+    const std::string key = panel_counter_key(c);
+    if (is_gpio(w.counts)) {
+      note(where(w.counts) + "a GPIO line carries no count: wire the encoder to " + key +
+           "_A and " + key + "_B");
+    }
+    if (!is_gpio(w.a) && !is_gpio(w.b)) continue;
+    if (!is_gpio(w.a) || !is_gpio(w.b)) {
+      note("[PANEL] " + key + "_A and " + key + "_B: an encoder on GPIO needs both on gpio lines");
+      continue;
+    }
+    encoder.a = input(w.a, panel_signal_name(key + "_A"));
+    encoder.b = input(w.b, panel_signal_name(key + "_B"));
+    encoder.a_low = w.a.active_low;
+    encoder.b_low = w.b.active_low;
+    if (encoder.a < 0 || encoder.b < 0) encoder.a = encoder.b = -1;  // a line was refused
+  }
+  for (int k = 0; k < config::kPanelAnalogs; ++k) {
+    const config::SignalAddress& a = panel_analog_address(panel, k);
+    if (is_gpio(a)) {
+      note(where(a) +
+           "a GPIO line carries no analog value (use modbus:BUS:SLAVE:ir:N or sim:NAME)");
+    }
+  }
+  for (std::size_t l = 0; l < panel_light_.size(); ++l) {
+    const auto which = static_cast<config::PanelLight>(l);
+    panel_light_[l] =
+        output(panel.lights[l], panel_signal_name(std::string(config::panel_light_key(which))));
   }
   return problem;
 }
@@ -138,7 +194,9 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
                                                std::max<std::int64_t>(1, servo_period_ns_));
   rt_priority_ = machine.cncd.rt_priority;
   if (base_period_ns_ <= 0) {
-    ini.fail("EMCMOT", "BASE_PERIOD", "step generation needs a base thread: set BASE_PERIOD");
+    // The base thread generates steps, samples the lines and decodes the panel's encoders.
+    ini.fail("EMCMOT", "BASE_PERIOD",
+             "the gpio driver needs a base thread (steps, inputs, encoders): set BASE_PERIOD");
     return ini.error();
   }
   const auto chip = ini.text("GPIO", "CHIP");
@@ -156,7 +214,7 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
   const int debounce_ticks = ticks_for(debounce_ns, base_period_ns_);
 
   std::vector<GpioOutput> outputs;
-  std::vector<int> input_lines;
+  std::vector<GpioLine> input_lines;
   std::vector<std::pair<bool, int>> input_specs;  // active_low, line
   std::set<int> used;
   const auto line = [&](const std::string& section, const char* key, bool required) -> int {
@@ -177,11 +235,11 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     }
     return offset;
   };
-  const auto add_input = [&](const std::string& section, const char* key,
-                             const char* low_key) -> int {
+  const auto add_input = [&](const std::string& section, const char* key, const char* low_key,
+                             const std::string& name) -> int {
     const int offset = line(section, key, false);
     if (offset < 0) return -1;
-    input_lines.push_back(offset);
+    input_lines.push_back(GpioLine{offset, name});
     input_specs.emplace_back(ini.boolean(section, low_key), offset);
     return static_cast<int>(input_lines.size()) - 1;
   };
@@ -210,9 +268,9 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
       outputs.push_back(GpioOutput{o, prefix + "enable"});
     }
     jl.enable_active_low = ini.boolean(s, "ENABLE_ACTIVE_LOW");
-    jl.home = add_input(s, "HOME_SWITCH_LINE", "HOME_SWITCH_ACTIVE_LOW");
-    jl.min_limit = add_input(s, "MIN_LIMIT_LINE", "MIN_LIMIT_ACTIVE_LOW");
-    jl.max_limit = add_input(s, "MAX_LIMIT_LINE", "MAX_LIMIT_ACTIVE_LOW");
+    jl.home = add_input(s, "HOME_SWITCH_LINE", "HOME_SWITCH_ACTIVE_LOW", prefix + "home");
+    jl.min_limit = add_input(s, "MIN_LIMIT_LINE", "MIN_LIMIT_ACTIVE_LOW", prefix + "min_limit");
+    jl.max_limit = add_input(s, "MAX_LIMIT_LINE", "MAX_LIMIT_ACTIVE_LOW", prefix + "max_limit");
     if (jl.home >= 0) capabilities_ |= kCapHomeSwitch;
     if (jl.min_limit >= 0 || jl.max_limit >= 0) capabilities_ |= kCapLimitSwitches;
 
@@ -228,8 +286,8 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     t.max_acceleration_steps = ini.real(s, "STEPGEN_MAXACCEL") * scale;
     stepgens_[k].setup(t);
   }
-  estop_input_ = add_input("GPIO", "ESTOP_LINE", "ESTOP_ACTIVE_LOW");
-  probe_input_ = add_input("GPIO", "PROBE_LINE", "PROBE_ACTIVE_LOW");
+  estop_input_ = add_input("GPIO", "ESTOP_LINE", "ESTOP_ACTIVE_LOW", "estop");
+  probe_input_ = add_input("GPIO", "PROBE_LINE", "PROBE_ACTIVE_LOW", "probe");
   const config::SignalAddress& probe = machine.io.probe_input;
   if (probe_input_ < 0 && probe.kind == config::SignalAddress::Kind::gpio) {
     std::string why;
@@ -238,7 +296,7 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     if (!used.insert(offset).second) {
       return where(probe) + "line " + probe.line + " is already used by another signal";
     }
-    input_lines.push_back(offset);
+    input_lines.push_back(GpioLine{offset, "probe"});
     input_specs.emplace_back(probe.active_low, offset);
     probe_input_ = static_cast<int>(input_lines.size()) - 1;
   }
@@ -255,6 +313,11 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     inputs_[i].backend_index = static_cast<int>(i);
     inputs_[i].active_low = input_specs[i].first;
     inputs_[i].debounce_ticks = debounce_ticks;
+  }
+  // The panel's buttons are read as sampled: the servo thread debounces them ([PANEL]
+  // DEBOUNCE_MS).
+  for (const int index : panel_in_) {
+    if (index >= 0) inputs_[static_cast<std::size_t>(index)].debounce_ticks = 1;
   }
   output_levels_.assign(outputs.size(), 0);
   input_levels_.assign(input_count_, 0);

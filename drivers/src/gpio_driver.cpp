@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "panel_wiring.hpp"
 #include "pwm_encoder.hpp"
 #include "stepgen.hpp"
 
@@ -23,6 +24,7 @@ std::int64_t to_ns(const timespec& t) {
 
 GpioDriver::GpioDriver() {
   digital_in_.fill(-1);
+  panel_in_.fill(-1);
 }
 
 GpioDriver::~GpioDriver() {
@@ -89,6 +91,7 @@ void GpioDriver::write_io(const IoCommand& command) noexcept {
   block.flood = command.flood;
   block.mist = command.mist;
   block.digital = command.digital;
+  block.panel = command.panel;
   io_mailbox_.store(block);
 }
 
@@ -97,6 +100,16 @@ void GpioDriver::read_io(IoFeedback& feedback) noexcept {
     if (digital_in_[n] < 0) continue;
     const std::uint32_t bit = 1u << n;
     feedback.digital = input(digital_in_[n]) ? feedback.digital | bit : feedback.digital & ~bit;
+  }
+  PanelFeedback& panel = feedback.panel;
+  for (std::size_t i = 0; i < panel_in_.size(); ++i) {
+    if (panel_in_[i] >= 0)
+      panel.inputs = with_bit(panel.inputs, static_cast<int>(i), input(panel_in_[i]));
+  }
+  for (std::size_t c = 0; c < panel_encoders_.size(); ++c) {
+    if (panel_encoders_[c].a < 0) continue;
+    panel.counts[c] = panel_counts_[c].load(std::memory_order_relaxed);
+    panel.counter_bits[c] = 32;
   }
   if (!spindle_) return;
   // While the base thread is publishing, the previous period's values do.
@@ -130,6 +143,8 @@ void GpioDriver::run_io(double dt, std::int64_t time_ns) noexcept {
   set_output(mist_, io_.mist);
   for (std::size_t n = 0; n < digital_out_.size(); ++n)
     set_output(digital_out_[n], ((io_.digital >> n) & 1u) != 0);
+  for (std::size_t l = 0; l < panel_light_.size(); ++l)
+    set_output(panel_light_[l], ((io_.panel >> l) & 1u) != 0);
   if (!spindle_) return;
   const double rpm = std::abs(io_.spindle_rpm);
   const double target = !io_.spindle_enable ? 0.0 : io_.spindle_reverse ? -rpm : rpm;
@@ -194,9 +209,22 @@ GpioDriver::BaseStats GpioDriver::base_stats() const noexcept {
   return stats;
 }
 
-void GpioDriver::sample_inputs() noexcept {
+void GpioDriver::sample_panel_encoders() noexcept {
+  for (std::size_t c = 0; c < panel_encoders_.size(); ++c) {
+    PanelEncoder& e = panel_encoders_[c];
+    if (e.a < 0) continue;
+    const bool a = (input_levels_[static_cast<std::size_t>(e.a)] != 0) != e.a_low;
+    const bool b = (input_levels_[static_cast<std::size_t>(e.b)] != 0) != e.b_low;
+    e.decoder.sample(a, b);
+    panel_counts_[c].store(e.decoder.count(), std::memory_order_relaxed);
+    panel_errors_[c].store(e.decoder.errors(), std::memory_order_relaxed);
+  }
+}
+
+void GpioDriver::sample_inputs(std::int64_t time_ns) noexcept {
   if (input_count_ == 0) return;
-  backend_->read_inputs(input_levels_.data());
+  backend_->read_inputs(input_levels_.data(), time_ns);
+  sample_panel_encoders();
   if (probe_input_ >= 0) {
     const Input& probe = inputs_[static_cast<std::size_t>(probe_input_)];
     const bool touching =
@@ -251,7 +279,7 @@ void GpioDriver::run_base_period(std::int64_t time_ns) noexcept {
   }
   run_io(dt, time_ns);
   backend_->write_outputs(output_levels_.data(), time_ns);
-  sample_inputs();
+  sample_inputs(time_ns);
   periods_.fetch_add(1, std::memory_order_relaxed);
 }
 

@@ -15,6 +15,7 @@
 
 #include "modbus_detail.hpp"
 #include "monotonic_clock.hpp"
+#include "panel_wiring.hpp"
 
 namespace cncd::drivers {
 namespace {
@@ -248,6 +249,9 @@ bool ModbusBus::exchange_points(const IoCommand& command) {
         case IoPoint::Signal::digital_out:
           value = (command.digital >> p.index) & 1u ? 1 : 0;
           break;
+        case IoPoint::Signal::panel_light:
+          value = (command.panel >> p.index) & 1u ? 1 : 0;
+          break;
         default:
           value = std::clamp(std::round(command.analog[static_cast<std::size_t>(p.index)]),
                              -32768.0, 65535.0);
@@ -281,11 +285,25 @@ bool ModbusBus::exchange_points(const IoCommand& command) {
       if (result != -1) {
         const bool bits = p.table == IoTable::coil || p.table == IoTable::discrete;
         const double value = bits ? bit : reg;
-        if (p.signal == IoPoint::Signal::digital_in) {
-          const std::uint32_t mask = 1u << p.index;
-          io_last_.digital = value != 0 ? io_last_.digital | mask : io_last_.digital & ~mask;
-        } else {
-          io_last_.analog[static_cast<std::size_t>(p.index)] = value;
+        const auto n = static_cast<std::size_t>(p.index);
+        switch (p.signal) {
+          case IoPoint::Signal::digital_in: {
+            const std::uint32_t mask = 1u << p.index;
+            io_last_.digital = value != 0 ? io_last_.digital | mask : io_last_.digital & ~mask;
+            break;
+          }
+          case IoPoint::Signal::panel_in:
+            io_last_.panel_inputs = with_bit(io_last_.panel_inputs, p.index, value != 0);
+            break;
+          case IoPoint::Signal::panel_counter:
+            io_last_.panel_counts[n] = reg;
+            break;
+          case IoPoint::Signal::panel_analog:
+            io_last_.panel_analog[n] = value;
+            break;
+          default:
+            io_last_.analog[n] = value;
+            break;
         }
       }
     }

@@ -50,7 +50,18 @@ enum class IoTable : std::uint8_t { coil, holding, discrete, input };
 
 // A coil or register one of the machine's signals lives in.
 struct IoPoint {
-  enum class Signal : std::uint8_t { flood, mist, digital_out, analog_out, digital_in, analog_in };
+  enum class Signal : std::uint8_t {
+    flood,
+    mist,
+    digital_out,
+    analog_out,
+    digital_in,
+    analog_in,
+    panel_in,       // index: config::PanelInput
+    panel_counter,  // index: config::PanelCounter, a register of 16 bits that wraps
+    panel_analog,   // index: config::PanelAnalog
+    panel_light,    // index: config::PanelLight
+  };
   Signal signal = Signal::flood;
   int index = 0;  // n of DIGITAL_OUTPUT_n and the like
   int slave = 1;
@@ -58,7 +69,7 @@ struct IoPoint {
   int address = 0;
   bool output() const {
     return signal == Signal::flood || signal == Signal::mist || signal == Signal::digital_out ||
-           signal == Signal::analog_out;
+           signal == Signal::analog_out || signal == Signal::panel_light;
   }
 };
 
@@ -105,6 +116,9 @@ struct IoSetpoint {
 struct IoReadback {
   std::uint32_t digital = 0;  // the bits of the digital inputs on this bus
   std::array<double, kMaxAnalogIo> analog{};
+  std::uint64_t panel_inputs = 0;  // bit (1 << config::PanelInput)
+  std::array<std::uint32_t, config::kPanelCounters> panel_counts{};  // registers: 0 .. 65535
+  std::array<double, config::kPanelAnalogs> panel_analog{};
   double vfd_rpm = 0;            // actual speed, >= 0
   std::int64_t vfd_time_ns = 0;  // CLOCK_MONOTONIC of the VFD's last full answer; 0 = never
   std::uint16_t vfd_status = 0;

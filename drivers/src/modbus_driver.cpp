@@ -14,137 +14,18 @@
 #include "cncd/drivers/exclusive_lock.hpp"
 #include "ini_lookup.hpp"
 #include "modbus_bus.hpp"
+#include "modbus_config.hpp"
 
 #include "monotonic_clock.hpp"
 
 namespace cncd::drivers {
-namespace {
-
-BusSettings read_bus(IniLookup& ini, int number) {
-  BusSettings b;
-  b.number = number;
-  b.section = "MODBUS_" + std::to_string(number);
-  const std::string& s = b.section;
-  const std::string transport = upper(ini.choice(s, "TRANSPORT"));
-  if (transport != "TCP" && transport != "RTU") ini.fail(s, "TRANSPORT", "must be tcp or rtu");
-  b.rtu = transport == "RTU";
-  b.host = ini.text(s, "HOST").value_or("");
-  b.port = static_cast<int>(ini.integer(s, "PORT"));
-  b.device = ini.text(s, "DEVICE").value_or("");
-  b.baud = static_cast<int>(ini.integer(s, "BAUD"));
-  const std::string parity = upper(ini.choice(s, "PARITY"));
-  if (parity != "N" && parity != "E" && parity != "O") ini.fail(s, "PARITY", "must be N, E or O");
-  b.parity = parity.empty() ? 'N' : parity[0];
-  b.data_bits = static_cast<int>(ini.integer(s, "DATA_BITS"));
-  b.stop_bits = static_cast<int>(ini.integer(s, "STOP_BITS"));
-  b.timeout_ms = static_cast<int>(ini.integer(s, "TIMEOUT_MS"));
-  b.update_period_ms = static_cast<int>(ini.integer(s, "UPDATE_PERIOD_MS"));
-  b.retries = static_cast<int>(ini.integer(s, "RETRIES"));
-  if (!b.rtu && b.host.empty()) ini.fail(s, "HOST", "missing: TRANSPORT = tcp needs HOST");
-  if (b.rtu && b.device.empty()) ini.fail(s, "DEVICE", "missing: TRANSPORT = rtu needs DEVICE");
-  return b;
-}
-
-IoTable table_of(config::SignalAddress::Table t) {
-  switch (t) {
-    case config::SignalAddress::Table::coil:
-      return IoTable::coil;
-    case config::SignalAddress::Table::holding:
-      return IoTable::holding;
-    case config::SignalAddress::Table::discrete:
-      return IoTable::discrete;
-    case config::SignalAddress::Table::input:
-      return IoTable::input;
-  }
-  return IoTable::coil;
-}
-
-// "FILE:LINE: ADDRESS: " for a problem with a signal address.
-std::string where(const config::SignalAddress& a) {
-  std::string out;
-  if (!a.source.file.empty()) out = a.source.file + ":" + std::to_string(a.source.line) + ": ";
-  return out + a.text + ": ";
-}
-
-// The modbus signals and the VFD of the config, by bus; "" or the first problem.
-std::string collect_io(const config::MachineConfig& machine, std::map<int, IoSettings>& by_bus) {
-  using Signal = IoPoint::Signal;
-  std::string problem;
-  const auto add = [&](const config::SignalAddress& a, Signal signal, int index) {
-    if (a.kind != config::SignalAddress::Kind::modbus) return;
-    IoPoint p;
-    p.signal = signal;
-    p.index = index;
-    p.slave = a.slave;
-    p.table = table_of(a.table);
-    p.address = a.address;
-    if (p.output() && (p.table == IoTable::discrete || p.table == IoTable::input)) {
-      if (problem.empty()) {
-        problem = where(a) + "discrete inputs and input registers are read-only: use coil or hr";
-      }
-      return;
-    }
-    by_bus[a.bus].points.push_back(p);
-  };
-  const config::IoConfig& io = machine.io;
-  add(io.flood, Signal::flood, 0);
-  add(io.mist, Signal::mist, 0);
-  for (int n = 0; n < kMaxDigitalIo; ++n) {
-    add(io.digital_outputs[static_cast<std::size_t>(n)], Signal::digital_out, n);
-    add(io.digital_inputs[static_cast<std::size_t>(n)], Signal::digital_in, n);
-  }
-  for (int n = 0; n < kMaxAnalogIo; ++n) {
-    add(io.analog_outputs[static_cast<std::size_t>(n)], Signal::analog_out, n);
-    add(io.analog_inputs[static_cast<std::size_t>(n)], Signal::analog_in, n);
-  }
-  const config::SpindleConfig& sp = machine.spindle;
-  if (!sp.present || sp.driver != config::SpindleDriver::modbus) return problem;
-  const std::string section = "[SPINDLE_0] ";
-  if (sp.modbus < 0 && problem.empty()) problem = section + "MODBUS: missing, the n of [MODBUS_n]";
-  if (!(sp.speed_scale > 0) && problem.empty()) {
-    problem = section + "SPEED_SCALE must be positive (register value = rpm x SPEED_SCALE)";
-  }
-  const auto bit_ok = [](int bit) { return bit >= -1 && bit <= 15; };
-  if (!(bit_ok(sp.running_bit) && bit_ok(sp.at_speed_bit) && bit_ok(sp.fault_bit)) &&
-      problem.empty()) {
-    problem = section + "RUNNING_BIT, AT_SPEED_BIT and FAULT_BIT are 0 .. 15, or -1 for none";
-  }
-  VfdSettings& v = by_bus[std::max(0, sp.modbus)].vfd;
-  v.present = true;
-  v.slave = sp.slave;
-  v.speed_scale = sp.speed_scale;
-  v.command_register = sp.command_register;
-  v.speed_register = sp.speed_register;
-  v.actual_speed_register = sp.actual_speed_register;
-  v.status_register = sp.status_register;
-  v.actual_speed_input = sp.actual_speed_table != config::SignalAddress::Table::holding;
-  v.status_input = sp.status_table != config::SignalAddress::Table::holding;
-  v.command_stop = sp.command_stop;
-  v.command_forward = sp.command_forward;
-  v.command_reverse = sp.command_reverse;
-  v.running_bit = sp.running_bit;
-  v.at_speed_bit = sp.at_speed_bit;
-  v.fault_bit = sp.fault_bit;
-  if (sp.position_register >= 0) {
-    if (sp.position_scale == 0 && problem.empty()) {
-      problem = section + "POSITION_REGISTER needs POSITION_SCALE (counts a revolution)";
-    }
-    v.position_register = sp.position_register;
-    v.position_input = sp.position_table != config::SignalAddress::Table::holding;
-    v.position_width = sp.position_width;
-    v.position_high_first = sp.position_high_first;
-    v.position_scale = sp.position_scale;
-    v.max_acceleration = sp.acceleration / 60.0;
-  }
-  return problem;
-}
-
-}  // namespace
-
 struct ModbusDriver::IoSlot {
   ModbusBus* bus = nullptr;
   std::uint32_t digital_mask = 0;  // the digital inputs it reads
   std::array<bool, kMaxAnalogIo> analog{};
+  std::uint64_t panel_mask = 0;  // the panel's inputs it reads
+  std::array<bool, config::kPanelCounters> panel_counters{};
+  std::array<bool, config::kPanelAnalogs> panel_analog{};
   bool vfd = false;
   std::int64_t stale_ns = 0;
   IoReadback last{};  // kept while the bus thread publishes
@@ -225,9 +106,11 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
     IoSlot io_slot;
     for (const IoPoint& p : io.points) {
       if (p.signal == IoPoint::Signal::digital_in) io_slot.digital_mask |= 1u << p.index;
-      if (p.signal == IoPoint::Signal::analog_in) {
-        io_slot.analog[static_cast<std::size_t>(p.index)] = true;
-      }
+      const auto n = static_cast<std::size_t>(p.index);
+      if (p.signal == IoPoint::Signal::analog_in) io_slot.analog[n] = true;
+      if (p.signal == IoPoint::Signal::panel_in) io_slot.panel_mask |= std::uint64_t{1} << n;
+      if (p.signal == IoPoint::Signal::panel_counter) io_slot.panel_counters[n] = true;
+      if (p.signal == IoPoint::Signal::panel_analog) io_slot.panel_analog[n] = true;
     }
     io_slot.vfd = io.vfd.present;
     io_slot.stale_ns = stale_ns;
@@ -327,6 +210,16 @@ void ModbusDriver::read_io(IoFeedback& feedback) noexcept {
     feedback.digital = (feedback.digital & ~slot.digital_mask) | (rb.digital & slot.digital_mask);
     for (std::size_t n = 0; n < slot.analog.size(); ++n) {
       if (slot.analog[n]) feedback.analog[n] = rb.analog[n];
+    }
+    PanelFeedback& panel = feedback.panel;
+    panel.inputs = (panel.inputs & ~slot.panel_mask) | (rb.panel_inputs & slot.panel_mask);
+    for (std::size_t c = 0; c < slot.panel_counters.size(); ++c) {
+      if (!slot.panel_counters[c]) continue;
+      panel.counts[c] = rb.panel_counts[c];
+      panel.counter_bits[c] = 16;
+    }
+    for (std::size_t k = 0; k < slot.panel_analog.size(); ++k) {
+      if (slot.panel_analog[k]) panel.analog[k] = rb.panel_analog[k];
     }
     if (!slot.vfd) continue;
     SpindleFeedback& fb = feedback.spindle;

@@ -38,10 +38,12 @@ void QuadratureDecoder::setup(int counts_per_revolution) {
 }
 
 void QuadratureDecoder::sample(bool a, bool b, bool index, std::int64_t time_ns) noexcept {
-  // Index: previous state x 4 + new state, A << 1 | B. A leading B counts up (00 10 11 01).
-  static constexpr int kStep[16] = {0, -1, 1, 0, 1, 0, 0, -1, -1, 0, 0, 1, 0, 1, -1, 0};
   const int state = (a ? 2 : 0) | (b ? 1 : 0);
-  if (state_ >= 0) count_ += kStep[state_ * 4 + state];
+  if (state_ >= 0) {
+    // A jump of both lines counts nothing: the index pulse puts back what it lost.
+    const int step = quadrature_step(state_, state);
+    if (step != kQuadratureJump) count_ += step;
+  }
   state_ = state;
   if (index && !index_) {
     // The first index pulse marks a position; each later one puts back counts that noise or

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "cncd/drivers/quadrature.hpp"
+
 namespace cncd::drivers {
 
 class Pwmgen {

@@ -8,6 +8,7 @@
 #include "cncd/drivers/fault_reason.hpp"
 
 #include "ini_lookup.hpp"
+#include "panel_wiring.hpp"
 
 namespace cncd::drivers {
 
@@ -49,6 +50,26 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   for (std::size_t n = 0; n < analog_in_.size(); ++n)
     analog_in_[n] = slot(io.analog_inputs[n]);
   probe_signal_ = slot(io.probe_input);
+  const config::PanelConfig& panel = machine.panel;
+  for (std::size_t i = 0; i < panel_in_.size(); ++i)
+    panel_in_[i] = slot(panel.inputs[i]);
+  for (int c = 0; c < config::kPanelCounters; ++c) {
+    const config::PanelCounterWiring& wiring = panel_counter_wiring(panel, c);
+    PanelCounter& counter = panel_counters_[static_cast<std::size_t>(c)];
+    counter.counts = slot(wiring.counts);
+    counter.a = slot(wiring.a);
+    counter.b = slot(wiring.b);
+    if ((counter.a >= 0) != (counter.b >= 0)) {
+      return std::string("[PANEL] ") + panel_counter_key(c) + "_A and " + panel_counter_key(c) +
+             "_B: an encoder on sim signals needs both A and B as sim:NAME";
+    }
+    counter.decoder = QuadratureCounter{};
+    counter.errors.store(0);
+  }
+  for (int k = 0; k < config::kPanelAnalogs; ++k)
+    panel_analog_[static_cast<std::size_t>(k)] = slot(panel_analog_address(panel, k));
+  for (std::size_t l = 0; l < panel_light_.size(); ++l)
+    panel_light_[l] = slot(panel.lights[l]);
   signal_count_ = names.size();
   signals_ = std::make_unique<Signal[]>(std::max<std::size_t>(1, signal_count_));
   for (std::size_t k = 0; k < signal_count_; ++k)
@@ -159,6 +180,33 @@ void SimDriver::write_io(const IoCommand& command) noexcept {
     store(digital_out_[n], (command.digital >> n) & 1u ? 1 : 0);
   for (std::size_t n = 0; n < analog_out_.size(); ++n)
     store(analog_out_[n], command.analog[n]);
+  for (std::size_t l = 0; l < panel_light_.size(); ++l)
+    store(panel_light_[l], (command.panel >> l) & 1u ? 1 : 0);
+}
+
+void SimDriver::read_panel(PanelFeedback& panel) noexcept {
+  for (std::size_t i = 0; i < panel_in_.size(); ++i) {
+    if (panel_in_[i] >= 0)
+      panel.inputs = with_bit(panel.inputs, static_cast<int>(i), load(panel_in_[i]) != 0);
+  }
+  for (std::size_t c = 0; c < panel_counters_.size(); ++c) {
+    PanelCounter& counter = panel_counters_[c];
+    if (counter.counts >= 0) {
+      // A counter as a 32-bit register would hold it: whole counts, wrapping.
+      const double value = load(counter.counts);
+      const bool usable = std::isfinite(value) && std::abs(value) < 9e18;
+      panel.counts[c] = usable ? static_cast<std::uint32_t>(std::llround(value)) : 0;
+      panel.counter_bits[c] = 32;
+    } else if (counter.a >= 0) {
+      counter.decoder.sample(load(counter.a) != 0, load(counter.b) != 0);
+      counter.errors.store(counter.decoder.errors(), std::memory_order_relaxed);
+      panel.counts[c] = counter.decoder.count();
+      panel.counter_bits[c] = 32;
+    }
+  }
+  for (std::size_t k = 0; k < panel_analog_.size(); ++k) {
+    if (panel_analog_[k] >= 0) panel.analog[k] = load(panel_analog_[k]);
+  }
 }
 
 void SimDriver::simulate_spindle(IoFeedback& feedback) noexcept {
@@ -200,6 +248,7 @@ void SimDriver::read_io(IoFeedback& feedback) noexcept {
   for (std::size_t n = 0; n < analog_in_.size(); ++n) {
     if (analog_in_[n] >= 0) feedback.analog[n] = load(analog_in_[n]);
   }
+  read_panel(feedback.panel);
 }
 
 SimDriver::Signal* SimDriver::find(std::string_view name) const {

@@ -1,6 +1,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <string>
 
 #include "cncd/drivers/gpio_backend.hpp"
 
@@ -15,7 +16,9 @@ char vcd_id(std::size_t output) {
 }  // namespace
 
 VcdBackend::VcdBackend(std::string path)
-    : path_(std::move(path)), ring_(std::make_unique<Transition[]>(kRingSize)) {}
+    : path_(std::move(path)),
+      ring_(std::make_unique<Transition[]>(kRingSize)),
+      feed_(std::make_unique<InputStep[]>(kFeedSize)) {}
 
 VcdBackend::~VcdBackend() {
   stop();
@@ -37,20 +40,27 @@ int VcdBackend::find_line(const std::string& spec, std::string& error) {
 }
 
 std::string VcdBackend::request(const std::vector<GpioOutput>& outputs,
-                                const std::vector<int>& inputs) {
-  if (outputs.size() > static_cast<std::size_t>('~' - '!')) return "too many recorded outputs";
+                                const std::vector<GpioLine>& inputs) {
+  if (outputs.size() + inputs.size() > static_cast<std::size_t>('~' - '!' + 1)) {
+    return "too many recorded lines";
+  }
   outputs_ = outputs;
   inputs_ = inputs;
-  last_.assign(outputs.size(), 0);
+  last_.assign(outputs.size() + inputs.size(), 0);
   file_ = std::fopen(path_.c_str(), "w");
   if (file_ == nullptr) return "cannot write " + path_ + ": " + std::strerror(errno);
-  std::fprintf(file_, "$comment cncd step/dir outputs $end\n$timescale 1ns $end\n");
+  std::fprintf(file_, "$comment cncd gpio lines $end\n$timescale 1ns $end\n");
   std::fprintf(file_, "$scope module cncd $end\n");
-  for (std::size_t i = 0; i < outputs_.size(); ++i) {
-    std::fprintf(file_, "$var wire 1 %c %s $end\n", vcd_id(i), outputs_[i].name.c_str());
+  for (std::size_t i = 0; i < last_.size(); ++i) {
+    const std::string& name =
+        i < outputs_.size() ? outputs_[i].name : inputs_[i - outputs_.size()].name;
+    // Every line has a name in the file: an unnamed input is called by its line.
+    const std::string shown =
+        name.empty() ? "in" + std::to_string(inputs_[i - outputs_.size()].line) : name;
+    std::fprintf(file_, "$var wire 1 %c %s $end\n", vcd_id(i), shown.c_str());
   }
   std::fprintf(file_, "$upscope $end\n$enddefinitions $end\n#0\n$dumpvars\n");
-  for (std::size_t i = 0; i < outputs_.size(); ++i)
+  for (std::size_t i = 0; i < last_.size(); ++i)
     std::fprintf(file_, "0%c\n", vcd_id(i));
   std::fprintf(file_, "$end\n");
   std::fflush(file_);
@@ -76,31 +86,57 @@ void VcdBackend::stop() {
   file_ = nullptr;
 }
 
-void VcdBackend::write_outputs(const std::uint8_t* levels, std::int64_t time_ns) noexcept {
-  if (start_ns_ < 0) start_ns_ = time_ns;
-  const std::int64_t at = time_ns - start_ns_;
-  std::uint64_t head = head_.load(std::memory_order_relaxed);
-  for (std::size_t i = 0; i < last_.size(); ++i) {
-    const std::uint8_t level = levels[i] != 0 ? 1 : 0;
-    if (level == last_[i]) continue;
-    if (head - tail_.load(std::memory_order_acquire) >= kRingSize) {
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-      continue;
-    }
-    last_[i] = level;
-    ring_[head % kRingSize] = Transition{at, static_cast<std::uint32_t>(i), level};
-    ++head;
+void VcdBackend::record(std::size_t signal, std::uint8_t level, std::int64_t time_ns) noexcept {
+  if (level == last_[signal]) return;
+  const std::uint64_t head = head_.load(std::memory_order_relaxed);
+  if (head - tail_.load(std::memory_order_acquire) >= kRingSize) {
+    dropped_.fetch_add(1, std::memory_order_relaxed);
+    return;
   }
-  head_.store(head, std::memory_order_release);
+  last_[signal] = level;
+  ring_[head % kRingSize] =
+      Transition{time_ns - start_ns_, static_cast<std::uint32_t>(signal), level};
+  head_.store(head + 1, std::memory_order_release);
 }
 
-void VcdBackend::read_inputs(std::uint8_t* levels) noexcept {
+void VcdBackend::write_outputs(const std::uint8_t* levels, std::int64_t time_ns) noexcept {
+  if (start_ns_ < 0) start_ns_ = time_ns;
+  for (std::size_t i = 0; i < outputs_.size(); ++i)
+    record(i, levels[i] != 0 ? 1 : 0, time_ns);
+}
+
+void VcdBackend::read_inputs(std::uint8_t* levels, std::int64_t time_ns) noexcept {
+  if (start_ns_ < 0) start_ns_ = time_ns;
+  apply_feed();
   for (std::size_t i = 0; i < inputs_.size(); ++i) {
-    const int line = inputs_[i];
+    const int line = inputs_[i].line;
     const bool high = line >= 0 && line < kVcdLines &&
                       input_levels_[static_cast<std::size_t>(line)].load(std::memory_order_relaxed);
     levels[i] = high ? 1 : 0;
+    record(outputs_.size() + i, levels[i], time_ns);
   }
+}
+
+void VcdBackend::apply_feed() noexcept {
+  if (hold_left_ > 0) --hold_left_;
+  const std::uint64_t head = feed_head_.load(std::memory_order_acquire);
+  std::uint64_t fed = fed_.load(std::memory_order_relaxed);
+  while (hold_left_ == 0 && fed < head) {
+    const InputStep& step = feed_[fed % kFeedSize];
+    set_input_level(step.line, step.high);
+    hold_left_ = step.hold_periods;
+    ++fed;
+  }
+  fed_.store(fed, std::memory_order_release);
+}
+
+bool VcdBackend::feed_inputs(const std::vector<InputStep>& steps) {
+  const std::uint64_t head = feed_head_.load(std::memory_order_relaxed);
+  if (head + steps.size() - fed_.load(std::memory_order_acquire) > kFeedSize) return false;
+  for (std::size_t k = 0; k < steps.size(); ++k)
+    feed_[(head + k) % kFeedSize] = steps[k];
+  feed_head_.store(head + steps.size(), std::memory_order_release);
+  return true;
 }
 
 void VcdBackend::set_input_level(int line, bool high) noexcept {

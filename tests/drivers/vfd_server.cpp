@@ -75,6 +75,16 @@ void VfdServer::set_discrete_input(int address, bool on) {
   as_mapping(mapping_)->tab_input_bits[address] = on ? 1 : 0;
 }
 
+void VfdServer::set_holding_register(int address, std::uint16_t value) {
+  std::lock_guard lock(mutex_);
+  as_mapping(mapping_)->tab_registers[address] = value;
+}
+
+void VfdServer::set_coil(int address, bool on) {
+  std::lock_guard lock(mutex_);
+  as_mapping(mapping_)->tab_bits[address] = on ? 1 : 0;
+}
+
 int VfdServer::writes(int address) {
   std::lock_guard lock(mutex_);
   return writes_[address];

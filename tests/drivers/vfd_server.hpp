@@ -69,6 +69,10 @@ class VfdServer {
   bool coil(int address);
   void set_input_register(int address, std::uint16_t value);
   void set_discrete_input(int address, bool on);
+  // What a panel wired to the drive's spare registers and coils shows: a counter in a holding
+  // register, a switch on a coil.
+  void set_holding_register(int address, std::uint16_t value);
+  void set_coil(int address, bool on);
   // How many write requests reached a coil or holding register.
   int writes(int address);
   // The drive trips (fault bits set, stops) or is healthy again.

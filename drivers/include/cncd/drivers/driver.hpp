@@ -196,7 +196,9 @@ struct DriverInstance {
 // ("driver 'modbus': ...") when one cannot be made or configured.
 std::vector<DriverInstance> make_drivers(const config::MachineConfig& config, std::string& error);
 
-// The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside.
+// The drivers the spindle and the signal addresses need ("gpio", "modbus", "sim"), joints aside:
+// the panel's addresses count too. `evdev:` addresses are not among them: make_drivers adds the
+// evdev driver for them (uses_evdev()).
 std::vector<const char*> io_driver_names(const config::MachineConfig& config);
 
 }  // namespace cncd::drivers

@@ -5,12 +5,17 @@
 //
 // The same base thread drives the `gpio:LINE` signals (coolant, digital outputs and inputs)
 // and a spindle with [SPINDLE_0] DRIVER = gpio: enable and direction lines, a PWM line whose
-// duty follows the speed ramped at ACCELERATION, and an optional quadrature encoder.
+// duty follows the speed ramped at ACCELERATION, and an optional quadrature encoder. The
+// panel's `gpio:` signals too: buttons and switches (sampled each base period, undebounced:
+// the servo thread debounces them), lights, and the A/B encoders of the MPG and the override
+// knobs, decoded in the base thread into 32-bit counts the servo thread reads from atomics.
+// Without BASE_PERIOD there is no base thread, and configure() fails saying so.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -20,6 +25,7 @@
 
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/gpio_backend.hpp"
+#include "cncd/drivers/quadrature.hpp"
 #include "cncd/drivers/rt.hpp"
 #include "cncd/drivers/seqlock.hpp"
 
@@ -59,6 +65,11 @@ class GpioDriver final : public Driver {
   // Any thread: the step count of the joint at `index` (position in configure()'s list).
   std::int64_t step_count(int index) const noexcept;
   GpioBackend* backend() noexcept { return backend_.get(); }
+  // Any thread: steps of a panel encoder that changed both lines between two base periods, so
+  // counted nothing (the wheel turned faster than the base thread samples).
+  std::uint32_t quadrature_errors(config::PanelCounter which) const noexcept {
+    return panel_errors_[static_cast<std::size_t>(which)].load(std::memory_order_relaxed);
+  }
   std::int64_t base_period_ns() const noexcept { return base_period_ns_; }
 
   // Any thread: how late the base thread woke, over all periods so far.
@@ -92,6 +103,7 @@ class GpioDriver final : public Driver {
     bool flood = false;
     bool mist = false;
     std::uint32_t digital = 0;
+    std::uint32_t panel = 0;  // the lights
   };
   // Base thread -> servo thread.
   struct SpindleState {
@@ -115,11 +127,25 @@ class GpioDriver final : public Driver {
     int max_limit = -1;
   };
 
+  // A panel encoder's lines: indexes into input_levels_ (-1: not on this driver).
+  struct PanelEncoder {
+    int a = -1;
+    int b = -1;
+    bool a_low = false;
+    bool b_low = false;
+    QuadratureCounter decoder;  // base thread
+  };
+
   void base_loop() noexcept;
-  void sample_inputs() noexcept;
+  void sample_inputs(std::int64_t time_ns) noexcept;
+  CNCD_RT void sample_panel_encoders() noexcept;
+  std::string configure_panel(
+      const config::MachineConfig& machine,
+      const std::function<int(const config::SignalAddress&, const std::string&)>& input,
+      const std::function<OutputLine(const config::SignalAddress&, const std::string&)>& output);
   bool input(int index) const noexcept;
   std::string configure_io(const config::MachineConfig& machine, std::vector<GpioOutput>& outputs,
-                           std::vector<int>& input_lines,
+                           std::vector<GpioLine>& input_lines,
                            std::vector<std::pair<bool, int>>& input_specs, std::set<int>& used);
   CNCD_RT void run_io(double dt, std::int64_t time_ns) noexcept;
   CNCD_RT void set_output(const OutputLine& line, bool on) noexcept;
@@ -167,7 +193,12 @@ class GpioDriver final : public Driver {
   OutputLine flood_;
   OutputLine mist_;
   std::array<OutputLine, kMaxDigitalIo> digital_out_{};
-  std::array<int, kMaxDigitalIo> digital_in_{};  // index into inputs_, -1 = none
+  std::array<int, kMaxDigitalIo> digital_in_{};       // index into inputs_, -1 = none
+  std::array<int, config::kPanelInputs> panel_in_{};  // index into inputs_, -1 = none
+  std::array<OutputLine, config::kPanelLights> panel_light_{};
+  std::array<PanelEncoder, config::kPanelCounters> panel_encoders_{};
+  std::array<std::atomic<std::uint32_t>, config::kPanelCounters> panel_counts_{};
+  std::array<std::atomic<std::uint32_t>, config::kPanelCounters> panel_errors_{};
   bool spindle_ = false;
   OutputLine spindle_enable_;
   OutputLine spindle_dir_;

@@ -9,7 +9,10 @@
 //
 // The same I/O threads write `modbus:` outputs (coils, holding registers) when they change,
 // read `modbus:` inputs every update, and drive a spindle VFD ([SPINDLE_0] DRIVER = modbus)
-// through its command, speed, actual speed and status registers. The VFD's fault and stale
+// through its command, speed, actual speed and status registers. The panel's signals go the
+// same way: buttons and switches from discrete inputs or coils, counters (MPG_COUNTS, a knob's
+// COUNTS) from holding or input registers, reported as 16-bit counts that wrap, analog knobs
+// from registers, and lights to coils. The VFD's fault and stale
 // feedback are reported as they are; the servo thread latches them.
 #pragma once
 

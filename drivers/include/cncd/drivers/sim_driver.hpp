@@ -1,7 +1,9 @@
 // The simulated driver: feedback follows the command, optionally through a first-order lag,
 // with home switches simulated at set positions and faults, stale feedback, limit switches
 // and the estop input injectable from any thread (tests, demos). With [SPINDLE_0] DRIVER = sim
-// it also simulates the spindle, and it owns every `sim:NAME` signal address.
+// it also simulates the spindle, and it owns every `sim:NAME` signal address, the panel's too:
+// buttons and switches (0/1), counters (a value wrapped to 32 bits), A/B encoders decoded each
+// servo period, analog knobs, and the lights (0/1).
 #pragma once
 
 #include <array>
@@ -13,6 +15,7 @@
 #include <string_view>
 
 #include "cncd/drivers/driver.hpp"
+#include "cncd/drivers/quadrature.hpp"
 #include "cncd/drivers/rt.hpp"
 
 namespace cncd::drivers {
@@ -79,6 +82,12 @@ class SimDriver final : public Driver {
   // names it. Setting an output is allowed too, and lasts until the servo writes it again.
   bool set_signal(std::string_view name, double value);
 
+  // Any thread: steps of a panel encoder given as two sim signals (A/B) that changed both
+  // lines at once between two servo periods, so counted nothing.
+  std::uint32_t quadrature_errors(config::PanelCounter which) const noexcept {
+    return panel_counters_[static_cast<std::size_t>(which)].errors.load(std::memory_order_relaxed);
+  }
+
  private:
   struct Signal {
     std::string name;
@@ -126,6 +135,19 @@ class SimDriver final : public Driver {
   std::array<int, kMaxAnalogIo> analog_out_ = none<kMaxAnalogIo>();
   std::array<int, kMaxDigitalIo> digital_in_ = none<kMaxDigitalIo>();
   std::array<int, kMaxAnalogIo> analog_in_ = none<kMaxAnalogIo>();
+  // The panel: signal slots of its inputs, analog knobs and lights (-1: not sim).
+  std::array<int, config::kPanelInputs> panel_in_ = none<config::kPanelInputs>();
+  std::array<int, config::kPanelAnalogs> panel_analog_ = none<config::kPanelAnalogs>();
+  std::array<int, config::kPanelLights> panel_light_ = none<config::kPanelLights>();
+  struct PanelCounter {
+    int counts = -1;  // COUNTS: the value is the count
+    int a = -1;       // A/B: decoded each servo period
+    int b = -1;
+    QuadratureCounter decoder;  // servo thread
+    std::atomic<std::uint32_t> errors{0};
+  };
+  std::array<PanelCounter, config::kPanelCounters> panel_counters_{};
+  CNCD_RT void read_panel(PanelFeedback& panel) noexcept;
 
   // The simulated spindle; state below is the servo thread's.
   bool spindle_ = false;
