@@ -127,7 +127,8 @@ void check_gpio_spindle(TypedReader& r, const MachineConfig& c) {
     r.problem(kSpindle, "DRIVER", "DRIVER = gpio needs [GPIO] CHIP (gpiochip0, or vcd:FILE)");
   }
   for (const Signal& signal : spindle_signals(s)) {
-    if (signal.address->kind == SignalAddress::Kind::modbus) {
+    if (signal.address->kind == SignalAddress::Kind::modbus ||
+        signal.address->kind == SignalAddress::Kind::evdev) {
       r.problem(kSpindle, signal.key,
                 "'" + signal.address->text +
                     "': DRIVER = gpio drives gpio lines; write gpio:LINE (or sim:NAME)");
