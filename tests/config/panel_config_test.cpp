@@ -207,5 +207,30 @@ TEST_F(PanelConfigTest, EncodersAndCountersMustBeWholeAndSingle) {
                     "both: RAPID_OVERRIDE_COUNTS is given too"));
 }
 
+TEST_F(PanelConfigTest, DescribeListsTheWiring) {
+  EXPECT_NE(describe(loaded(minimal_ini())).find("Panel:        none (no [PANEL])\n"),
+            std::string::npos);
+  const std::string text = describe(loaded(
+      panel("DOOR_MODE = estop\nCYCLE_START = sim:go\nJOG_Y_MINUS = sim:ym\nMPG_AXIS_Z = sim:mz\n"
+            "MPG_A = sim:a\nMPG_B = sim:b\nMPG_MODE = velocity\nMPG_COUNTS_PER_DETENT = 100\n"
+            "FEED_OVERRIDE_COUNTS = sim:fc\nSPINDLE_OVERRIDE_ANALOG = sim:sa\n"
+            "SPINDLE_OVERRIDE_ANALOG_MAX = 5\nLAMP_CYCLE_START = sim:lamp\n")));
+  for (const char* expected : {
+           "Panel:        debounce 10 ms, door trips the estop\n",
+           "  CYCLE_START = sim:go\n",
+           "  JOG_Y_MINUS = sim:ym\n",
+           "  MPG_AXIS_Z = sim:mz\n",
+           "  MPG: encoder A sim:a, B sim:b, 100 counts a detent, velocity mode, steps 0.001 / "
+           "0.01 / 0.1 mm\n",
+           "  feed override knob: counter sim:fc, 1 % a count\n",
+           "  spindle override knob: analog sim:sa, 0 .. 5 over the override's range\n",
+           "  LAMP_CYCLE_START = sim:lamp\n",
+       }) {
+    EXPECT_NE(text.find(expected), std::string::npos) << expected << "\nin\n" << text;
+  }
+  EXPECT_EQ(text.find("rapid override knob"), std::string::npos) << text;
+  EXPECT_EQ(text.find("FEED_HOLD"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace cncd::config::test
