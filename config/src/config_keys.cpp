@@ -3,13 +3,14 @@
 #include <array>
 
 #include "key_makers.hpp"
+#include "panel_key_specs.hpp"
 
 namespace cncd::config {
 namespace {
 
 using namespace key_makers;
 
-constexpr std::array kKeys{
+constexpr std::array kMachineKeys{
     text_key("EMC", "MACHINE", "", "Machine name shown to operators"),
     integer_key("EMCMOT", "SERVO_PERIOD", "1000000", 50'000, 100'000'000, "ns",
                 "Period of the servo (motion) thread"),
@@ -372,6 +373,8 @@ constexpr std::array kKeys{
                 "Repeats of a failed request before the drive is faulted"),
 };
 
+constexpr auto kKeys = panel_keys::with_panel_keys(kMachineKeys);
+
 bool matches_section(std::string_view pattern, std::string_view section) {
   if (pattern == "JOINT_n") return section.starts_with("JOINT_") && section.size() > 6;
   if (pattern == "MODBUS_n") {
@@ -382,8 +385,15 @@ bool matches_section(std::string_view pattern, std::string_view section) {
   return pattern == section;
 }
 
-// "DIGITAL_OUTPUT_n" matches DIGITAL_OUTPUT_ and digits.
+// "DIGITAL_OUTPUT_n" matches DIGITAL_OUTPUT_ and digits; "JOG_L_PLUS" and "MPG_AXIS_L" match
+// any axis letter (upper case) for the L.
 bool matches_key(std::string_view pattern, std::string_view key) {
+  if (const std::size_t at = pattern.find("_L");
+      at != std::string_view::npos && (at + 2 == pattern.size() || pattern[at + 2] == '_')) {
+    return key.size() == pattern.size() && key.substr(0, at + 1) == pattern.substr(0, at + 1) &&
+           key.substr(at + 2) == pattern.substr(at + 2) &&
+           std::string_view("XYZABCUVW").find(key[at + 1]) != std::string_view::npos;
+  }
   if (!pattern.ends_with("_n")) return pattern == key;
   const std::string_view prefix = pattern.substr(0, pattern.size() - 1);
   return key.size() > prefix.size() && key.starts_with(prefix) &&

@@ -147,6 +147,52 @@ void describe_io(std::string& out, const IoConfig& io) {
   line(out, "  user M codes stopped after " + num(io.user_m_timeout_s) + " s");
 }
 
+// The panel's wiring by its INI keys, as the docs name them.
+void describe_panel(std::string& out, const PanelConfig& p, const std::string& units) {
+  if (!p.present) {
+    line(out, "Panel:        none (no [PANEL])");
+    return;
+  }
+  line(out, "Panel:        debounce " + std::to_string(p.debounce_ms) + " ms, door " +
+                (p.door_mode == PanelConfig::DoorMode::estop
+                     ? "trips the estop"
+                     : "holds (feed hold, spindle stop at rest, coolant off)"));
+  for (int i = 0; i < kPanelInputs; ++i) {
+    signal_line(out, panel_input_key(static_cast<PanelInput>(i)),
+                p.inputs[static_cast<std::size_t>(i)]);
+  }
+  const auto wiring = [](const PanelCounterWiring& w) {
+    if (w.counts.given()) return "counter " + w.counts.text;
+    return "encoder A " + w.a.text + ", B " + w.b.text;
+  };
+  if (p.mpg.given()) {
+    line(out, "  MPG: " + wiring(p.mpg) + ", " + std::to_string(p.mpg_counts_per_detent) +
+                  " counts a detent, " +
+                  (p.mpg_mode == PanelConfig::MpgMode::velocity ? "velocity" : "position") +
+                  " mode, steps " + num(p.mpg_step_distance[0]) + " / " +
+                  num(p.mpg_step_distance[1]) + " / " + num(p.mpg_step_distance[2]) + " " + units +
+                  (p.mpg_override_feed ? ", feed override while a program runs" : ""));
+  } else {
+    line(out, "  MPG: none");
+  }
+  static constexpr const char* kKnobs[] = {"feed", "rapid", "spindle"};
+  for (std::size_t k = 0; k < p.knobs.size(); ++k) {
+    const OverrideKnob& knob = p.knobs[k];
+    if (knob.encoder.given()) {
+      line(out, std::string("  ") + kKnobs[k] + " override knob: " + wiring(knob.encoder) + ", " +
+                    num(knob.per_count * 100) + " % a count");
+    } else if (knob.analog.given()) {
+      line(out, std::string("  ") + kKnobs[k] + " override knob: analog " + knob.analog.text +
+                    ", " + num(knob.analog_min) + " .. " + num(knob.analog_max) +
+                    " over the override's range");
+    }
+  }
+  for (int l = 0; l < kPanelLights; ++l) {
+    signal_line(out, std::string(panel_light_key(static_cast<PanelLight>(l))),
+                p.lights[static_cast<std::size_t>(l)]);
+  }
+}
+
 }  // namespace
 
 std::string describe(const MachineConfig& c) {
@@ -250,6 +296,7 @@ std::string describe(const MachineConfig& c) {
   describe_spindle(out, c.spindle);
   describe_tool_change(out, c.tool_change);
   describe_io(out, c.io);
+  describe_panel(out, c.panel, lu);
   line(out, "cncd:");
   line(out, "  socket " + c.cncd.socket_path + ", read group " + or_none(c.cncd.read_group) +
                 ", control group " + or_none(c.cncd.control_group));

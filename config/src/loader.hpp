@@ -4,6 +4,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cncd/config/machine_config.hpp"
 #include "typed_reader.hpp"
@@ -25,14 +26,35 @@ void load_spindle(TypedReader& reader, MachineConfig& config);
 // The [CNCD] signals and USER_M_TIMEOUT, [RS274NGC] USER_M_PATH (after load_program_dirs) and
 // the [EMCIO] tool change keys.
 void load_io(TypedReader& reader, MachineConfig& config);
+// [PANEL]: every key, the pairs that go together and the axes named (after load_general).
+void load_panel(TypedReader& reader, MachineConfig& config);
 // Cross-checks between keys and sections.
 void validate(TypedReader& reader, const MachineConfig& config);
 // What the spindle's DRIVER needs, the directions, buses and lines of every signal address,
 // and the tool change position against the soft limits (after load_motion).
 void validate_io(TypedReader& reader, const MachineConfig& config);
 
-// What a program or the spindle does with a signal (signal_address.cpp).
-enum class SignalUse { digital_output, analog_output, digital_input, analog_input };
+// What a program, the spindle or the panel does with a signal (signal_address.cpp). The panel
+// reads buttons and switches (panel_button: digital inputs, or an input device's KEY_*/BTN_*),
+// counters that wrap (modbus registers, sim, REL_*), quadrature channels (gpio, sim: decoded by
+// the driver) and analog knobs (registers, sim, ABS_*); its lights are digital outputs.
+enum class SignalUse {
+  digital_output,
+  analog_output,
+  digital_input,
+  analog_input,
+  panel_button,
+  panel_counter,
+  panel_encoder,
+  panel_analog
+};
+// A [PANEL] key that names a signal, and what the panel does with it (load_panel.cpp).
+struct PanelSignal {
+  std::string key;
+  const SignalAddress* address;
+  SignalUse use;
+};
+std::vector<PanelSignal> panel_signals(const PanelConfig& panel);
 // "" when an address of that kind can serve that use, else why not.
 std::string signal_use_refusal(const SignalAddress& address, SignalUse use);
 // Repeated single-valued keys, and unknown keys that look like a misspelt known one.

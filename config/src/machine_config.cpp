@@ -61,6 +61,7 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
   load_web(reader, config);
   load_spindle(reader, config);
   load_io(reader, config);
+  load_panel(reader, config);
   if (check_sections(reader)) {
     load_motion(reader, config);
     validate(reader, config);

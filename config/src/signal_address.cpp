@@ -2,6 +2,7 @@
 #include <string>
 #include <vector>
 
+#include "cncd/config/evdev_codes.hpp"
 #include "loader.hpp"
 #include "text.hpp"
 
@@ -9,7 +10,8 @@ namespace cncd::config {
 namespace {
 
 constexpr std::string_view kSyntax =
-    "an address is gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N or sim:NAME";
+    "an address is gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N, sim:NAME or "
+    "evdev:DEVICE:CODE";
 
 std::vector<std::string_view> split(std::string_view text, char separator) {
   std::vector<std::string_view> parts;
@@ -88,6 +90,30 @@ std::string parse_modbus(const std::vector<std::string_view>& parts, SignalAddre
   return parse_whole(parts[4], what, 65535, out.address);
 }
 
+// `rest` is what follows "evdev:": DEVICE up to the last ':', then CODE.
+std::string parse_evdev(std::string_view rest, SignalAddress& out) {
+  const std::string usage = ": write evdev:DEVICE:CODE, e.g. evdev:/dev/input/by-id/NAME:KEY_F1";
+  const std::size_t colon = rest.rfind(':');
+  if (colon == std::string_view::npos) return "missing the event code" + usage;
+  const std::string_view device = rest.substr(0, colon);
+  const std::string_view code = rest.substr(colon + 1);
+  if (device.empty()) return "missing the device" + usage;
+  if (auto e = check_name(device, "device"); !e.empty()) return e;
+  if (!device.starts_with('/')) {
+    return "device '" + printable(device) + "' is not an absolute path" + usage;
+  }
+  if (code.empty()) return "missing the event code" + usage;
+  const std::string upper = to_upper(code);
+  if (!evdev_code(upper)) {
+    return "unknown event code '" + printable(code) +
+           "': write a KEY_*, BTN_*, REL_* or ABS_* name of <linux/input-event-codes.h>, as "
+           "evtest prints it";
+  }
+  out.device = std::string(device);
+  out.code = upper;
+  return "";
+}
+
 }  // namespace
 
 std::string parse_signal_address(std::string_view text, SignalAddress& out) {
@@ -124,6 +150,9 @@ std::string parse_signal_address(std::string_view text, SignalAddress& out) {
       error = "signal name '" + printable(rest) + "' contains ':'";
     }
     parsed.name = std::string(rest);
+  } else if (kind == "evdev") {
+    parsed.kind = SignalAddress::Kind::evdev;
+    error = parse_evdev(rest, parsed);
   } else {
     error = kind.empty() ? "missing the kind before ':'; " + std::string(kSyntax)
                          : "unknown kind '" + printable(written.substr(0, colon)) + "'; " +
@@ -133,13 +162,52 @@ std::string parse_signal_address(std::string_view text, SignalAddress& out) {
   return error;
 }
 
+namespace {
+
+// The kind of event an evdev address's code gives (parse_signal_address checked the name).
+EvdevCode::Type evdev_type(const SignalAddress& a) {
+  const auto code = evdev_code(a.code);
+  return code ? code->type : EvdevCode::Type::key;
+}
+
+// Only the panel reads input devices, and each use wants one type of event.
+std::string evdev_refusal(const SignalAddress& a, SignalUse use) {
+  using Type = EvdevCode::Type;
+  const Type type = evdev_type(a);
+  switch (use) {
+    case SignalUse::panel_button:
+      if (type == Type::key) return "";
+      return a.code + " is not a button: a button or switch is a KEY_* or BTN_* code";
+    case SignalUse::panel_counter:
+      if (type == Type::rel) return "";
+      return a.code + " does not count: a counter is a REL_* code (a jog dial or wheel)";
+    case SignalUse::panel_analog:
+      if (type == Type::abs) return "";
+      return a.code + " is not analog: an analog knob is an ABS_* code";
+    case SignalUse::panel_encoder:
+      return "an input device gives no quadrature channel: wire its REL_* code to the _COUNTS "
+             "key instead";
+    case SignalUse::digital_output:
+    case SignalUse::analog_output:
+      return "an input device (evdev) cannot be written: use gpio, a modbus coil or sim";
+    case SignalUse::digital_input:
+    case SignalUse::analog_input:
+      break;
+  }
+  return "an input device (evdev) is read only by [PANEL] keys";
+}
+
+}  // namespace
+
 std::string signal_use_refusal(const SignalAddress& a, SignalUse use) {
   using Kind = SignalAddress::Kind;
   using Table = SignalAddress::Table;
+  if (a.kind == Kind::evdev) return evdev_refusal(a, use);
   const bool sim = a.kind == Kind::sim;
   const bool gpio = a.kind == Kind::gpio;
   const bool modbus = a.kind == Kind::modbus;
   const Table t = a.table;
+  const bool register_table = modbus && (t == Table::input || t == Table::holding);
   switch (use) {
     case SignalUse::digital_output:
       if (sim || gpio || (modbus && t == Table::coil)) return "";
@@ -150,12 +218,22 @@ std::string signal_use_refusal(const SignalAddress& a, SignalUse use) {
       if (gpio) return "a gpio line is not analog: use a holding register (hr)";
       return "an analog output is a holding register (hr)";
     case SignalUse::digital_input:
+    case SignalUse::panel_button:
       if (sim || gpio || (modbus && (t == Table::discrete || t == Table::coil))) return "";
       return "a register is not a bit: use a discrete input (di) or a coil";
     case SignalUse::analog_input:
-      if (sim || (modbus && (t == Table::input || t == Table::holding))) return "";
+    case SignalUse::panel_analog:
+      if (sim || register_table) return "";
       if (gpio) return "a gpio line is not analog: use an input (ir) or holding register (hr)";
       return "a bit is not analog: use an input (ir) or holding register (hr)";
+    case SignalUse::panel_counter:
+      if (sim || register_table) return "";
+      if (gpio) return "a gpio line gives no count: wire an encoder to the _A and _B keys";
+      return "a bit gives no count: use an input (ir) or holding register (hr)";
+    case SignalUse::panel_encoder:
+      if (sim || gpio) return "";
+      return "a Modbus signal is read an update period apart, far too seldom for quadrature: "
+             "wire the encoder to gpio lines, or its count to the _COUNTS key";
   }
   return "";
 }

@@ -127,7 +127,8 @@ void check_gpio_spindle(TypedReader& r, const MachineConfig& c) {
     r.problem(kSpindle, "DRIVER", "DRIVER = gpio needs [GPIO] CHIP (gpiochip0, or vcd:FILE)");
   }
   for (const Signal& signal : spindle_signals(s)) {
-    if (signal.address->kind == SignalAddress::Kind::modbus) {
+    if (signal.address->kind == SignalAddress::Kind::modbus ||
+        signal.address->kind == SignalAddress::Kind::evdev) {
       r.problem(kSpindle, signal.key,
                 "'" + signal.address->text +
                     "': DRIVER = gpio drives gpio lines; write gpio:LINE (or sim:NAME)");
@@ -222,6 +223,7 @@ struct Taken {
   std::string label;
   SourceRef source;
   bool output = false;
+  bool panel = false;
 };
 
 void reserve_gpio_lines(TypedReader& r, const MachineConfig& c,
@@ -255,26 +257,50 @@ void check_shared(TypedReader& r, const MachineConfig& c, const std::vector<Sign
     for (const Signal& s : signals) {
       if (is_output(s.use) != outputs) continue;
       const std::string id = identity(*s.address);
+      const bool panel = s.section == "PANEL";
       const auto [it, fresh] =
-          taken.emplace(id, Taken{label(s.section, s.key), s.address->source, outputs});
-      // Reading back a coil or a sim signal one writes is fine; a gpio line is one or the other.
-      if (fresh ||
-          (!outputs && (!it->second.output || s.address->kind != SignalAddress::Kind::gpio))) {
-        continue;
-      }
+          taken.emplace(id, Taken{label(s.section, s.key), s.address->source, outputs, panel});
+      if (fresh) continue;
       const Taken& other = it->second;
+      const bool gpio = s.address->kind == SignalAddress::Kind::gpio;
+      // Reading back a coil or a sim signal one writes is fine; a gpio line is one or the other.
+      // A panel input is one button: two panel keys on it, or a gpio line the driver reads for
+      // another key too, is a wiring mistake.
+      const bool both_inputs_clash =
+          !other.output && (panel || other.panel) && (gpio || (panel && other.panel));
+      if (!outputs && !both_inputs_clash && (!other.output || !gpio)) continue;
+      const std::string why =
+          outputs        ? (other.output ? "; an output has one driver"
+                                         : ", an input; an output cannot share its line")
+          : other.output ? ", an output; an input cannot share its line"
+                         : ", an input too; a panel input has a signal of its own";
       r.problem(s.section, s.key,
                 "'" + s.address->text + "': " + id + " is also " + other.label +
-                    (other.source.line > 0 ? " (" + at_line(other.source) + ")" : "") +
-                    (outputs ? (other.output ? "; an output has one driver"
-                                             : ", an input; an output cannot share its line")
-                             : ", an output; an input cannot share its line"));
+                    (other.source.line > 0 ? " (" + at_line(other.source) + ")" : "") + why);
+    }
+  }
+}
+
+// The gpio driver reads the panel's lines (and decodes its encoders) in the base thread.
+void check_panel_base_thread(TypedReader& r, const MachineConfig& c,
+                             const std::vector<Signal>& signals) {
+  if (c.base_period_ns > 0 || r.failed("EMCMOT", "BASE_PERIOD")) return;
+  for (const Signal& s : signals) {
+    if (s.section == "PANEL" && s.address->kind == SignalAddress::Kind::gpio) {
+      r.problem(s.section, s.key,
+                "'" + s.address->text +
+                    "': the panel's gpio lines are read in the base thread: set [EMCMOT] "
+                    "BASE_PERIOD");
+      return;
     }
   }
 }
 
 void check_signals(TypedReader& r, const MachineConfig& c) {
   std::vector<Signal> signals = program_signals(c.io);
+  for (const PanelSignal& s : panel_signals(c.panel))
+    signals.push_back(Signal{"PANEL", s.key, s.address, s.use});
+  check_panel_base_thread(r, c, signals);
   const bool check_chip = !has_chip(r);
   for (const Signal& s : signals) {
     const SignalAddress& a = *s.address;

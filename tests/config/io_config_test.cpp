@@ -104,12 +104,14 @@ TEST_F(IoConfigTest, BadAddressIsRefusedAtItsKey) {
   EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nFLOOD_OUTPUT = relay:3\n"),
             problem_at(43,
                        "[CNCD] FLOOD_OUTPUT: 'relay:3': unknown kind 'relay'; an address is "
-                       "gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N or sim:NAME"));
+                       "gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N, sim:NAME or "
+                       "evdev:DEVICE:CODE"));
   // Outside [SPINDLE_0] a bare line is not an address.
   EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nMIST_OUTPUT = 17\n"),
             problem_at(43,
                        "[CNCD] MIST_OUTPUT: '17': '17' names no kind; an address is "
-                       "gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N or sim:NAME"));
+                       "gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N, sim:NAME or "
+                       "evdev:DEVICE:CODE"));
 }
 
 TEST_F(IoConfigTest, EachSignalMustBeAbleToGoItsWay) {

@@ -64,7 +64,8 @@ TEST(SignalAddressTest, SimByName) {
 
 TEST(SignalAddressTest, GarbageIsRefusedSayingWhatIsWrong) {
   const std::string syntax =
-      "an address is gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N or sim:NAME";
+      "an address is gpio:LINE, gpio:!LINE, modbus:BUS:SLAVE:coil|hr|di|ir:N, sim:NAME or "
+      "evdev:DEVICE:CODE";
   EXPECT_EQ(error_of(""), "empty address; " + syntax);
   EXPECT_EQ(error_of("17"), "'17' names no kind; " + syntax);
   EXPECT_EQ(error_of("pin:17"), "unknown kind 'pin'; " + syntax);
