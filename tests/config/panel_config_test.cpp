@@ -265,5 +265,27 @@ TEST_F(PanelConfigTest, TheExamplePanelsLoadWithoutProblemsOrWarnings) {
   EXPECT_GT(gpio.config->base_period_ns, 0);
 }
 
+TEST_F(PanelConfigTest, SettingsOfWhatIsNotWiredAreWarnedAbout) {
+  const auto result =
+      load(panel("MPG_COUNTS_PER_DETENT = 100\nMPG_MODE = velocity\nFEED_OVERRIDE_SCALE = 0.02\n"
+                 "RAPID_OVERRIDE_COUNTS = sim:r\nRAPID_OVERRIDE_ANALOG_MAX = 5\n"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(strings(result.warnings),
+            (std::vector<std::string>{
+                at(kKey) + ": [PANEL] MPG_COUNTS_PER_DETENT: ignored: no MPG (MPG_A and MPG_B, "
+                           "or MPG_COUNTS)",
+                at(kKey + 1) + ": [PANEL] MPG_MODE: ignored: no MPG (MPG_A and MPG_B, or "
+                               "MPG_COUNTS)",
+                at(kKey + 2) + ": [PANEL] FEED_OVERRIDE_SCALE: ignored: no encoder "
+                               "(FEED_OVERRIDE_A and _B, or FEED_OVERRIDE_COUNTS)",
+                at(kKey + 4) + ": [PANEL] RAPID_OVERRIDE_ANALOG_MAX: ignored: no analog input "
+                               "(RAPID_OVERRIDE_ANALOG)"}));
+  // A misspelt axis key is guessed with its own letter.
+  EXPECT_EQ(refused("JOG_Y_PLSU = sim:y\n"),
+            problem(1,
+                    "JOG_Y_PLSU: unknown key in the panel's section; did you mean "
+                    "JOG_Y_PLUS?"));
+}
+
 }  // namespace
 }  // namespace cncd::config::test
