@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "key_makers.hpp"
 #include "linuxcnc_keys.hpp"
 #include "loader.hpp"
 #include "text.hpp"
@@ -38,13 +39,21 @@ std::size_t allowed_edits(std::string_view key) {
   return key.size() >= 4 ? 1 : 0;
 }
 
-std::vector<std::string_view> known_keys(std::string_view pattern) {
-  std::vector<std::string_view> keys;
+// The known keys of a section; an axis key ("JOG_L_PLUS") is guessed with the axis letter the
+// typed key has in its place ("JOG_Y_PLSU" -> JOG_Y_PLUS).
+std::vector<std::string> known_keys(std::string_view pattern, std::string_view typed) {
+  std::vector<std::string> keys;
   for (const auto& spec : key_table()) {
-    if (spec.section == pattern) keys.push_back(spec.key);
+    if (spec.section != pattern) continue;
+    std::string key(spec.key);
+    const std::size_t at = key_makers::axis_placeholder(key);
+    if (at < typed.size() && kAxisLetters.find(typed[at]) != std::string_view::npos) {
+      key[at] = typed[at];
+    }
+    keys.push_back(std::move(key));
   }
   for (const auto key : linuxcnc_keys(pattern))
-    keys.push_back(key);
+    keys.emplace_back(key);
   return keys;
 }
 
@@ -79,16 +88,16 @@ void check_repeated(TypedReader& r, const IniEntry& entry) {
 std::string did_you_mean(std::string_view section, std::string_view key) {
   const std::string_view pattern = key_table_section(section);
   if (pattern.empty()) return "";
-  const auto keys = known_keys(pattern);
-  for (const auto known : keys) {
+  const std::string upper = to_upper(key);
+  const auto keys = known_keys(pattern, upper);
+  for (const auto& known : keys) {
     if (iequals(known, key)) {
-      return "; did you mean " + std::string(known) + "? (key names are case-sensitive)";
+      return "; did you mean " + known + "? (key names are case-sensitive)";
     }
   }
-  const std::string upper = to_upper(key);
   std::string_view best;
   std::size_t best_edits = allowed_edits(key) + 1;
-  for (const auto known : keys) {
+  for (const auto& known : keys) {
     const std::size_t edits = edit_distance(upper, known);
     if (edits < best_edits && !min_max_pair(upper, known)) {
       best = known;

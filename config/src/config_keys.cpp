@@ -388,11 +388,10 @@ bool matches_section(std::string_view pattern, std::string_view section) {
 // "DIGITAL_OUTPUT_n" matches DIGITAL_OUTPUT_ and digits; "JOG_L_PLUS" and "MPG_AXIS_L" match
 // any axis letter (upper case) for the L.
 bool matches_key(std::string_view pattern, std::string_view key) {
-  if (const std::size_t at = pattern.find("_L");
-      at != std::string_view::npos && (at + 2 == pattern.size() || pattern[at + 2] == '_')) {
-    return key.size() == pattern.size() && key.substr(0, at + 1) == pattern.substr(0, at + 1) &&
-           key.substr(at + 2) == pattern.substr(at + 2) &&
-           std::string_view("XYZABCUVW").find(key[at + 1]) != std::string_view::npos;
+  if (const std::size_t at = axis_placeholder(pattern); at != std::string_view::npos) {
+    return key.size() == pattern.size() && key.substr(0, at) == pattern.substr(0, at) &&
+           key.substr(at + 1) == pattern.substr(at + 1) &&
+           std::string_view("XYZABCUVW").find(key[at]) != std::string_view::npos;
   }
   if (!pattern.ends_with("_n")) return pattern == key;
   const std::string_view prefix = pattern.substr(0, pattern.size() - 1);

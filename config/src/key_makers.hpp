@@ -91,4 +91,14 @@ constexpr KeySpec positive_key(std::string_view section, std::string_view key,
   return {section, key, KeyType::real, default_value, 0, kInf, true, unit, "", help};
 }
 
+// Where a key's axis letter placeholder is: the L of "JOG_L_PLUS" and "MPG_AXIS_L" (4, 9),
+// which stands for any axis letter; npos for a key without one.
+constexpr std::size_t axis_placeholder(std::string_view key) {
+  const std::size_t at = key.find("_L");
+  if (at == std::string_view::npos || (at + 2 != key.size() && key[at + 2] != '_')) {
+    return std::string_view::npos;
+  }
+  return at + 1;
+}
+
 }  // namespace cncd::config::key_makers

@@ -51,6 +51,18 @@ void check_unknown_keys(TypedReader& r, const MachineConfig& c) {
   }
 }
 
+// Settings of an MPG or knob that is not wired: read by nobody, which the integrator should know.
+void warn_unwired(TypedReader& r, bool wired, const std::vector<std::string>& wiring,
+                  const std::vector<std::string>& settings, const std::string& what) {
+  if (wired) return;
+  for (const std::string& key : wiring) {
+    if (r.failed(kPanel, key)) return;  // its own problem says enough
+  }
+  for (const std::string& key : settings) {
+    if (r.given(kPanel, key)) r.warning(kPanel, key, "ignored: " + what);
+  }
+}
+
 void load_counter(TypedReader& r, const std::string& prefix, PanelCounterWiring& w) {
   w.a = r.signal(kPanel, prefix + "_A");
   w.b = r.signal(kPanel, prefix + "_B");
@@ -83,6 +95,11 @@ void load_knob(TypedReader& r, const std::string& prefix, OverrideKnob& k) {
   }
   const std::string min_key = prefix + "_ANALOG_MIN";
   const std::string max_key = prefix + "_ANALOG_MAX";
+  const std::vector<std::string> encoder = {prefix + "_A", prefix + "_B", prefix + "_COUNTS"};
+  warn_unwired(r, k.encoder.given(), encoder, {prefix + "_SCALE"},
+               "no encoder (" + prefix + "_A and _B, or " + prefix + "_COUNTS)");
+  warn_unwired(r, k.analog.given(), {prefix + "_ANALOG"}, {min_key, max_key},
+               "no analog input (" + prefix + "_ANALOG)");
   if (!(k.analog_min < k.analog_max) && !r.failed(kPanel, min_key) && !r.failed(kPanel, max_key)) {
     r.problem(kPanel, r.given(kPanel, max_key) ? max_key : min_key,
               max_key + " " + format_number(k.analog_max) + " must be above " + min_key + " " +
@@ -105,6 +122,10 @@ void load_mpg(TypedReader& r, const MachineConfig& c, PanelConfig& p) {
     p.mpg_mode = *v == "velocity" ? PanelConfig::MpgMode::velocity : PanelConfig::MpgMode::position;
   }
   if (const auto v = r.choice(kPanel, "MPG_OVERRIDE")) p.mpg_override_feed = *v == "feed";
+  warn_unwired(
+      r, p.mpg.given(), {"MPG_A", "MPG_B", "MPG_COUNTS"},
+      {"MPG_COUNTS_PER_DETENT", kSteps[0], kSteps[1], kSteps[2], "MPG_MODE", "MPG_OVERRIDE"},
+      "no MPG (MPG_A and MPG_B, or MPG_COUNTS)");
 }
 
 }  // namespace

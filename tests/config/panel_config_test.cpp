@@ -232,5 +232,60 @@ TEST_F(PanelConfigTest, DescribeListsTheWiring) {
   EXPECT_EQ(text.find("FEED_HOLD"), std::string::npos) << text;
 }
 
+TEST_F(PanelConfigTest, TheExamplePanelsLoadWithoutProblemsOrWarnings) {
+  const std::filesystem::path examples = CNCD_CONFIG_EXAMPLES_DIR;
+  const auto sim = load_machine_config(examples / "sim_panel_mill.ini");
+  ASSERT_TRUE(sim.ok()) << ::testing::PrintToString(strings(sim.problems));
+  EXPECT_TRUE(sim.warnings.empty()) << ::testing::PrintToString(strings(sim.warnings));
+  const PanelConfig& p = sim.config->panel;
+  // Every button and switch of an XYZ mill, and every light.
+  for (int i = 0; i < kPanelInputs; ++i) {
+    const std::string key = panel_input_key(static_cast<PanelInput>(i));
+    const bool other_axis = key.find_first_of("ABCUVW", key.starts_with("JOG_") ? 4 : 9) ==
+                            (key.starts_with("JOG_") ? 4u : 9u);
+    if ((key.starts_with("JOG_") || key.starts_with("MPG_AXIS_")) && other_axis) continue;
+    EXPECT_EQ(p.inputs[static_cast<std::size_t>(i)].kind, Kind::sim) << key;
+  }
+  for (const SignalAddress& light : p.lights)
+    EXPECT_EQ(light.kind, Kind::sim);
+  EXPECT_EQ(p.mpg.counts.name, "mpg_counts");
+  EXPECT_EQ(p.mpg_counts_per_detent, 100);
+  EXPECT_TRUE(p.knobs[0].encoder.counts.given());
+  EXPECT_TRUE(p.knobs[1].analog.given());
+  EXPECT_TRUE(p.knobs[2].encoder.counts.given());
+
+  const auto gpio = load_machine_config(examples / "gpio_panel_mill.ini");
+  ASSERT_TRUE(gpio.ok()) << ::testing::PrintToString(strings(gpio.problems));
+  EXPECT_TRUE(gpio.warnings.empty()) << ::testing::PrintToString(strings(gpio.warnings));
+  const PanelConfig& g = gpio.config->panel;
+  EXPECT_EQ(g.mpg.a.line, "GPIO2");
+  EXPECT_EQ(g.mpg.b.line, "GPIO3");
+  EXPECT_TRUE(g.input(PanelInput::cycle_start).active_low);
+  EXPECT_EQ(g.lights[static_cast<int>(PanelLight::green)].kind, Kind::gpio);
+  EXPECT_GT(gpio.config->base_period_ns, 0);
+}
+
+TEST_F(PanelConfigTest, SettingsOfWhatIsNotWiredAreWarnedAbout) {
+  const auto result =
+      load(panel("MPG_COUNTS_PER_DETENT = 100\nMPG_MODE = velocity\nFEED_OVERRIDE_SCALE = 0.02\n"
+                 "RAPID_OVERRIDE_COUNTS = sim:r\nRAPID_OVERRIDE_ANALOG_MAX = 5\n"));
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_EQ(strings(result.warnings),
+            (std::vector<std::string>{
+                at(kKey) + ": [PANEL] MPG_COUNTS_PER_DETENT: ignored: no MPG (MPG_A and MPG_B, "
+                           "or MPG_COUNTS)",
+                at(kKey + 1) + ": [PANEL] MPG_MODE: ignored: no MPG (MPG_A and MPG_B, or "
+                               "MPG_COUNTS)",
+                at(kKey + 2) + ": [PANEL] FEED_OVERRIDE_SCALE: ignored: no encoder "
+                               "(FEED_OVERRIDE_A and _B, or FEED_OVERRIDE_COUNTS)",
+                at(kKey + 4) + ": [PANEL] RAPID_OVERRIDE_ANALOG_MAX: ignored: no analog input "
+                               "(RAPID_OVERRIDE_ANALOG)"}));
+  // A misspelt axis key is guessed with its own letter.
+  EXPECT_EQ(refused("JOG_Y_PLSU = sim:y\n"),
+            problem(1,
+                    "JOG_Y_PLSU: unknown key in the panel's section; did you mean "
+                    "JOG_Y_PLUS?"));
+}
+
 }  // namespace
 }  // namespace cncd::config::test
