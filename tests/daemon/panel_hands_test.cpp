@@ -52,7 +52,7 @@ TEST_F(DISABLED_PanelTest, ButtonsInEstopAndWhileOffDoNothingButResetAndMachineO
 TEST_F(DISABLED_PanelTest, TenEncoderCountsAtOnePercentTakeTheFeedOverrideTo110Percent) {
   ready_machine();
   EXPECT_EQ(status()["overrides"]["feed"], 1.0);
-  ASSERT_NO_FATAL_FAILURE(set("feed_knob", 10));
+  ASSERT_NO_FATAL_FAILURE(set("feed_override_counts", 10));
   json s = wait_until([](const json& st) { return st["overrides"]["feed"] != 1.0; });
   EXPECT_NEAR(s["overrides"]["feed"].get<double>(), 1.1, 1e-9);
   // The planned feed with it: F600 (10 mm/s) cruises at 11 mm/s.
@@ -61,32 +61,33 @@ TEST_F(DISABLED_PanelTest, TenEncoderCountsAtOnePercentTakeTheFeedOverrideTo110P
   EXPECT_NEAR(s["velocity"].get<double>(), 11.0, 1e-6);
   result_of(call("program.abort"));
   // Back down: counts the other way.
-  ASSERT_NO_FATAL_FAILURE(set("feed_knob", -20));
+  ASSERT_NO_FATAL_FAILURE(set("feed_override_counts", -20));
   s = wait_until([](const json& st) { return st["overrides"]["feed"].get<double>() < 1.0; });
   EXPECT_NEAR(s["overrides"]["feed"].get<double>(), 0.8, 1e-9);
 }
 
 TEST_F(DISABLED_PanelTest, AnAnalogKnobAtHalfScaleGivesTheMidOverride) {
   ready_machine();
-  // [DISPLAY] MIN_SPINDLE_OVERRIDE 0.5 .. MAX_SPINDLE_OVERRIDE 1.2: the knob at 0 V has set the
-  // lowest when the machine came on.
+  // RAPID_OVERRIDE_ANALOG 0 .. 10 over the rapid override's 0 .. 1.
   const auto override_near = [](double ratio) {
     return [ratio](const json& st) {
-      return std::abs(st["overrides"]["spindle"].get<double>() - ratio) < 1e-9;
+      return std::abs(st["overrides"]["rapid"].get<double>() - ratio) < 1e-9;
     };
   };
+  wait_until(override_near(1.0), std::chrono::seconds(10));
+  ASSERT_NO_FATAL_FAILURE(set("rapid_override_analog", 5.0));
   wait_until(override_near(0.5), std::chrono::seconds(10));
-  ASSERT_NO_FATAL_FAILURE(set("spindle_knob", 5.0));
-  wait_until(override_near(0.85), std::chrono::seconds(10));
-  ASSERT_NO_FATAL_FAILURE(set("spindle_knob", 10.0));
-  wait_until(override_near(1.2), std::chrono::seconds(10));
+  ASSERT_NO_FATAL_FAILURE(set("rapid_override_analog", 2.5));
+  wait_until(override_near(0.25), std::chrono::seconds(10));
 }
 
 TEST_F(DISABLED_PanelTest, AClientJogWhileTheMpgMovesIsRefusedNamingTheMpg) {
   ready_machine();
+  ASSERT_NO_FATAL_FAILURE(level("MPG_ENABLE", true));
   ASSERT_NO_FATAL_FAILURE(level("MPG_AXIS_X", true));
-  // 250 detents of 1 mm: well over a second at 200 mm/s.
-  ASSERT_NO_FATAL_FAILURE(set("mpg", 25000));
+  ASSERT_NO_FATAL_FAILURE(level("MPG_STEP_100", true));
+  // 2500 detents of 0.1 mm: 250 mm, over a second at 200 mm/s.
+  ASSERT_NO_FATAL_FAILURE(set("mpg_counts", 250000));
   wait_until([](const json& st) { return st["panel"]["mpg"]["jogging"] == true; });
   const json answer = call("jog.start", {{"axis", "Y"}, {"velocity", 5}});
   ASSERT_EQ(error_code(answer), 1004) << answer.dump();
