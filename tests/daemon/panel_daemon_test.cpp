@@ -121,15 +121,16 @@ TEST_F(DISABLED_PanelTest, BlockDeleteSkipsSlashLinesWhileOn) {
 
 TEST_F(DISABLED_PanelTest, TheDoorHoldsStopsTheSpindleAndResumeWaitsForItsSpeed) {
   ready_machine();
-  // 6000 rpm at 6000 rpm/s: a second to come up to speed.
+  // 6000 rpm at 6000 rpm/s: a second to come up to speed from rest.
   open_program("cut.ngc", "G21 G90 G0 X0 Y0 Z0\nM3 S6000\nM8\nG1 X150 F1200\nM2\n");
   ASSERT_NO_FATAL_FAILURE(press("CYCLE_START"));
   wait_until([&](const json& s) { return commanded(s, "x") > 5; });
   const auto since = last_seq();
   ASSERT_NO_FATAL_FAILURE(level("DOOR", true));
+  // Held, then the spindle stops (coming to rest at its ACCELERATION) and the coolant goes off.
   json s = wait_until([](const json& st) {
     return st["motion"] == "paused" && st["spindle"]["enabled"] == false &&
-           st["coolant"]["flood"] == false;
+           st["spindle"]["actual_rpm"] == 0.0 && st["coolant"]["flood"] == false;
   });
   EXPECT_EQ(s["exec"], "paused");
   EXPECT_EQ(s["panel"]["door"], true);
