@@ -19,11 +19,12 @@ void ServoLoop::advance_panel() noexcept {
   const std::uint32_t own = mpg_.moving >= 0 ? 1u << mpg_.moving : 0u;
   const int axis = panel.mpg_axis;
   // One hand on the machine: a client's jog (any axis) keeps the MPG still, and the MPG moves
-  // one axis at a time (a new selection waits for the last to come to rest).
+  // one axis at a time. A move it let go of (a new selection, a stop) comes to rest before it
+  // takes the wheel again, from where the axis then stands.
   const bool allowed = status_.machine == MachineState::on && !homing_.active() &&
                        !path_.pending() && panel_.mpg_enabled() && axis >= 0 && !mpg_.drop &&
                        (jog_.active_mask() & ~own) == 0 && (mpg_.axis < 0 || mpg_.axis == axis) &&
-                       (mpg_.moving < 0 || mpg_.moving == axis);
+                       (mpg_.moving < 0 || mpg_.moving == mpg_.axis);
   mpg_.drop = false;
   if (!allowed) {
     mpg_release();

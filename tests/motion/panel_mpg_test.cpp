@@ -93,6 +93,49 @@ TEST(PanelMpg, RandomBurstsEndOnTheSummedDetentsWithinTheLimits) {
   }
 }
 
+TEST(PanelMpg, AStepChangedMidMoveKeepsEachDetentsDistance) {
+  PanelRig rig(panel_mill(kPosition, 1));
+  rig.select(2, 2);  // Z, 0.1 a detent
+  rig.drive.turn(30);
+  rig.m.cycles(5);
+  rig.select(2, 0);  // 0.001 a detent from now on
+  rig.drive.turn(7);
+  rig.m.run_until_idle();
+  EXPECT_EQ(rig.m.status().commanded[2], 30 * 0.1 + 7 * 0.001);
+}
+
+TEST(PanelMpg, AClientStopHoldsTheMpgAndDropsItsTarget) {
+  PanelRig rig(panel_mill(kPosition, 1));
+  rig.select(0, 2);
+  rig.drive.turn(500);  // 50 mm
+  rig.m.cycles(100);
+  ASSERT_TRUE(rig.m.status().panel.mpg_jogging);
+  send(rig.m, Command::Kind::jog_stop, 0);
+  rig.m.run_until_idle();
+  const double held = rig.m.status().commanded[0];
+  EXPECT_LT(held, 50);
+  rig.m.cycles(200);
+  EXPECT_EQ(rig.m.status().commanded[0], held);
+  rig.drive.turn(1);  // the next detent moves from where it stopped
+  rig.m.run_until_idle();
+  EXPECT_NEAR(rig.m.status().commanded[0], held + 0.1, 1e-12);
+}
+
+TEST(PanelMpg, AnotherAxisSelectedMidMoveStopsTheFirstAndWaitsForIt) {
+  PanelRig rig(panel_mill(kPosition, 1));
+  rig.select(0, 2);
+  rig.drive.turn(500);
+  rig.m.cycles(100);
+  rig.select(1, 2);
+  rig.drive.turn(10);  // while X comes to rest: dropped
+  rig.m.run_until_idle();
+  EXPECT_LT(rig.m.status().commanded[0], 50);
+  EXPECT_EQ(rig.m.status().commanded[1], 0);
+  rig.drive.turn(10);
+  rig.m.run_until_idle();
+  EXPECT_EQ(rig.m.status().commanded[1], 10 * 0.1);
+}
+
 TEST(PanelMpg, AHomedAxisStopsAtItsSoftLimit) {
   config::MachineConfig c = panel_mill(kPosition, 1);
   c.axes[0].max_limit = 3;
