@@ -379,6 +379,7 @@ std::string jog_problem(const config::MachineConfig& config, const Status& statu
   if (status.motion != MotionState::idle && status.motion != MotionState::jogging)
     return "the machine is moving";
   if (status.queued != 0) return "the machine is moving";
+  if (status.panel.mpg_jogging) return "the panel's MPG is jogging";
   bool homed = false;
   for (int j = 0; j < status.joint_count; ++j) {
     if (config::axis_index(config.joints[static_cast<std::size_t>(j)].axis) != axis) continue;

@@ -77,6 +77,26 @@ const char* Jog::increment(int axis, double position, double distance, double sp
   return nullptr;
 }
 
+void Jog::follow(int axis, double position, double target, double speed) noexcept {
+  if (axis < 0 || axis >= kAxes) return;
+  auto& j = axes_[static_cast<std::size_t>(axis)];
+  const double capped = std::min(speed, config_.axes[static_cast<std::size_t>(axis)].max_velocity);
+  if (!j.active) {
+    if (target != position && capped > 0) begin(axis, position, target, capped);
+    return;
+  }
+  j.pending = false;
+  const double a = config_.axes[static_cast<std::size_t>(axis)].max_acceleration;
+  const double ahead = j.direction * (target - j.origin);
+  if (ahead >= j.s + j.v * j.v / (2.0 * a)) {
+    j.length = ahead;
+    j.target = target;
+    j.v_max = capped;
+  } else {
+    stop(axis);
+  }
+}
+
 void Jog::stop(int axis) noexcept {
   if (axis < 0 || axis >= kAxes) return;
   auto& j = axes_[static_cast<std::size_t>(axis)];

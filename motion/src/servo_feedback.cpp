@@ -27,6 +27,7 @@ void ServoLoop::read_drivers() noexcept {
     joints_.home_switch[k] = feedback_[k].home_switch;
   }
   probe_input_ = inputs.probe;
+  panel_in_ = io.panel;
   io_.set_cycle(cycle_);
   io_.feedback(io);
   if (inputs.estop && status_.machine != MachineState::estop) {
@@ -87,6 +88,9 @@ void ServoLoop::write_drivers() noexcept {
     last_motor_cmd_[k] = motor;
   }
   checks_.record(cycle_, commands_out_.data());
+  drivers::IoCommand io = io_.command();
+  io.panel = panel_lights();
+  status_.panel.lights = io.panel;
   for (auto& binding : drivers_) {
     drivers::JointCommand block[kJoints];
     const int n = static_cast<int>(binding.joints.size());
@@ -94,7 +98,7 @@ void ServoLoop::write_drivers() noexcept {
       block[k] =
           commands_out_[static_cast<std::size_t>(binding.joints[static_cast<std::size_t>(k)])];
     binding.driver->write(block, n);
-    binding.driver->write_io(io_.command());
+    binding.driver->write_io(io);
   }
 }
 

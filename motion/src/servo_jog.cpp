@@ -16,6 +16,8 @@ bool ServoLoop::axis_homed(int axis) const noexcept {
 void ServoLoop::apply_jog(const Command& command) noexcept {
   if (command.kind == Command::Kind::jog_stop) {
     jog_.stop(command.axis);
+    // A stop holds the MPG too: its target is forgotten, not resumed next period.
+    if (command.axis == mpg_.axis) mpg_.drop = true;
     return;
   }
   const char* refusal = nullptr;
@@ -23,6 +25,8 @@ void ServoLoop::apply_jog(const Command& command) noexcept {
     refusal = "the machine is not on";
   } else if (path_.pending() || homing_.active()) {
     refusal = "the machine is moving";
+  } else if (status_.panel.mpg_jogging) {
+    refusal = "the panel's MPG is jogging";
   } else if (command.axis < 0 || command.axis >= kAxes) {
     refusal = "the machine has no such axis";
   } else {

@@ -34,6 +34,14 @@ FeedbackChecks::JointDrivers joint_drivers(const std::vector<DriverBinding>& dri
   return out;
 }
 
+std::uint32_t axes_present(const config::MachineConfig& config) {
+  std::uint32_t mask = 0;
+  for (int axis = 0; axis < kAxes; ++axis) {
+    if (config.axes[static_cast<std::size_t>(axis)].present) mask |= 1u << axis;
+  }
+  return mask;
+}
+
 }  // namespace
 
 ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBinding> drivers)
@@ -45,9 +53,12 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config),
+      panel_(config.panel, period_s_, axes_present(config)),
       checks_(config, joint_count_, joint_drivers(drivers_),
               history_depth(drivers_, config.servo_period_ns)) {
   path_.set_gate(&io_);
+  // The MPG's speed in velocity mode: its counts over about 50 ms.
+  mpg_.window = std::clamp(static_cast<int>(std::lround(0.05 / period_s_)), 1, Mpg::kWindowMax);
   joint_axis_.fill(-1);
   for (int j = 0; j < joint_count_; ++j) {
     joint_axis_[static_cast<std::size_t>(j)] =
@@ -186,6 +197,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       path_.abort();
       homing_.abort();
       jog_.stop_all();
+      mpg_.drop = true;
       // The spindle, coolant and outputs stop at once, not when the path has come to rest.
       io_.stop_all();
       resume_pending_ = false;
@@ -210,7 +222,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       io_.release(command.id);
       break;
     case Command::Kind::panel_lights:
-      status_.panel.lights = command.id;
+      lights_asked_ = command.id;
       break;
     case Command::Kind::io_hold:
       io_hold_pending_ = true;
@@ -372,6 +384,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     apply(command);
   check_joints();
   check_spindle();
+  if (config_.panel.present) advance_panel();
 
   if (status_.machine == MachineState::on) {
     if (homing_.active()) {
@@ -390,6 +403,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
     joints_.command = joints_.feedback;
     sync_axes_from_joints();
   }
+  if (config_.panel.present) settle_mpg();
   guard_set_points();
   write_drivers();
   publish();

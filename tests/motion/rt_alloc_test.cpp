@@ -19,6 +19,7 @@
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/servo_loop.hpp"
 #include "machine_fixture.hpp"
+#include "panel_fixture.hpp"
 #include "path_distance.hpp"
 #include "rt_alloc_hooks.hpp"
 
@@ -32,12 +33,15 @@ using Kind = Command::Kind;
 // The servo loop on the simulated driver, every cycle() counted.
 class Rig {
  public:
-  explicit Rig(const config::MachineConfig& config) : config_(config), planner_(config_) {
+  // `panel`: a driver of no joints that reports the panel's inputs.
+  explicit Rig(const config::MachineConfig& config, drivers::Driver* panel = nullptr)
+      : config_(config), planner_(config_) {
     for (int j = 0; j < static_cast<int>(config_.joints.size()); ++j)
       joints_.push_back(j);
     EXPECT_EQ(sim_.configure(config_, joints_), "");
-    loop_ = std::make_unique<ServoLoop>(config_,
-                                        std::vector<DriverBinding>{DriverBinding{&sim_, joints_}});
+    std::vector<DriverBinding> bindings{DriverBinding{&sim_, joints_}};
+    if (panel != nullptr) bindings.push_back(DriverBinding{panel, {}});
+    loop_ = std::make_unique<ServoLoop>(config_, std::move(bindings));
   }
 
   void cycles(int n) {
@@ -272,6 +276,45 @@ void run_everything(Rig& rig) {
   EXPECT_GT(rig.periods(), 10'000);
 }
 
+// Every panel input pressed and released, counters wrapping, lights, and the MPG jogging
+// in the config's mode; a client jog refused while it moves; counts dropped in estop.
+void run_panel(Rig& rig, test::panel::PanelDrive& panel) {
+  using test::panel::bit;
+  using test::panel::mpg_axis_bit;
+  take_counts();
+  rig.command(Kind::reset_estop);
+  rig.command(Kind::on);
+  rig.command(Kind::home, 0xFFFFFFFFu);
+  rig.run_until_idle();
+  rig.command(Kind::panel_lights, 0, 0, 0, 0);
+  panel.bits = {16, 32, 16, 32};
+  for (int i = 0; i < 20; ++i) {
+    panel.inputs = i % 2 == 0 ? ~std::uint64_t{0} : 0;
+    panel.counts[1] += 40'000;
+    panel.counts[2] = (panel.counts[2] + 50'000) & 0xFFFF;
+    panel.analog[0] = i;
+    rig.cycles(15);
+  }
+  EXPECT_GT(rig.status().panel.presses[0], 0u);
+  panel.inputs =
+      mpg_axis_bit(0) | bit(config::PanelInput::mpg_enable) | bit(config::PanelInput::mpg_step_100);
+  rig.cycles(15);
+  for (int i = 0; i < 600; ++i) {
+    panel.turn(i < 300 ? 3 : -2);
+    rig.cycles(1);
+    if (i == 100) {
+      EXPECT_TRUE(rig.status().panel.mpg_jogging);
+      rig.command(Kind::jog_start, 0, 1, 50);
+    }
+  }
+  rig.run_until_idle();
+  EXPECT_TRUE(rig.saw("jog ignored: the panel's MPG is jogging"));
+  rig.command(Kind::estop);
+  panel.turn(1000);
+  rig.cycles(20);
+  EXPECT_PERIODS_RT_SAFE("panel");
+}
+
 class RtAllocation : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -325,6 +368,16 @@ TEST_F(RtAllocation, SCurveServoPeriodsNeverAllocate) {
   config.max_linear_jerk = 50'000;
   Rig rig(config);
   run_everything(rig);
+}
+
+TEST_F(RtAllocation, PanelServoPeriodsNeverAllocate) {
+  for (const auto mode :
+       {config::PanelConfig::MpgMode::position, config::PanelConfig::MpgMode::velocity}) {
+    test::panel::PanelDrive panel;
+    Rig rig(test::panel::panel_mill(mode, 4, 10), &panel);
+    run_everything(rig);
+    run_panel(rig, panel);
+  }
 }
 
 }  // namespace

@@ -29,6 +29,12 @@ class Jog {
   // `speed` units/s. Refused while the axis jogs.
   CNCD_RT const char* increment(int axis, double position, double distance, double speed,
                                 bool homed) noexcept;
+  // RT. Moves `axis` toward `target` at up to `speed`, called again as the target moves (the
+  // MPG's summed detents): a target further along the way the axis moves extends its move; one
+  // it can no longer reach without overshooting (behind it, or within its stopping distance)
+  // brings it to rest, and the next call turns it back. The caller clips the target at the soft
+  // limits. Ends exactly on the target.
+  CNCD_RT void follow(int axis, double position, double target, double speed) noexcept;
   // RT. Controlled stop at the axis's MAX_ACCELERATION.
   CNCD_RT void stop(int axis) noexcept;
   CNCD_RT void stop_all() noexcept;

@@ -15,6 +15,7 @@
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
 #include "cncd/motion/machine_io.hpp"
+#include "cncd/motion/panel.hpp"
 #include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/rt_event.hpp"
 #include "cncd/motion/rt_stats.hpp"
@@ -140,6 +141,17 @@ class ServoLoop {
   CNCD_RT void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
   CNCD_RT void advance_jog() noexcept;
   CNCD_RT bool axis_homed(int axis) const noexcept;
+  // The panel (servo_panel.cpp): inputs read into status_.panel, then the MPG's counts turned
+  // into a jog of the selected axis, or dropped when it may not move.
+  CNCD_RT void advance_panel() noexcept;
+  CNCD_RT void mpg_position(int axis, std::int64_t counts) noexcept;
+  CNCD_RT void mpg_velocity(int axis, std::int64_t counts) noexcept;
+  // Stops the MPG's jog (if any) and forgets its counts and target.
+  CNCD_RT void mpg_release() noexcept;
+  // The MPG's jog ends when its axis comes to rest (status_.panel.mpg_jogging).
+  CNCD_RT void settle_mpg() noexcept;
+  // The lights the drivers are told: the task's, and red in estop or with a fault.
+  CNCD_RT std::uint32_t panel_lights() const noexcept;
   CNCD_RT void read_drivers() noexcept;
   // Feedback judged by checks_; the first joint that fails latches the fault.
   CNCD_RT void check_joints() noexcept;  // servo_feedback.cpp, like read_drivers and write_drivers
@@ -179,6 +191,29 @@ class ServoLoop {
   Jog jog_;
   // Servo cycles counted from 1 (drivers::JointCommand::cycle).
   std::uint64_t cycle_ = 0;
+  Panel panel_;
+  drivers::PanelFeedback panel_in_{};  // this period's readings
+  std::uint32_t lights_asked_ = 0;     // by the task (Command::Kind::panel_lights)
+  // The MPG's jog: the axis it moves (-1: none), its counts as last seen, counts short of a
+  // detent; position mode: the target is base + detents x step; velocity mode: the counts of
+  // the last window of periods, a ring.
+  struct Mpg {
+    static constexpr int kWindowMax = 256;
+    int axis = -1;
+    int moving = -1;  // the axis whose jog the MPG started, until it comes to rest
+    std::int64_t seen = 0;
+    std::int64_t carry = 0;
+    double base = 0;
+    std::int64_t detents = 0;
+    double step = 0;
+    bool drop = false;  // an abort or a client's stop: forget the target this period
+    int window = 1;     // periods in the velocity window
+    int at = 0;
+    std::int64_t window_sum = 0;
+    int quiet = 0;  // periods since the last count
+    double velocity = 0;
+    std::array<std::int32_t, kWindowMax> ring{};
+  } mpg_;
   FeedbackChecks checks_;
   JointArray last_motor_cmd_{};  // what the drivers were told last period (motor coordinates)
   std::array<drivers::JointCommand, kJoints> commands_out_{};
