@@ -13,7 +13,7 @@ using nlohmann::json;
 
 const std::string kSeedProgram = std::string(CNCD_SOURCE_DIR) + "/examples/g81_example1.ngc";
 
-TEST_F(DISABLED_PanelTest, CycleStartRunsTheOpenG81ProgramToX4Y5Z3) {
+TEST_F(PanelTest, CycleStartRunsTheOpenG81ProgramToX4Y5Z3) {
   ready_machine();
   result_of(call("program.open", {{"path", kSeedProgram}}));
   const auto since = last_seq();
@@ -28,7 +28,7 @@ TEST_F(DISABLED_PanelTest, CycleStartRunsTheOpenG81ProgramToX4Y5Z3) {
   EXPECT_DOUBLE_EQ(commanded(s, "z"), 3.0);
 }
 
-TEST_F(DISABLED_PanelTest, CycleStartWithoutAProgramIsRefusedWithTheReason) {
+TEST_F(PanelTest, CycleStartWithoutAProgramIsRefusedWithTheReason) {
   ready_machine();
   const auto since = last_seq();
   ASSERT_NO_FATAL_FAILURE(press("CYCLE_START"));
@@ -38,7 +38,7 @@ TEST_F(DISABLED_PanelTest, CycleStartWithoutAProgramIsRefusedWithTheReason) {
   EXPECT_EQ(status()["exec"], "idle");
 }
 
-TEST_F(DISABLED_PanelTest, FeedHoldMidMovePausesAndCycleStartResumes) {
+TEST_F(PanelTest, FeedHoldMidMovePausesAndCycleStartResumes) {
   ready_machine();
   open_program("long.ngc", "G21 G90 G0 X0 Y0 Z0\nG1 X200 F3000\nM2\n");
   ASSERT_NO_FATAL_FAILURE(press("CYCLE_START"));
@@ -60,7 +60,7 @@ TEST_F(DISABLED_PanelTest, FeedHoldMidMovePausesAndCycleStartResumes) {
   EXPECT_EQ(s["panel"]["lights"]["LAMP_FEED_HOLD"], false);
 }
 
-TEST_F(DISABLED_PanelTest, SingleBlockStopsAfterEachBlock) {
+TEST_F(PanelTest, SingleBlockStopsAfterEachBlock) {
   ready_machine();
   open_program("blocks.ngc", "G21 G90\nG0 X10\nG0 Y20\nG0 Z-5\nM2\n");
   ASSERT_NO_FATAL_FAILURE(level("SINGLE_BLOCK", true));
@@ -81,7 +81,7 @@ TEST_F(DISABLED_PanelTest, SingleBlockStopsAfterEachBlock) {
   EXPECT_EQ(s["program"]["result"], "done");
 }
 
-TEST_F(DISABLED_PanelTest, TheOptionalStopSwitchDecidesWhetherM1Stops) {
+TEST_F(PanelTest, TheOptionalStopSwitchDecidesWhetherM1Stops) {
   ready_machine();
   open_program("m1.ngc", "G21 G90 G0 X0 Y0 Z0\nG0 X10\nM1\nG0 X20\nM2\n");
   ASSERT_NO_FATAL_FAILURE(level("OPTIONAL_STOP", false));
@@ -102,7 +102,7 @@ TEST_F(DISABLED_PanelTest, TheOptionalStopSwitchDecidesWhetherM1Stops) {
   EXPECT_DOUBLE_EQ(commanded(s, "x"), 20.0);
 }
 
-TEST_F(DISABLED_PanelTest, BlockDeleteSkipsSlashLinesWhileOn) {
+TEST_F(PanelTest, BlockDeleteSkipsSlashLinesWhileOn) {
   ready_machine();
   open_program("slash.ngc", "G21 G90 G0 X0 Y0 Z0\nG0 X10\n/G0 Y30\nG0 Z-5\nM2\n");
   ASSERT_NO_FATAL_FAILURE(level("BLOCK_DELETE", true));
@@ -119,7 +119,7 @@ TEST_F(DISABLED_PanelTest, BlockDeleteSkipsSlashLinesWhileOn) {
   EXPECT_DOUBLE_EQ(commanded(s, "y"), 30.0);
 }
 
-TEST_F(DISABLED_PanelTest, TheDoorHoldsStopsTheSpindleAndResumeWaitsForItsSpeed) {
+TEST_F(PanelTest, TheDoorHoldsStopsTheSpindleAndResumeWaitsForItsSpeed) {
   ready_machine();
   // 6000 rpm at 6000 rpm/s: a second to come up to speed from rest.
   open_program("cut.ngc", "G21 G90 G0 X0 Y0 Z0\nM3 S6000\nM8\nG1 X150 F1200\nM2\n");

@@ -72,7 +72,4 @@ class PanelTest : public MachineTest {
   }
 };
 
-// Until the servo thread debounces the panel and counts its presses.
-using DISABLED_PanelTest = PanelTest;
-
 }  // namespace cncd::test
