@@ -98,6 +98,35 @@ TEST_F(PanelTest, AClientJogWhileTheMpgMovesIsRefusedNamingTheMpg) {
   EXPECT_EQ(commanded(s, "y"), 0.0);
 }
 
+// 400 counts at 100 a detent on the 0.01 mm step: X moves by exactly 0.04 mm; then a spin of
+// 0.1 mm detents far past X's soft limit (300 mm) stops there.
+TEST_F(PanelTest, TheMpgMovesItsStepsExactlyAndStopsAtTheSoftLimit) {
+  ready_machine();
+  ASSERT_NO_FATAL_FAILURE(level("MPG_ENABLE", true));
+  ASSERT_NO_FATAL_FAILURE(level("MPG_AXIS_X", true));
+  ASSERT_NO_FATAL_FAILURE(level("MPG_STEP_10", true));
+  json s = status();
+  EXPECT_EQ(s["panel"]["mpg"]["axis"], "X");
+  EXPECT_EQ(s["panel"]["mpg"]["step"], 0.01);
+  ASSERT_NO_FATAL_FAILURE(set("mpg_counts", 400));
+  s = wait_until([](const json& st) {
+    return st["panel"]["mpg"]["counts"] == 400 && st["motion"] == "idle" &&
+           st["position"]["commanded"]["x"].get<double>() > 0;
+  });
+  EXPECT_NEAR(commanded(s, "x"), 0.04, 1e-9);
+  EXPECT_EQ(commanded(s, "y"), 0.0);
+  ASSERT_NO_FATAL_FAILURE(level("MPG_STEP_10", false));
+  ASSERT_NO_FATAL_FAILURE(level("MPG_STEP_100", true));
+  // 4000 detents of 0.1 mm: 400 mm asked, 300 mm allowed.
+  ASSERT_NO_FATAL_FAILURE(set("mpg_counts", 400 + 400000));
+  s = wait_until([](const json& st) {
+    return st["panel"]["mpg"]["jogging"] == false && st["motion"] == "idle" &&
+           st["position"]["commanded"]["x"].get<double>() > 299;
+  });
+  EXPECT_NEAR(commanded(s, "x"), 300.0, 1e-6);
+  EXPECT_LE(commanded(s, "x"), 300.0);
+}
+
 TEST_F(PanelTest, AJogButtonWhileAClientJogsIsRefusedNamingTheClient) {
   ready_machine();
   result_of(call("jog.start", {{"axis", "Y"}, {"velocity", 2}}));
