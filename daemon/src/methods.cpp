@@ -8,6 +8,7 @@
 #include "override_methods.hpp"
 #include "server.hpp"
 #include "setup_methods.hpp"
+#include "sim_methods.hpp"
 #include "status_json.hpp"
 #include "version.hpp"
 
@@ -213,6 +214,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
   register_setup_methods(dispatcher, task, config);
   register_jog_methods(dispatcher, task, config, heartbeats, events);
   register_override_methods(dispatcher, task, config);
+  register_sim_methods(dispatcher, task, config);
   dispatcher.require_all_added();
 }
 

@@ -122,6 +122,31 @@ json rt_object(const motion::RtStats& rt) {
           {"memory_locked", rt.memory_locked}};
 }
 
+json panel_object(const std::optional<PanelReport>& panel) {
+  if (!panel) return nullptr;
+  json inputs = json::object();
+  for (const auto& [key, on] : panel->inputs)
+    inputs[key] = on;
+  json lights = json::object();
+  for (const auto& [key, on] : panel->lights)
+    lights[key] = on;
+  const int axis = panel->mpg_axis;
+  return json{
+      {"inputs", inputs},
+      {"mpg",
+       {{"axis", axis >= 0 && static_cast<std::size_t>(axis) < config::kAxisLetters.size()
+                     ? json(std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)]))
+                     : json(nullptr)},
+        {"step", panel->mpg_step},
+        {"counts", panel->mpg_counts},
+        {"jogging", panel->mpg_jogging}}},
+      {"door", panel->door},
+      {"single_block", panel->single_block},
+      {"optional_stop", panel->optional_stop},
+      {"block_delete", panel->block_delete},
+      {"lights", lights}};
+}
+
 }  // namespace
 
 json status_json(const TaskStatus& s, const config::MachineConfig& config) {
@@ -193,6 +218,7 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
       {"mcodes", s.mcodes},
       {"feed_rate", s.feed_rate},
       {"rt", rt_object(s.rt)},
+      {"panel", panel_object(s.panel)},
   };
 }
 

@@ -77,6 +77,11 @@ std::string Task::start() {
   // The machine's parts, built here from the config and handed to motion.
   std::string error;
   auto drivers = drivers::make_drivers(config_, error);
+  sim_ = nullptr;
+  for (const auto& instance : drivers) {
+    if (auto* sim = dynamic_cast<drivers::SimDriver*>(instance.driver.get()); sim != nullptr)
+      sim_ = sim;
+  }
   if (error.empty()) error = motion_.start(std::move(drivers));
   started_ = error.empty();
   if (started_) mark_running();
@@ -141,6 +146,7 @@ void Task::run_program(int from_line, bool step) {
                                                   ", the program's length");
   }
   const auto status = ready_status("running a program");
+  refuse_if_door_open();
   // Checked again: a directory on the way may have been replaced by a symlink leading out.
   const ProgramFile file = find_program(program_path_, config_.program_dirs);
   tool_at_start_ = interp_->state().tool_in_spindle;
@@ -194,6 +200,7 @@ void Task::mdi(const std::string& line, std::uint64_t token) {
   if (exec_ != ExecState::idle)
     throw TaskError(TaskErrorKind::busy, "a program or MDI command is running");
   const auto status = ready_status("MDI");
+  refuse_if_door_open();
   if (line.find('\n') != std::string::npos || line.size() > 4096) {
     throw TaskError(TaskErrorKind::bad_value,
                     "\"line\" must be one block of at most 4096 characters");
@@ -340,6 +347,7 @@ void Task::feed() {
 void Task::poll() {
   drain_servo_events();
   user_m_.tick();
+  poll_panel(motion_.status());
   if (opening_) {
     if (auto outcome = opener_.take()) finish_open(std::move(*outcome));
   }

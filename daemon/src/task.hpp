@@ -15,10 +15,12 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/drivers/sim_driver.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/motion/controller.hpp"
 #include "cncd/pipeline/feeder.hpp"
 #include "event_log.hpp"
+#include "panel_rules.hpp"
 #include "persist.hpp"
 #include "plan_estimate.hpp"
 #include "probe_writer.hpp"
@@ -124,6 +126,8 @@ class Task {
                    std::optional<double> rotation_deg);
 
   TaskStatus status() const;
+  // The sim driver start() made (sim.set sets its signals), null when the machine has none.
+  drivers::SimDriver* sim_driver() const { return started_ ? sim_ : nullptr; }
   // The servo thread's cycle counter: it advances while the servo loop is alive.
   std::uint64_t servo_heartbeat() const { return motion_.status().sequence; }
   // One line for systemd's STATUS=, e.g. "on, running part.ngc line 12".
@@ -264,6 +268,35 @@ class Task {
   };
   std::optional<PendingOpen> opening_;  // program.open waiting for its check
   bool was_estop_ = true;               // the machine was in estop at the last poll()
+  drivers::SimDriver* sim_ = nullptr;   // among the drivers motion_ runs
+  // machine.on from the panel: its outcome is an event, not an answer.
+  static constexpr std::uint64_t kPanelToken = ~std::uint64_t{0};
+  // The panel ([PANEL], task_panel.cpp): each poll() acts on its presses, switches, jog
+  // buttons and knobs as PanelStatus shows them, and lights its lamps.
+  void poll_panel(const motion::Status& status);
+  void panel_press(config::PanelInput input);
+  void panel_door(const motion::Status& status);
+  void panel_switches(const motion::Status& status);
+  void panel_jogs(const motion::Status& status);
+  void panel_knobs(const motion::Status& status);
+  void panel_lights(const motion::Status& status);
+  // Why a jog button cannot jog `axis` now ("" when it can): one hand on the machine.
+  std::string panel_jog_refusal(const motion::Status& status) const;
+  bool panel_wired(config::PanelInput input) const;
+  // The input is wired and on.
+  bool panel_level(config::PanelInput input, const motion::Status& status) const;
+  // The DOOR input is wired and open: programs, MDI and resume are refused.
+  bool door_open(const motion::Status& status) const;
+  void refuse_if_door_open() const;
+  PanelReport panel_report(const motion::Status& status) const;
+  PanelMemory panel_;
+  // Client jogs under way (bit = axis) and who started the last: the panel's jog buttons are
+  // refused naming them.
+  std::uint32_t client_jog_axes_ = 0;
+  std::string client_jog_by_;
+  // Throws TaskError (busy) when a client may not jog now: a program runs, the panel jogs.
+  void client_may_jog() const;
+  void client_jogs(int axis);
   // Run from line: the index in the estimate of the line's first move (time_estimate()).
   struct FirstMove {
     std::shared_ptr<const std::vector<std::int32_t>> lines;  // the estimate's move lines

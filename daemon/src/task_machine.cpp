@@ -41,6 +41,8 @@ void Task::estop() {
 
 void Task::reset() {
   if (motion_.status().machine != motion::MachineState::estop) return;
+  // The door in the estop chain holds the machine there while it is open.
+  if (config_.panel.door_mode == config::PanelConfig::DoorMode::estop) refuse_if_door_open();
   motion_.reset_estop();
   // An estop input still asserted latches estop again in the next period.
   wait_servo_periods(kJudgedPeriods);
@@ -89,6 +91,17 @@ void Task::confirm_machine_on(const motion::Status& status) {
   if (on_tokens_.empty()) return;
   if (status.machine == motion::MachineState::on && Clock::now() < on_check_until_) return;
   for (const auto token : on_tokens_) {
+    if (token == kPanelToken) {
+      if (status.machine != motion::MachineState::on) {
+        const std::string before = events_.actor();
+        events_.set_actor("panel");
+        events_.add("warning", "command",
+                    "MACHINE_ON: machine.on: the machine did not come on: " +
+                        why_not(status, motion::MachineState::on));
+        events_.set_actor(before);
+      }
+      continue;
+    }
     if (status.machine == motion::MachineState::on) {
       answers_.post(token, CommandDone{});
     } else {

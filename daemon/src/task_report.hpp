@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cncd/interp/canon.hpp"
@@ -134,6 +135,20 @@ struct ActiveOffsets {
   interp::Pose g92{};
 };
 
+// The panel ([PANEL]) as status.get shows it.
+struct PanelReport {
+  std::vector<std::pair<std::string, bool>> inputs;  // each wired input by its INI key
+  std::vector<std::pair<std::string, bool>> lights;  // each lamp by its INI key
+  int mpg_axis = -1;                                 // axis index, -1: none selected
+  double mpg_step = 0;
+  std::int64_t mpg_counts = 0;
+  bool mpg_jogging = false;
+  bool door = false;  // open
+  bool single_block = false;
+  bool optional_stop = true;  // M1 stops
+  bool block_delete = false;  // '/' lines are skipped
+};
+
 struct TaskStatus {
   motion::MachineState machine = motion::MachineState::estop;
   ExecState exec = ExecState::idle;
@@ -167,6 +182,7 @@ struct TaskStatus {
   std::vector<std::string> mcodes;
   double feed_rate = 0;  // program units per minute
   motion::RtStats rt;
+  std::optional<PanelReport> panel;  // none without [PANEL]
 };
 
 // offsets.get: every coordinate system's origin and the G92 offset.

@@ -17,6 +17,7 @@ PauseWaitReport Task::pause() {
 void Task::resume() {
   if (exec_ != ExecState::paused)
     throw TaskError(TaskErrorKind::wrong_state, "the program is not paused");
+  refuse_if_door_open();
   stepping_ = false;
   motion_.resume();
   set_exec(ExecState::running);
@@ -76,6 +77,7 @@ void Task::step() {
     run_program(0, true);
     return;
   }
+  refuse_if_door_open();
   motion_.resume();
   set_exec(ExecState::running);
   stepping_ = true;

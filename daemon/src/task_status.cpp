@@ -287,6 +287,7 @@ TaskStatus Task::status() const {
   out.mcodes = active_m_codes(st);
   out.feed_rate = st.feed_rate;
   out.rt = s.rt;
+  if (config_.panel.present) out.panel = panel_report(s);
   return out;
 }
 

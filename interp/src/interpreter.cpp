@@ -407,6 +407,10 @@ Dialect Interpreter::dialect() const {
   return impl_->dialect_;
 }
 
+void Interpreter::set_block_delete(bool on) {
+  impl_->options_.block_delete = on;
+}
+
 std::optional<InterpError> Interpreter::save_parameters() const {
   const auto& path = impl_->options_.parameter_file;
   if (path.empty()) return std::nullopt;

@@ -357,6 +357,20 @@ void MotionController::end_wait(WaitStatus::Kind kind, std::uint64_t since) {
   impl_->send(command);
 }
 
+void MotionController::set_panel_lights(std::uint32_t bits) {
+  Command command;
+  command.kind = Command::Kind::panel_lights;
+  command.id = bits;
+  impl_->send(command);
+}
+
+void MotionController::hold_io_at_rest(bool restore) {
+  Command command;
+  command.kind = Command::Kind::io_hold;
+  command.id = restore ? 1 : 0;
+  impl_->send(command);
+}
+
 namespace {
 // Why a jog cannot start now (checked before the servo thread sees it), or "".
 std::string jog_problem(const config::MachineConfig& config, const Status& status, int axis,

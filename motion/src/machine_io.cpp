@@ -182,6 +182,7 @@ void MachineIo::stop_all() noexcept {
   spindle_.direction = 0;
   spindle_.paused_off = false;
   resuming_ = false;
+  coolant_held_ = false;
   update_command();
   io_.flood = io_.mist = false;
   io_.douts = 0;
@@ -220,12 +221,35 @@ void MachineIo::path_paused() noexcept {
   update_command();
 }
 
-void MachineIo::resume_requested() noexcept {
-  if (!spindle_.paused_off) return;
+bool MachineIo::resume_requested() noexcept {
+  if (coolant_held_) {
+    coolant_held_ = false;
+    io_.flood = out_.flood = held_flood_;
+    io_.mist = out_.mist = held_mist_;
+  }
+  if (!spindle_.paused_off) return false;
   spindle_.paused_off = false;
   update_command();
   resuming_ = true;
   resume_waited_ = 0;
+  return true;
+}
+
+void MachineIo::hold_at_rest(bool restore) noexcept {
+  if (restore) {
+    if (spindle_.direction != 0) spindle_.paused_off = true;
+    if (io_.flood || io_.mist) {
+      coolant_held_ = true;
+      held_flood_ = io_.flood;
+      held_mist_ = io_.mist;
+    }
+  } else {
+    spindle_.direction = 0;
+    spindle_.paused_off = false;
+  }
+  io_.flood = io_.mist = false;
+  out_.flood = out_.mist = false;
+  update_command();
 }
 
 bool MachineIo::resume_ready() noexcept {

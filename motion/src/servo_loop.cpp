@@ -201,6 +201,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       // The spindle, coolant and outputs stop at once, not when the path has come to rest.
       io_.stop_all();
       resume_pending_ = false;
+      io_hold_pending_ = false;
       disarm_probe();
       break;
     case Command::Kind::pause:
@@ -208,9 +209,11 @@ void ServoLoop::apply(const Command& command) noexcept {
       resume_pending_ = false;
       break;
     case Command::Kind::resume:
-      // A spindle stopped by the pause turns again first; the path waits for it.
-      io_.resume_requested();
+      // A spindle stopped by the pause or the door turns again first; the path (also one at
+      // rest after M0, about to take new moves) waits for it.
+      if (io_.resume_requested()) path_.pause();
       resume_pending_ = true;
+      io_hold_pending_ = false;
       break;
     case Command::Kind::spindle_override:
       io_.set_override(command.velocity);
@@ -220,6 +223,10 @@ void ServoLoop::apply(const Command& command) noexcept {
       break;
     case Command::Kind::panel_lights:
       lights_asked_ = command.id;
+      break;
+    case Command::Kind::io_hold:
+      io_hold_pending_ = true;
+      io_hold_restore_ = command.id != 0;
       break;
     case Command::Kind::end_wait:
       io_.end_wait(static_cast<WaitStatus::Kind>(command.id), command.since);
@@ -324,6 +331,11 @@ void ServoLoop::advance_io() noexcept {
     path_.resume();
   }
   if (status_.motion == MotionState::paused && !resume_pending_) io_.path_paused();
+  if (io_hold_pending_ &&
+      (status_.motion == MotionState::paused || status_.motion == MotionState::idle)) {
+    io_.hold_at_rest(io_hold_restore_);
+    io_hold_pending_ = false;
+  }
   RtEvent error;
   if (io_.take_error(error)) {
     // The program stops there; the machine stays on.

@@ -248,7 +248,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return false;
           },
           [&](const in::ProgramStop&) { return stop(); },
-          [&](const in::OptionalProgramStop&) { return stop(); },
+          [&](const in::OptionalProgramStop&) { return optional_stop && stop(); },
           [&](const in::StartSpindleClockwise&) { return spindle(1); },
           [&](const in::StartSpindleCounterclockwise&) { return spindle(-1); },
           [&](const in::StopSpindleTurning&) { return spindle(0); },

@@ -106,6 +106,9 @@ class RpcParamsTest : public MachineTest {
           {"orientation", 0},
           {"comment", "6 mm end mill"}}},
         {"tool.change_done", {{"tool", 3}}},
+        {"wait.done", {{"kind", "input"}}},
+        // sim_mm.ini: DIGITAL_INPUT_0 = sim:door_closed.
+        {"sim.set", {{"signal", "door_closed"}, {"value", 1}}},
         {"offsets.set", {{"system", "G54"}, {"origin", {{"x", 0}}}, {"rotation", 0}}},
     };
   }

@@ -198,6 +198,8 @@ class Interpreter {
   // The dialect in effect for the open program: InterpOptions::dialect, or the one its first
   // line names.
   Dialect dialect() const;
+  // Block delete (InterpOptions::block_delete) from the next line read on: the panel's switch.
+  void set_block_delete(bool on);
 
   InterpState state() const;
   // Coordinate system `system` (1..9 = G54..G59.3) from the parameters, machine units.

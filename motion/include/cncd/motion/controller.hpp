@@ -81,6 +81,12 @@ class MotionController {
   // Ends the wait Status::wait shows (`kind`, begun in servo cycle `since`), when it is still
   // that one: an M66 wait as on its timeout, an at-speed wait while the spindle turns.
   void end_wait(WaitStatus::Kind kind, std::uint64_t since);
+  // The panel's lamps ([PANEL] LIGHT_*, LAMP_*): bits (1 << config::PanelLight) to light.
+  void set_panel_lights(std::uint32_t bits);
+  // The door is open: once the path rests the spindle stops and the coolant goes off; with
+  // `restore` the next resume() turns them on as they were and the path waits for the
+  // spindle's speed, else they stay off.
+  void hold_io_at_rest(bool restore);
 
   // Jogs of one axis (config::axis_index), run by the servo thread within the axis's
   // MAX_VELOCITY (speeds above it are capped) and MAX_ACCELERATION; on a homed axis up to its

@@ -73,9 +73,13 @@ class MachineIo final : public ActionGate {
   CNCD_RT void end_wait(WaitStatus::Kind kind, std::uint64_t since) noexcept;
   CNCD_RT void set_override(double ratio) noexcept;
   // Pause and resume with [SPINDLE_0] STOP_ON_PAUSE: the spindle stops once the path rests,
-  // and restarts on resume; resumed() says when the path may go on (the spindle at speed).
+  // and restarts on resume; resume_ready() says when the path may go on (the spindle at
+  // speed). resume_requested() is true when it restarts the spindle: the path waits.
   CNCD_RT void path_paused() noexcept;
-  CNCD_RT void resume_requested() noexcept;
+  CNCD_RT bool resume_requested() noexcept;
+  // The door opened and the path rests: the spindle stops and the coolant goes off; with
+  // `restore` the next resume_requested() turns them on as they were, else they stay off.
+  CNCD_RT void hold_at_rest(bool restore) noexcept;
   CNCD_RT bool resume_ready() noexcept;
   // An error that stops the path (not the machine): true once, with the event.
   CNCD_RT bool take_error(RtEvent& out) noexcept;
@@ -131,6 +135,10 @@ class MachineIo final : public ActionGate {
   bool has_error_ = false;
   RtEvent error_{};
   bool resuming_ = false;  // STOP_ON_PAUSE: restarted, waiting for at-speed before going on
+  // hold_at_rest(true) turned the coolant off: what resume_requested() turns on again.
+  bool coolant_held_ = false;
+  bool held_flood_ = false;
+  bool held_mist_ = false;
   std::uint64_t resume_waited_ = 0;
   // Synchronized motion: the follower, whether it drives the spindle (a tap), and the
   // spindle's position last period (its signed speed) or, for the ideal spindle, where its

@@ -42,14 +42,17 @@ struct Command {
     spindle_override,  // velocity = the new ratio
     release,           // id: the hold the task answers (tool change done, user M code ended)
     end_wait,          // id: the WaitStatus::Kind the operator ends, since: that wait's `since`
-    panel_lights       // id: bits (1 << config::PanelLight) to light; red also lights in estop
+    panel_lights,      // id: bits (1 << config::PanelLight) to light; red also lights in estop
+    // The door opened: once the path rests the spindle and coolant stop; id 1: the next resume
+    // turns them on again (and the path waits for the spindle's speed), id 0: for good (M5 M9).
+    io_hold
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
   int axis = 0;             // jogs: axis index
   double velocity = 0;      // jog_start: units/s, signed; jog_increment: speed
   double distance = 0;      // jog_increment: units, signed
-  std::uint32_t id = 0;     // release, end_wait, panel_lights
+  std::uint32_t id = 0;     // release, end_wait, panel_lights, io_hold
   std::uint64_t since = 0;  // end_wait
 };
 
@@ -220,6 +223,8 @@ class ServoLoop {
   bool has_start_positions_ = false;
   drivers::Driver* spindle_driver_ = nullptr;  // the driver that reports the spindle
   bool resume_pending_ = false;                // a resume waits for the spindle (STOP_ON_PAUSE)
+  bool io_hold_pending_ = false;               // io_hold: the spindle stops once the path rests
+  bool io_hold_restore_ = false;               // ... and the next resume restores it
   bool probe_input_ = false;                   // read this period
   ProbeMode probe_mode_ = ProbeMode::none;     // of the armed probing move
   bool probe_tripped_ = false;

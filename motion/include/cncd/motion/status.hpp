@@ -52,7 +52,7 @@ struct SpindleStatus {
   bool override_enabled = true;  // M51 P0 / M49 turn it off
   bool has_position = false;     // revolutions comes from an encoder (or the sim spindle)
   double revolutions = 0;
-  bool paused_off = false;  // stopped by a pause ([SPINDLE_0] STOP_ON_PAUSE), restarts on resume
+  bool paused_off = false;  // stopped by a pause (STOP_ON_PAUSE) or the door; resume restarts it
   // G96 (IoAction::css_*): programmed_rpm is then the surface speed; 0 = G97.
   double css_numerator = 0;
   double css_max_rpm = 0;

@@ -100,6 +100,8 @@ class ProgramFeeder final : public interp::CanonSink {
 
   std::deque<motion::Move> pending;  // moves the planner had no room for yet
   bool stop_seen = false;            // M0/M1/M60 reached in the stream
+  // M1 stops only while this is true (the panel's OPTIONAL_STOP switch; none wired: always).
+  bool optional_stop = true;
   // M66 reached in the stream: the interpreter must not read on until the machine has waited
   // and its result is in #5399 (Interpreter::set_input_result()). The caller clears it.
   bool input_wait_seen = false;
