@@ -78,9 +78,11 @@ std::string Task::start() {
   std::string error;
   auto drivers = drivers::make_drivers(config_, error);
   sim_ = nullptr;
+  drivers_.clear();
   for (const auto& instance : drivers) {
     if (auto* sim = dynamic_cast<drivers::SimDriver*>(instance.driver.get()); sim != nullptr)
       sim_ = sim;
+    drivers_.push_back(instance.driver.get());
   }
   if (error.empty()) error = motion_.start(std::move(drivers));
   started_ = error.empty();
@@ -98,6 +100,13 @@ void Task::drain_servo_events() {
                                                                        : "info";
     events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text);
   }
+  drivers::DriverNotice notice;
+  for (auto* driver : drivers_) {
+    while (driver->take_notice(notice)) {
+      const bool warning = notice.level == drivers::DriverNotice::Level::warning;
+      events_.add(warning ? "warning" : "info", "driver", notice.text);
+    }
+  }
 }
 
 void Task::shutdown() {
@@ -114,6 +123,8 @@ void Task::shutdown() {
   }
   motion_.machine_off();
   motion_.stop();
+  drivers_.clear();
+  sim_ = nullptr;
   if (files_corrupt_) return;
   // Also when nothing changed: a parameter file that did not exist yet is created.
   if (const auto error = interp_->save_parameters()) {

@@ -269,6 +269,8 @@ class Task {
   std::optional<PendingOpen> opening_;  // program.open waiting for its check
   bool was_estop_ = true;               // the machine was in estop at the last poll()
   drivers::SimDriver* sim_ = nullptr;   // among the drivers motion_ runs
+  // Every driver motion_ runs, for the notices they give (a pendant unplugged): events.
+  std::vector<drivers::Driver*> drivers_;
   // machine.on from the panel: its outcome is an event, not an answer.
   static constexpr std::uint64_t kPanelToken = ~std::uint64_t{0};
   // The panel ([PANEL], task_panel.cpp): each poll() acts on its presses, switches, jog
