@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench_mill.hpp"
 #include "cncd/drivers/sim_driver.hpp"
 #include "cncd/motion/servo_loop.hpp"
 
@@ -21,26 +22,7 @@ using namespace cncd;
 using config::PanelInput;
 
 config::MachineConfig bench_mill() {
-  config::MachineConfig c;
-  c.servo_period_ns = 1'000'000;
-  c.coordinates = "XYZ";
-  c.joint_count = 3;
-  c.max_linear_velocity = 200;
-  for (int i = 0; i < 3; ++i) {
-    auto& axis = c.axes[static_cast<std::size_t>(i)];
-    axis.present = true;
-    axis.min_limit = -500;
-    axis.max_limit = 500;
-    axis.max_velocity = 200;
-    axis.max_acceleration = 2000;
-    config::JointConfig joint;
-    joint.axis = "XYZ"[i];
-    joint.max_velocity = 200;
-    joint.max_acceleration = 2000;
-    joint.home_sequence = 0;
-    c.joints.push_back(joint);
-  }
-  return c;
+  return bench::three_axis_mill();
 }
 
 config::SignalAddress wired(const char* code) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <thread>
 
+#include "bench_mill.hpp"
 #include "cncd/motion/controller.hpp"
 
 namespace {
@@ -17,27 +18,10 @@ namespace {
 using namespace cncd;
 
 config::MachineConfig bench_mill(std::int64_t period_ns, int priority, int cpu) {
-  config::MachineConfig c;
+  config::MachineConfig c = bench::three_axis_mill();
   c.servo_period_ns = period_ns;
-  c.coordinates = "XYZ";
-  c.joint_count = 3;
-  c.max_linear_velocity = 200;
   c.cncd.rt_priority = priority;
   c.cncd.rt_cpu = cpu;
-  for (int i = 0; i < 3; ++i) {
-    auto& axis = c.axes[static_cast<std::size_t>(i)];
-    axis.present = true;
-    axis.min_limit = -500;
-    axis.max_limit = 500;
-    axis.max_velocity = 200;
-    axis.max_acceleration = 2000;
-    config::JointConfig joint;
-    joint.axis = "XYZ"[i];
-    joint.max_velocity = 200;
-    joint.max_acceleration = 2000;
-    joint.home_sequence = 0;
-    c.joints.push_back(joint);
-  }
   return c;
 }
 
