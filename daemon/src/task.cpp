@@ -92,23 +92,6 @@ std::string Task::start() {
   return error;
 }
 
-void Task::drain_servo_events() {
-  motion::Event event;
-  while (motion_.poll_event(event)) {
-    const char* level = event.level == motion::Event::Level::fault     ? "error"
-                        : event.level == motion::Event::Level::warning ? "warning"
-                                                                       : "info";
-    events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text);
-  }
-  drivers::DriverNotice notice;
-  for (auto* driver : drivers_) {
-    while (driver->take_notice(notice)) {
-      const bool warning = notice.level == drivers::DriverNotice::Level::warning;
-      events_.add(warning ? "warning" : "info", "driver", notice.text);
-    }
-  }
-}
-
 void Task::shutdown() {
   cancel_open("cncd is shutting down");
   if (exec_ != ExecState::idle) finish_program("aborted", "daemon shutting down");

@@ -140,4 +140,21 @@ void Task::home(std::uint32_t joint_mask) {
   }
 }
 
+void Task::drain_servo_events() {
+  motion::Event event;
+  while (motion_.poll_event(event)) {
+    const char* level = event.level == motion::Event::Level::fault     ? "error"
+                        : event.level == motion::Event::Level::warning ? "warning"
+                                                                       : "info";
+    events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text);
+  }
+  drivers::DriverNotice notice;
+  for (auto* driver : drivers_) {
+    while (driver->take_notice(notice)) {
+      const bool warning = notice.level == drivers::DriverNotice::Level::warning;
+      events_.add(warning ? "warning" : "info", "driver", notice.text);
+    }
+  }
+}
+
 }  // namespace cncd::daemon

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "cncd/motion/planner.hpp"
+#include "jog_problem.hpp"
 
 // GCC names the sanitizers with macros, clang through __has_feature.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
@@ -325,73 +326,44 @@ void MotionController::pause() {
 void MotionController::resume() {
   impl_->send(Command::Kind::resume);
 }
-void MotionController::set_feed_override(double ratio) {
+namespace {
+Command with_ratio(Command::Kind kind, double ratio) {
   Command command;
-  command.kind = Command::Kind::feed_override;
+  command.kind = kind;
   command.velocity = ratio;
-  impl_->send(command);
+  return command;
+}
+Command with_id(Command::Kind kind, std::uint32_t id) {
+  Command command;
+  command.kind = kind;
+  command.id = id;
+  return command;
+}
+}  // namespace
+
+void MotionController::set_feed_override(double ratio) {
+  impl_->send(with_ratio(Command::Kind::feed_override, ratio));
 }
 void MotionController::set_rapid_override(double ratio) {
-  Command command;
-  command.kind = Command::Kind::rapid_override;
-  command.velocity = ratio;
-  impl_->send(command);
+  impl_->send(with_ratio(Command::Kind::rapid_override, ratio));
 }
 void MotionController::set_spindle_override(double ratio) {
-  Command command;
-  command.kind = Command::Kind::spindle_override;
-  command.velocity = ratio;
-  impl_->send(command);
+  impl_->send(with_ratio(Command::Kind::spindle_override, ratio));
 }
 void MotionController::release_hold(std::uint32_t hold_id) {
-  Command command;
-  command.kind = Command::Kind::release;
-  command.id = hold_id;
-  impl_->send(command);
+  impl_->send(with_id(Command::Kind::release, hold_id));
 }
 void MotionController::end_wait(WaitStatus::Kind kind, std::uint64_t since) {
-  Command command;
-  command.kind = Command::Kind::end_wait;
-  command.id = static_cast<std::uint32_t>(kind);
+  Command command = with_id(Command::Kind::end_wait, static_cast<std::uint32_t>(kind));
   command.since = since;
   impl_->send(command);
 }
-
 void MotionController::set_panel_lights(std::uint32_t bits) {
-  Command command;
-  command.kind = Command::Kind::panel_lights;
-  command.id = bits;
-  impl_->send(command);
+  impl_->send(with_id(Command::Kind::panel_lights, bits));
 }
-
 void MotionController::hold_io_at_rest(bool restore) {
-  Command command;
-  command.kind = Command::Kind::io_hold;
-  command.id = restore ? 1 : 0;
-  impl_->send(command);
+  impl_->send(with_id(Command::Kind::io_hold, restore ? 1 : 0));
 }
-
-namespace {
-// Why a jog cannot start now (checked before the servo thread sees it), or "".
-std::string jog_problem(const config::MachineConfig& config, const Status& status, int axis,
-                        double direction) {
-  if (status.machine != MachineState::on) return "machine is not on";
-  if (status.motion != MotionState::idle && status.motion != MotionState::jogging)
-    return "the machine is moving";
-  if (status.queued != 0) return "the machine is moving";
-  if (status.panel.mpg_jogging) return "the panel's MPG is jogging";
-  bool homed = false;
-  for (int j = 0; j < status.joint_count; ++j) {
-    if (config::axis_index(config.joints[static_cast<std::size_t>(j)].axis) != axis) continue;
-    homed = status.homed[static_cast<std::size_t>(j)];
-    if (!homed) break;
-  }
-  const double position =
-      axis >= 0 && axis < kAxes ? status.commanded[static_cast<std::size_t>(axis)] : 0.0;
-  const char* refusal = jog_refusal(config, axis, position, direction, homed);
-  return refusal != nullptr ? refusal : "";
-}
-}  // namespace
 
 std::string MotionController::jog_start(int axis, double velocity_per_s) {
   if (!impl_->loop) return "motion is not started";
