@@ -13,6 +13,7 @@
 
 #include "cncd/config/evdev_codes.hpp"
 #include "evdev_reader.hpp"
+#include "panel_wiring.hpp"
 
 namespace cncd::drivers {
 namespace {
@@ -24,9 +25,6 @@ using Target = EvdevBinding::Target;
 // A press shows this much longer than the debounce time, for the servo thread's sampling and
 // a late reader thread.
 constexpr std::int64_t kHoldMarginNs = 50'000'000;
-
-constexpr const char* kKnobNames[] = {"FEED", "RAPID", "SPINDLE"};
-static_assert(std::size(kKnobNames) == config::kPanelAnalogs);
 
 bool is_evdev(const SignalAddress& a) {
   return a.kind == SignalAddress::Kind::evdev;
@@ -94,16 +92,8 @@ std::string check_device(const std::string& path) {
 }  // namespace
 
 bool uses_evdev(const config::MachineConfig& config) {
-  const config::PanelConfig& p = config.panel;
-  bool any = is_evdev(p.mpg.a) || is_evdev(p.mpg.b) || is_evdev(p.mpg.counts);
-  for (const SignalAddress& a : p.inputs)
-    any |= is_evdev(a);
-  for (const config::OverrideKnob& k : p.knobs) {
-    any |= is_evdev(k.encoder.a) || is_evdev(k.encoder.b) || is_evdev(k.encoder.counts) ||
-           is_evdev(k.analog);
-  }
-  for (const SignalAddress& a : p.lights)
-    any |= is_evdev(a);
+  bool any = false;
+  for_each_panel_address(config.panel, [&](const SignalAddress& a) { any |= is_evdev(a); });
   return any;
 }
 
@@ -168,7 +158,7 @@ std::string EvdevDriver::configure(const config::MachineConfig& machine,
   }
   for (int k = 0; k < config::kPanelAnalogs && problem.empty(); ++k) {
     const config::OverrideKnob& knob = panel.knobs[static_cast<std::size_t>(k)];
-    const std::string name = std::string(kKnobNames[k]) + "_OVERRIDE";
+    const std::string name = panel_counter_key(k + 1);
     problem = no_quadrature(name, knob.encoder);
     if (problem.empty())
       problem = bind(name + "_COUNTS", knob.encoder.counts, Target::counter, k + 1);
