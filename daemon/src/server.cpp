@@ -149,6 +149,8 @@ void Server::drop(Client& client) {
   client.line.reset();
   client.out.clear();
   client.session.open_requests.clear();
+  client.held.clear();
+  client.held_bytes = 0;
   client.closing = true;
 }
 
@@ -163,8 +165,13 @@ bool Server::wants_input(const Client& client) {
   return !client.closing && (client.complete == 0 || client.in.size() < kReadAheadBytes);
 }
 
+bool Server::backed_up(const Client& client) {
+  return client.out.size() > kMaxBacklogBytes || !client.held.empty() ||
+         client.session.open_requests.size() >= kMaxOwedAnswers;
+}
+
 bool Server::has_work(const Client& client) const {
-  return (client.line || client.complete > 0) && client.out.size() <= kMaxBacklogBytes;
+  return (client.line || client.complete > 0) && !backed_up(client);
 }
 
 void Server::read_client(Client& client) {
@@ -251,7 +258,7 @@ void Server::serve_client(Client& client, std::size_t& budget, std::size_t throu
   std::size_t start = 0;
   for (;;) {
     const bool priority = start < through;
-    if (!priority && (budget == 0 || client.out.size() > kMaxBacklogBytes)) break;
+    if (!priority && (budget == 0 || backed_up(client))) break;
     if (!client.line) {
       if (start >= client.complete) break;
       const std::size_t newline = client.in.find('\n', start);
@@ -280,30 +287,41 @@ void Server::serve_client(Client& client, std::size_t& budget, std::size_t throu
 }
 
 void Server::write_client(Client& client) {
-  while (!client.out.empty()) {
-    const ssize_t n = ::send(client.fd, client.out.data(), client.out.size(), MSG_NOSIGNAL);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      if (errno != EAGAIN && errno != EWOULDBLOCK) drop(client);
-      break;
+  for (;;) {
+    while (!client.out.empty()) {
+      const ssize_t n = ::send(client.fd, client.out.data(), client.out.size(), MSG_NOSIGNAL);
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        if (errno != EAGAIN && errno != EWOULDBLOCK) drop(client);
+        break;
+      }
+      client.out.erase(0, static_cast<std::size_t>(n));
     }
-    client.out.erase(0, static_cast<std::size_t>(n));
+    // Held answers follow as the backlog drains; each one appended leaves it full or none held.
+    if (client.held.empty() || client.out.size() > kMaxBacklogBytes) break;
+    while (!client.held.empty() && client.out.size() <= kMaxBacklogBytes) {
+      auto [id, result] = std::move(client.held.front());
+      client.held.pop_front();
+      client.held_bytes -= result->size();
+      answer_raw(client, id, std::move(result));
+    }
   }
   client.asked_bytes = std::min(client.asked_bytes, client.out.size());
   if (client.out.size() > kMaxBacklogBytes + client.asked_bytes) {
-    client_log_.log(spdlog::level::warn,
-                    "control client not reading: " + std::to_string(client.out.size()) +
-                        " bytes unsent, disconnecting");
-    // What it never read is dropped; the reason is sent once it reads what the socket holds
-    // (within kCloseGrace). The newline ends a line the last send may have cut.
-    const nlohmann::json notice = {
-        {"jsonrpc", "2.0"},
-        {"method", "connection.closing"},
-        {"params", {{"reason", "client does not read its messages: backlog over 4 MiB"}}}};
-    drop(client);
-    client.out = "\n" + notice.dump() + "\n";
-    stop_reading(client);
+    cut_off(client, std::to_string(client.out.size()) + " bytes unsent",
+            "client does not read its messages: backlog over 4 MiB");
   }
+}
+
+void Server::cut_off(Client& client, const std::string& what, const std::string& reason) {
+  client_log_.log(spdlog::level::warn, "control client not reading: " + what + ", disconnecting");
+  // What it never read is dropped; the reason is sent once it reads what the socket holds
+  // (within kCloseGrace). The newline ends a line the last send may have cut.
+  const nlohmann::json notice = {
+      {"jsonrpc", "2.0"}, {"method", "connection.closing"}, {"params", {{"reason", reason}}}};
+  drop(client);
+  client.out = "\n" + notice.dump() + "\n";
+  stop_reading(client);
 }
 
 void Server::poll_once(int timeout_ms, int extra_fd) {
@@ -354,8 +372,8 @@ void Server::poll_once(int timeout_ms, int extra_fd) {
   }
   now = Clock::now();
   std::erase_if(clients_, [now](const Client& client) {
-    const bool done = client.out.empty() && client.session.open_requests.empty() &&
-                      client.complete == 0 && !client.line;
+    const bool done = client.out.empty() && client.held.empty() &&
+                      client.session.open_requests.empty() && client.complete == 0 && !client.line;
     if (client.closing && (done || (!client.out.empty() && now >= client.close_by))) {
       ::close(client.fd);
       return true;

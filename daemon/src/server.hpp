@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -41,6 +42,12 @@ class Server {
   static constexpr std::size_t kInputBudgetBytes = 16 << 20;
   // Unsent output past which a client that does not read is disconnected.
   static constexpr std::size_t kMaxBacklogBytes = 4 << 20;
+  // Deferred answers one connection may be owed; its further requests wait in its socket
+  // (stops among them are still acted on) until one is answered.
+  static constexpr std::size_t kMaxOwedAnswers = 16;
+  // Large answers ready while the backlog is full, held for a client until it reads; past this
+  // it is asking for more than it reads and is disconnected.
+  static constexpr std::size_t kMaxHeldBytes = 32 << 20;
   static constexpr int kMinSubscribeIntervalMs = 10;
   // Complete lines read ahead of serving from one connection; the rest waits in its socket.
   static constexpr std::size_t kReadAheadBytes = 64 << 10;
@@ -100,6 +107,11 @@ class Server {
     // Bytes of `out` the client asked for in one large answer (program.preview): the largest
     // such answer may wait beyond kMaxBacklogBytes until the client has read it.
     std::size_t asked_bytes = 0;
+    // Large answers (request id, result) that became ready while `out` was over the backlog:
+    // sent as it drains, so that a client that reads is not cut off for having asked several
+    // at once, and their results shared with the previews kept rather than copied.
+    std::deque<std::pair<nlohmann::json, std::shared_ptr<const std::string>>> held;
+    std::size_t held_bytes = 0;
     // Reads no more; closed once `out` is flushed and no deferred answer is owed, or when
     // `out` is still unsent at `close_by`.
     bool closing = false;
@@ -123,6 +135,14 @@ class Server {
   static void stop_reading(Client& client);
   static bool wants_input(const Client& client);
   bool has_work(const Client& client) const;
+  // Whether `client` may be served no further requests now: its output is backed up or it is
+  // owed kMaxOwedAnswers deferred answers.
+  static bool backed_up(const Client& client);
+  // Disconnects a client that does not read: logs `what`, tells it `reason` if it reads on.
+  void cut_off(Client& client, const std::string& what, const std::string& reason);
+  // Appends the answer with `id` and serialized `result`, or holds it while the backlog is full.
+  void answer_raw(Client& client, const nlohmann::json& id,
+                  std::shared_ptr<const std::string> result);
   void read_client(Client& client);
   static std::size_t stop_through(Client& client);
   void serve_stops();

@@ -125,16 +125,9 @@ void Server::deliver_completions() {
       if (it == open.end()) continue;
       if (client.closing) client.close_by = Clock::now() + kCloseGrace;
       if (done.error_code == 0 && done.raw_result) {
-        // {"id","jsonrpc","result"}, as nlohmann orders keys; the result is copied, not parsed.
-        client.out += R"({"id":)";
-        client.out += it->second.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-        client.out += R"(,"jsonrpc":"2.0","result":)";
-        client.out += *done.raw_result;
-        client.out += "}\n";
-        // One such answer may wait beyond the backlog, not one per ask: a client asking again
-        // and again without reading is cut off as any other.
-        client.asked_bytes = std::max(client.asked_bytes, done.raw_result->size());
+        const nlohmann::json id = std::move(it->second);
         open.erase(it);
+        answer_raw(client, id, std::move(done.raw_result));
         write_client(client);
         break;
       }
@@ -151,6 +144,28 @@ void Server::deliver_completions() {
       break;
     }
   }
+}
+
+void Server::answer_raw(Client& client, const nlohmann::json& id,
+                        std::shared_ptr<const std::string> result) {
+  if (client.out.size() > kMaxBacklogBytes) {
+    client.held_bytes += result->size();
+    client.held.emplace_back(id, std::move(result));
+    if (client.held_bytes > kMaxHeldBytes) {
+      cut_off(client, std::to_string(client.held_bytes) + " bytes of answers held",
+              "client does not read its messages: answers held over 32 MiB");
+    }
+    return;
+  }
+  // {"id","jsonrpc","result"}, as nlohmann orders keys; the result is copied, not parsed.
+  const std::size_t before = client.out.size();
+  client.out += R"({"id":)";
+  client.out += id.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  client.out += R"(,"jsonrpc":"2.0","result":)";
+  client.out += *result;
+  client.out += "}\n";
+  // One such answer may wait beyond the backlog: the next is held until the client reads.
+  client.asked_bytes = std::max(client.asked_bytes, client.out.size() - before);
 }
 
 void Server::push_events() {

@@ -138,12 +138,15 @@ TEST_F(PreviewDaemon, OpeningAnotherProgramCancelsTheOneWaitedFor) {
   EXPECT_EQ(result_of(call("program.preview"))["extents"]["X"], json({3.0, 3.0}));
 }
 
-// `asks` requests for the open program's preview, ids 1 ..., one line each.
-std::string preview_asks(int asks) {
+// `asks` requests for the open program's preview, ids 1 ..., one line each; at `tolerance`
+// when it is given.
+std::string preview_asks(int asks, const std::string& tolerance = "") {
+  const std::string params =
+      tolerance.empty() ? "" : R"(,"params":{"tolerance":)" + tolerance + "}";
   std::string requests;
   for (int id = 1; id <= asks; ++id) {
-    requests +=
-        R"({"jsonrpc":"2.0","id":)" + std::to_string(id) + R"(,"method":"program.preview"})" + "\n";
+    requests += R"({"jsonrpc":"2.0","id":)" + std::to_string(id) +
+                R"(,"method":"program.preview")" + params + "}\n";
   }
   return requests;
 }
@@ -217,18 +220,8 @@ TEST_F(PreviewDaemon, AClientThatReadsGetsAnAnswerToEveryAsk) {
   EXPECT_TRUE(call("status.get").contains("result"));
 }
 
-// One that asks for more than the backlog and reads only later is cut off, and told so: never
-// left waiting for answers that do not come.
-TEST_F(PreviewDaemon, AClientThatAsksForMoreThanItReadsIsCutOffAndTold) {
-  open(dir_.write("surface.ngc", surface(200, 500)));
-  const std::size_t kept = result_of(call("program.preview")).dump().size();
-  ASSERT_GT(100 * kept, std::size_t{5} << 20);
-  const int fd = raw_connect(daemon_.socket());
-  ASSERT_GE(fd, 0);
-  const std::string requests = preview_asks(100);
-  ASSERT_EQ(send_for(fd, requests, std::chrono::seconds(10)), requests.size());
-  // The answers pile up unread until the daemon cuts the connection off.
-  std::this_thread::sleep_for(std::chrono::seconds(1));
+// Reads what `fd` receives until the daemon closes it or nothing comes for 30 s.
+Answered read_to_the_end(int fd) {
   Answered got;
   std::string seen;
   for (pollfd ready{fd, POLLIN, 0}; !got.closed && ::poll(&ready, 1, 30'000) == 1;) {
@@ -237,11 +230,72 @@ TEST_F(PreviewDaemon, AClientThatAsksForMoreThanItReadsIsCutOffAndTold) {
     seen += more;
     count_lines(seen, got);
   }
+  return got;
+}
+
+// One that asks at once for far more than the backlog and only then reads (as cncd-web does
+// when the machine is busy and the answers come together) gets every answer as it reads:
+// the answers beyond the backlog wait for it, and its further asks wait in its socket.
+TEST_F(PreviewDaemon, AClientThatAsksForMoreThanTheBacklogGetsItAllAsItReads) {
+  open(dir_.write("surface.ngc", surface(200, 500)));
+  const std::size_t kept = result_of(call("program.preview")).dump().size();
+  ASSERT_GT(100 * kept, std::size_t{5} << 20);
+  const int fd = raw_connect(daemon_.socket());
+  ASSERT_GE(fd, 0);
+  const std::string requests = preview_asks(100);
+  ASSERT_EQ(send_for(fd, requests, std::chrono::seconds(10)), requests.size());
+  ::shutdown(fd, SHUT_WR);  // the daemon closes once all is answered
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_TRUE(call("status.get").contains("result"));
+  const Answered got = read_to_the_end(fd);
+  ::close(fd);
+  EXPECT_EQ(got.answers, 100);
+  EXPECT_FALSE(got.notice);
+  EXPECT_TRUE(got.closed);
+}
+
+// One that asks for more than it reads is cut off, and told so: never left waiting for
+// answers that do not come, nor holding the daemon's memory. Each answer here is several MiB
+// (nothing left out at a tolerance of 1e-6): past 32 MiB of them held, it is cut off.
+TEST_F(PreviewDaemon, AClientThatAsksForMoreThanItReadsIsCutOffAndTold) {
+  open(dir_.write("surface.ngc", surface(400, 500)));
+  const std::size_t kept =
+      result_of(client_.call("program.preview", {{"tolerance", 1e-6}}, 60000)).dump().size();
+  ASSERT_GT(kept, std::size_t{3} << 20);
+  const int fd = raw_connect(daemon_.socket());
+  ASSERT_GE(fd, 0);
+  const std::string requests = preview_asks(40, "0.000001");
+  ASSERT_EQ(send_for(fd, requests, std::chrono::seconds(10)), requests.size());
+  // The answers pile up unread until the daemon cuts the connection off.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const Answered got = read_to_the_end(fd);
   ::close(fd);
   EXPECT_TRUE(got.closed);
   EXPECT_TRUE(got.notice);
-  EXPECT_LT(got.answers, 100);
+  EXPECT_LT(got.answers, 40);
   EXPECT_TRUE(call("status.get").contains("result"));
+}
+
+// A connection owed as many deferred answers as the daemon allows has its further requests
+// wait, but a stop among them is acted on at once.
+TEST_F(PreviewDaemon, AStopBehindManyOwedAnswersIsActedOnAtOnce) {
+  ready_machine();
+  open(dir_.write("surface.ngc", surface(300, 500)));
+  const int fd = raw_connect(daemon_.socket());
+  ASSERT_GE(fd, 0);
+  const std::string requests =
+      preview_asks(40, "0.000001") + R"({"jsonrpc":"2.0","id":99,"method":"machine.estop"})" + "\n";
+  result_of(call("jog.start", {{"axis", "X"}, {"velocity", 20}}));
+  ASSERT_EQ(send_for(fd, requests, std::chrono::seconds(10)), requests.size());
+  const auto sent = std::chrono::steady_clock::now();
+  while (status()["state"] != "estop" &&
+         std::chrono::steady_clock::now() - sent < std::chrono::seconds(5)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(status()["state"], "estop");
+  const json reply = answer_to(fd, 99, "", std::chrono::seconds(120));
+  ::close(fd);
+  EXPECT_EQ(reply["result"]["ok"], true) << reply.dump().substr(0, 300);
 }
 
 }  // namespace
