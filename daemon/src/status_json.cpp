@@ -122,6 +122,16 @@ json rt_object(const motion::RtStats& rt) {
           {"memory_locked", rt.memory_locked}};
 }
 
+json manual_holder_object(const std::optional<ManualHolder>& holder) {
+  if (!holder) return nullptr;
+  const int axis = holder->axis;
+  return {{"by", holder->by},
+          {"panel", holder->panel},
+          {"axis", axis >= 0 && static_cast<std::size_t>(axis) < config::kAxisLetters.size()
+                       ? json(std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)]))
+                       : json(nullptr)}};
+}
+
 json panel_object(const std::optional<PanelReport>& panel) {
   if (!panel) return nullptr;
   json inputs = json::object();
@@ -219,6 +229,7 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
       {"feed_rate", s.feed_rate},
       {"rt", rt_object(s.rt)},
       {"panel", panel_object(s.panel)},
+      {"manual_holder", manual_holder_object(s.manual_holder)},
   };
 }
 

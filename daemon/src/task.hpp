@@ -296,9 +296,18 @@ class Task {
   // refused naming them.
   std::uint32_t client_jog_axes_ = 0;
   std::string client_jog_by_;
-  // Throws TaskError (busy) when a client may not jog now: a program runs, the panel jogs.
+  // The servo cycle a client's last jog was started at: the status of the cycles after it
+  // shows the jog (the command is taken within one period).
+  std::uint64_t client_jog_cycle_ = 0;
+  static constexpr std::uint64_t kJogSeenCycles = 3;
+  // Who jogs now, if anyone: the panel or a client (task_manual.cpp).
+  std::optional<ManualHolder> manual_holder(const motion::Status& status) const;
+  // Throws TaskError (busy) when a client may not jog now: a program runs, the panel or
+  // another client jogs.
   void client_may_jog() const;
   void client_jogs(int axis);
+  // The name a client's jog is held by: who the request comes from.
+  std::string jog_actor() const;
   // Run from line: the index in the estimate of the line's first move (time_estimate()).
   struct FirstMove {
     std::shared_ptr<const std::vector<std::int32_t>> lines;  // the estimate's move lines

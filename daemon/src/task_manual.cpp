@@ -1,4 +1,6 @@
 // The operator's manual controls: jogs and the overrides.
+#include <bit>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
@@ -23,38 +25,56 @@ std::string ratio_text(double ratio) {
 
 }  // namespace
 
-void Task::client_may_jog() const {
-  if (exec_ != ExecState::idle)
-    throw TaskError(TaskErrorKind::busy, "a program or MDI block is running");
-  // One hand on the machine: the panel's, while it jogs.
-  const motion::Status status = motion_.status();
-  if (status.panel.mpg_jogging) {
-    const int axis = status.panel.mpg_axis;
-    throw TaskError(
-        TaskErrorKind::busy,
-        "the panel's MPG is jogging" +
-            (axis >= 0 && axis < config::kPanelAxes
-                 ? " " + std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)])
-                 : std::string()) +
-            ": wait until it rests");
-  }
-  if (status.motion != motion::MotionState::jogging) return;
+std::optional<ManualHolder> Task::manual_holder(const motion::Status& status) const {
+  if (status.panel.mpg_jogging) return ManualHolder{"the panel's MPG", true, status.panel.mpg_axis};
+  // A client's jog holds from its start, before the servo thread's status shows it moving.
+  const bool client_starting =
+      client_jog_axes_ != 0 && status.sequence < client_jog_cycle_ + kJogSeenCycles;
+  if (status.motion != motion::MotionState::jogging && !client_starting) return std::nullopt;
   for (int axis = 0; axis < config::kPanelAxes; ++axis) {
     const int direction = panel_.jogging[static_cast<std::size_t>(axis)];
     if (direction == 0) continue;
-    throw TaskError(TaskErrorKind::busy,
-                    "the panel's " +
-                        config::panel_input_key(static_cast<config::PanelInput>(
-                            static_cast<int>(direction > 0 ? config::PanelInput::jog_plus_x
-                                                           : config::PanelInput::jog_minus_x) +
-                            axis)) +
-                        " button is jogging");
+    const auto input = static_cast<config::PanelInput>(
+        static_cast<int>(direction > 0 ? config::PanelInput::jog_plus_x
+                                       : config::PanelInput::jog_minus_x) +
+        axis);
+    return ManualHolder{"the panel's " + config::panel_input_key(input) + " button", true, axis};
   }
+  if (client_jog_axes_ == 0) return std::nullopt;
+  const bool one = (client_jog_axes_ & (client_jog_axes_ - 1)) == 0;
+  return ManualHolder{client_jog_by_, false, one ? std::countr_zero(client_jog_axes_) : -1};
+}
+
+void Task::client_may_jog() const {
+  if (exec_ != ExecState::idle)
+    throw TaskError(TaskErrorKind::busy, "a program or MDI block is running");
+  // One hand on the machine: the panel's while it jogs, or another client's.
+  const motion::Status status = motion_.status();
+  const auto holder = manual_holder(status);
+  if (!holder) return;
+  const std::string axis =
+      holder->axis >= 0 && holder->axis < config::kPanelAxes
+          ? " " + std::string(1, config::kAxisLetters[static_cast<std::size_t>(holder->axis)])
+          : std::string();
+  if (status.panel.mpg_jogging) {
+    throw TaskError(TaskErrorKind::busy,
+                    holder->by + " is jogging" + axis + ": wait until it rests");
+  }
+  if (holder->panel) throw TaskError(TaskErrorKind::busy, holder->by + " is jogging");
+  if (holder->by != jog_actor()) {
+    throw TaskError(TaskErrorKind::busy,
+                    holder->by + " is jogging" + axis + ": wait until the jog stops");
+  }
+}
+
+std::string Task::jog_actor() const {
+  return events_.actor().empty() ? std::string("a client") : events_.actor();
 }
 
 void Task::client_jogs(int axis) {
   client_jog_axes_ |= 1u << axis;
-  client_jog_by_ = events_.actor().empty() ? std::string("a client") : events_.actor();
+  client_jog_by_ = jog_actor();
+  client_jog_cycle_ = motion_.status().sequence;
 }
 
 void Task::jog_start(int axis, double velocity) {

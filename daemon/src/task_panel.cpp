@@ -201,9 +201,9 @@ void Task::panel_switches(const motion::Status& status) {
 
 std::string Task::panel_jog_refusal(const motion::Status& status) const {
   if (exec_ != ExecState::idle) return "a program or MDI block is running";
-  if (status.panel.mpg_jogging) return "the panel's MPG is jogging";
-  if (client_jog_axes_ != 0 && status.motion == motion::MotionState::jogging)
-    return client_jog_by_ + " is jogging";
+  const auto holder = manual_holder(status);
+  // The panel's own buttons share the one hand at the machine.
+  if (holder && (!holder->panel || status.panel.mpg_jogging)) return holder->by + " is jogging";
   return "";
 }
 

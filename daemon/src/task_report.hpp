@@ -149,6 +149,14 @@ struct PanelReport {
   bool block_delete = false;  // '/' lines are skipped
 };
 
+// Who has manual motion now (one hand on the machine): the panel's MPG or a jog button, or
+// the client that jogs, by the name its events carry.
+struct ManualHolder {
+  std::string by;      // "the panel's MPG", "the panel's JOG_X_PLUS button", a client
+  bool panel = false;  // the panel (at the machine) rather than a client
+  int axis = -1;       // the axis it moves, -1: more than one or unknown
+};
+
 struct TaskStatus {
   motion::MachineState machine = motion::MachineState::estop;
   ExecState exec = ExecState::idle;
@@ -156,7 +164,8 @@ struct TaskStatus {
   motion::MotionState motion = motion::MotionState::idle;
   std::vector<JointReport> joints;  // the configured joints
   std::string fault;                // latched fault, "" when none
-  motion::AxisPose commanded{};     // machine coordinates
+  std::optional<ManualHolder> manual_holder;
+  motion::AxisPose commanded{};  // machine coordinates
   motion::AxisPose actual{};
   // "clean", "unclean" or "none": where the joints started (Task::load_files).
   std::string position_restored;

@@ -210,6 +210,7 @@ TaskStatus Task::status() const {
     out.joints.push_back({s.homed[k], s.joint_fault[k], s.joints[k]});
   }
   out.fault = s.fault_reason;
+  out.manual_holder = manual_holder(s);
   out.commanded = s.commanded;
   out.actual = s.actual;
   out.position_restored = position_restored_;

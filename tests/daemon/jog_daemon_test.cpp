@@ -63,5 +63,43 @@ TEST_F(JogTest, RefusedWhenOffAndStoppedByEstop) {
   EXPECT_EQ(s["state"], "estop");
 }
 
+// One hand on the machine: while one client jogs, another's jog is refused naming it (its
+// stop is not), the jogging client may jog a second axis, and status says who holds it.
+TEST_F(JogTest, AnotherClientsJogIsRefusedNamingTheOneThatJogs) {
+  ready_machine();
+  EXPECT_TRUE(status()["manual_holder"].is_null());
+  result_of(call("jog.start", {{"axis", "X"}, {"velocity", 2}}));
+  json s = status();
+  ASSERT_TRUE(s["manual_holder"].is_object()) << s["manual_holder"].dump();
+  const std::string holder = s["manual_holder"]["by"];
+  EXPECT_NE(holder.find(" pid "), std::string::npos) << holder;
+  EXPECT_EQ(s["manual_holder"]["panel"], false);
+  EXPECT_EQ(s["manual_holder"]["axis"], "X");
+
+  // cncctl is another client (another process).
+  auto r = cncctl({"jog", "Y", "-5"});
+  EXPECT_NE(r.exit_status, 0);
+  EXPECT_NE(r.err.find(holder + " is jogging X: wait until the jog stops"), std::string::npos)
+      << r.err;
+  // The one that jogs may jog another axis too; then nobody is named for one axis.
+  result_of(call("jog.start", {{"axis", "Y"}, {"velocity", -2}}));
+  s = status();
+  EXPECT_EQ(s["manual_holder"]["by"], holder);
+  EXPECT_TRUE(s["manual_holder"]["axis"].is_null());
+  // Anyone stops a jog (cncctl waits until the machine rests).
+  result_of(call("jog.stop", {{"axis", "X"}}));
+  EXPECT_EQ(cncctl({"jog", "Y", "stop"}).exit_status, 0);
+  s = wait_until([](const json& st) { return st["motion"] == "idle"; });
+  EXPECT_TRUE(s["manual_holder"].is_null());
+  // At rest, the other client jogs.
+  const double y = s["position"]["commanded"]["y"];
+  r = cncctl({"jog", "Y", "--increment", "-1"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  s = wait_until([y](const json& st) {
+    return st["motion"] == "idle" && st["position"]["commanded"]["y"].get<double>() < y;
+  });
+  EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), y - 1, 1e-9);
+}
+
 }  // namespace
 }  // namespace cncd::test

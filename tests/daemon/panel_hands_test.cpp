@@ -88,7 +88,10 @@ TEST_F(PanelTest, AClientJogWhileTheMpgMovesIsRefusedNamingTheMpg) {
   ASSERT_NO_FATAL_FAILURE(level("MPG_STEP_100", true));
   // 2500 detents of 0.1 mm: 250 mm, over a second at 200 mm/s.
   ASSERT_NO_FATAL_FAILURE(set("mpg_counts", 250000));
-  wait_until([](const json& st) { return st["panel"]["mpg"]["jogging"] == true; });
+  const json moving =
+      wait_until([](const json& st) { return st["panel"]["mpg"]["jogging"] == true; });
+  EXPECT_EQ(moving["manual_holder"],
+            json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}}));
   const json answer = call("jog.start", {{"axis", "Y"}, {"velocity", 5}});
   ASSERT_EQ(error_code(answer), 1004) << answer.dump();
   EXPECT_NE(answer["error"]["message"].get<std::string>().find("the panel's MPG"),
@@ -96,6 +99,7 @@ TEST_F(PanelTest, AClientJogWhileTheMpgMovesIsRefusedNamingTheMpg) {
       << answer.dump();
   const json s = wait_until([](const json& st) { return st["panel"]["mpg"]["jogging"] == false; });
   EXPECT_EQ(commanded(s, "y"), 0.0);
+  EXPECT_TRUE(s["manual_holder"].is_null());
 }
 
 // 400 counts at 100 a detent on the 0.01 mm step: X moves by exactly 0.04 mm; then a spin of
@@ -143,7 +147,9 @@ TEST_F(PanelTest, AJogButtonWhileAClientJogsIsRefusedNamingTheClient) {
   EXPECT_EQ(commanded(s, "x"), 0.0);
   // And the other way round: the panel's button jogs, a client is refused naming it.
   ASSERT_NO_FATAL_FAILURE(level("JOG_X_PLUS", true));
-  wait_until([](const json& st) { return st["motion"] == "jogging"; });
+  const json jogging = wait_until([](const json& st) { return st["motion"] == "jogging"; });
+  EXPECT_EQ(jogging["manual_holder"],
+            json({{"by", "the panel's JOG_X_PLUS button"}, {"panel", true}, {"axis", "X"}}));
   const json answer = call("jog.start", {{"axis", "Y"}, {"velocity", 2}});
   ASSERT_EQ(error_code(answer), 1004) << answer.dump();
   EXPECT_NE(answer["error"]["message"].get<std::string>().find("the panel's JOG_X_PLUS"),

@@ -209,5 +209,60 @@ TEST_F(WebWsTest, AnAdminAddsAUserAndChangesAPasswordAlone) {
   EXPECT_EQ(login("nina", "nina-new").status, 200);
 }
 
+// One hand on the machine: while the panel's MPG jogs at the machine, the page sees who holds
+// manual motion and control is not taken from the web; once it rests, it is.
+class WebPanelTest : public WebWsTest {
+ protected:
+  WebPanelTest() { machine_ = "sim_panel_mill"; }
+  void sim_set(const std::string& signal, const json& value) {
+    const auto answer = client_.call("sim.set", {{"signal", signal}, {"value", value}}, 30000);
+    ASSERT_TRUE(has_result(answer)) << answer.dump();
+  }
+};
+
+TEST_F(WebPanelTest, ControlIsNotTakenFromTheWebWhileThePanelsMpgJogs) {
+  // The example's rapid knob stands at 0 V: turned up, or the MPG does not move.
+  ASSERT_NO_FATAL_FAILURE(sim_set("rapid_override_analog", 10.0));
+  for (const char* method : {"machine.reset", "machine.on", "machine.home"}) {
+    const auto answer = client_.call(method, nullptr, 30000);
+    ASSERT_TRUE(has_result(answer)) << method << ": " << answer.dump();
+  }
+  wait_until([](const json& s) { return s["homed"][0] == true && s["motion"] == "idle"; });
+  for (const char* signal : {"mpg_enable", "mpg_axis_x", "mpg_step_100"})
+    ASSERT_NO_FATAL_FAILURE(sim_set(signal, 1));
+  // Counts before the switches are taken (debounced) would be dropped.
+  wait_until([](const json& s) {
+    const auto& in = s["panel"]["inputs"];
+    return in["MPG_ENABLE"] == true && in["MPG_AXIS_X"] == true && in["MPG_STEP_100"] == true &&
+           s["overrides"]["rapid"] == 1.0;
+  });
+  // 2500 detents of 0.1 mm: 250 mm of X, more than a second.
+  ASSERT_NO_FATAL_FAILURE(sim_set("mpg_counts", 250000));
+  wait_until([](const json& s) { return s["panel"]["mpg"]["jogging"] == true; });
+  auto otto = ws("otto");
+  const json seen = otto->call("status.get")["result"]["manual_holder"];
+  EXPECT_EQ(seen, json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}}));
+  // cncd-web hears of it within its status interval.
+  json refused;
+  for (int i = 0; i < 100 && !refused.contains("error"); ++i) {
+    refused = otto->call("lease.take", {{"force", true}});
+    if (has_result(refused)) {
+      otto->call("lease.release");
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  ASSERT_EQ(code_of(refused), kLeaseRefused) << refused.dump();
+  EXPECT_EQ(refused["error"]["message"],
+            "the panel's MPG is jogging X at the machine: take control once it rests");
+  wait_until([](const json& s) { return s["panel"]["mpg"]["jogging"] == false; });
+  json taken;
+  for (int i = 0; i < 100 && !has_result(taken); ++i) {
+    taken = otto->call("lease.take");
+    if (!has_result(taken)) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_TRUE(has_result(taken)) << taken.dump();
+  EXPECT_TRUE(otto->call("status.get")["result"]["manual_holder"].is_null());
+}
+
 }  // namespace
 }  // namespace cncd::test

@@ -91,7 +91,7 @@ class WebProcess {
 class WebTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ini_ = copy_example_machine(dir_.path());
+    ini_ = copy_example_machine(dir_.path(), machine_);
     programs_ = dir_.path() / "programs";
     outside_ = dir_.path() / "outside";
     www_ = dir_.path() / "www";
@@ -104,7 +104,12 @@ class WebTest : public ::testing::Test {
     port_ = free_port();
     std::string text = slurp(ini_);
     const std::string dirs = "PROGRAM_DIRS = .\n";
-    text.replace(text.find(dirs), dirs.size(), "PROGRAM_DIRS = .:" + programs_.string() + "\n");
+    const std::string ours = "PROGRAM_DIRS = .:" + programs_.string() + "\n";
+    if (const auto at = text.find(dirs); at != std::string::npos) {
+      text.replace(at, dirs.size(), ours);
+    } else {
+      text.replace(text.find("[CNCD]\n"), 7, "[CNCD]\n" + ours);
+    }
     text += "\n[WEB]\nPORT = " + std::to_string(port_) + "\nPROGRAM_DIR = " + programs_.string() +
             "\nUSERS_FILE = " + (dir_.path() / "web-users").string() +
             "\nMAX_UPLOAD_MB = 1\nJOG_HEARTBEAT = 0.25\n";
@@ -172,6 +177,7 @@ class WebTest : public ::testing::Test {
 
   TempDir dir_;
   std::filesystem::path ini_;
+  std::string machine_ = "sim_mm";  // the example INI the daemon and cncd-web run
   std::filesystem::path programs_;
   std::filesystem::path outside_;
   std::filesystem::path www_;

@@ -87,6 +87,8 @@ struct App {
   // The program cncd has open (absolute path) as last seen in a status answer; "" = none.
   std::filesystem::path open_program;
   bool program_running = false;
+  // Who has manual motion in cncd now (status "manual_holder"), null when nothing jogs.
+  nlohmann::json manual_holder;
 
   // Reloads the users file when the command line changed it; "" or why it could not.
   std::string refresh_users();

@@ -11,6 +11,7 @@ void StatusWatch::start() {
   upstream_->start([this](std::string line) { on_line(line); },
                    [this](const std::string& why) {
                      app_.program_running = false;
+                     app_.manual_holder = nullptr;
                      // Once per outage, not every 2 s while cncd is away.
                      if (!away_) spdlog::warn("{}; trying again every 2 s", why);
                      away_ = true;
@@ -19,12 +20,12 @@ void StatusWatch::start() {
                        if (!ec) start();
                      });
                    });
-  upstream_->send(
-      nlohmann::json{{"jsonrpc", "2.0"},
-                     {"id", 1},
-                     {"method", "status.subscribe"},
-                     {"params", {{"interval_ms", 200}, {"fields", {"program", "exec"}}}}}
-          .dump());
+  upstream_->send(nlohmann::json{
+      {"jsonrpc", "2.0"},
+      {"id", 1},
+      {"method", "status.subscribe"},
+      {"params", {{"interval_ms", 200}, {"fields", {"program", "exec", "manual_holder"}}}}}
+                      .dump());
 }
 
 void StatusWatch::stop() {
@@ -47,6 +48,7 @@ void StatusWatch::on_line(const std::string& line) {
                           ? std::filesystem::path(program["path"].get<std::string>())
                           : std::filesystem::path();
   app_.program_running = status_.value("exec", "idle") != "idle";
+  app_.manual_holder = status_.value("manual_holder", nlohmann::json());
 }
 
 }  // namespace cncd::web

@@ -53,6 +53,16 @@ json WsRpc::web_method(const std::string& method, const json& params, json& forw
   if (method == "lease.get") return app_.lease_json();
   if (method == "lease.take") {
     const bool force = params.is_object() && params.value("force", false) == true;
+    // One hand on the machine: while the panel at the machine jogs, control is not taken
+    // from the web, forced or not.
+    if (app_.manual_holder.is_object() && app_.manual_holder.value("panel", false) &&
+        !app_.lease.held_by(who_.session.id)) {
+      const auto axis = app_.manual_holder.value("axis", nlohmann::json());
+      throw WebError{kLeaseRefused,
+                     app_.manual_holder.value("by", std::string("the panel")) + " is jogging" +
+                         (axis.is_string() ? " " + axis.get<std::string>() : std::string()) +
+                         " at the machine: take control once it rests"};
+    }
     Session session = who_.session;
     session.address = address_;
     const auto taken = app_.lease.take(session, force);

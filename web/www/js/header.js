@@ -72,6 +72,12 @@ export function setupHeader(ctx) {
     const fault = $('#fault');
     setText(fault, status.fault ?? '');
     fault.hidden = !status.fault;
+    // One hand on the machine: who jogs now, when it is not this page (the panel's MPG or
+    // buttons at the machine, or another client); the daemon refuses other jogs meanwhile.
+    const hand = status.manual_holder;
+    const handBox = $('#manual-holder');
+    handBox.hidden = !hand || (!hand.panel && ctx.holdsLease());
+    if (hand) setText(handBox, `jogging: ${hand.by}${hand.axis ? ' ' + hand.axis : ''}`);
     const homed = status.homed ?? [];
     $('#home-all').classList.toggle('active', homed.length > 0 && homed.every(Boolean));
   });
