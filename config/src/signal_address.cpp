@@ -169,7 +169,7 @@ std::string line_active_low_key(std::string_view key) {
 
 std::string parse_gpio_line_key(std::string_view key, std::string_view value,
                                 std::optional<bool> active_low, GpioLineKey& out) {
-  const std::string_view written = trim(value);
+  const std::string_view written = strip_trailing_comment(value);
   // A bare line is taken as written, as before addresses: a chip's line names may hold blanks.
   if (written.find(':') == std::string_view::npos) {
     out = GpioLineKey{std::string(written), active_low.value_or(false)};

@@ -208,8 +208,7 @@ std::optional<GpioLineKey> TypedReader::gpio_line(std::string_view section, std:
       active_low = parse_bool(strip_trailing_comment(*v));
   }
   GpioLineKey line;
-  const std::string error =
-      parse_gpio_line_key(key, strip_trailing_comment(e->value), active_low, line);
+  const std::string error = parse_gpio_line_key(key, e->value, active_low, line);
   if (error.empty()) return line;
   problem(section, key, error);
   return std::nullopt;

@@ -37,6 +37,9 @@ TEST(GpioLineKeyTest, BareLineAndAddressFormReadTheSame) {
   }
   EXPECT_EQ(read("STEP_LINE", "17").line, "17");
   EXPECT_EQ(read("STEP_LINE", "gpio:17").line, "17");
+  // A trailing comment is no part of the line, for the driver as for validation.
+  EXPECT_EQ(read("DIR_LINE", "GPIO27   # high = negative").line, "GPIO27");
+  EXPECT_TRUE(read("ENABLE_LINE", "gpio:!22 ; ENA-").active_low);
   // Empty: not connected, as before.
   EXPECT_EQ(read("PROBE_LINE", "").line, "");
   EXPECT_EQ(read("PROBE_LINE", "  ").line, "");
