@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cncd/config/ini_file.hpp"
 #include "io_config_fixture.hpp"
 
 namespace cncd::config::test {
@@ -175,6 +176,28 @@ TEST_F(GpioLineKeysLoadTest, LinesAreComparedAsTheLineTheyName) {
                        "[CNCD] DIGITAL_OUTPUT_0: 'gpio:1': gpio line 1 is also [JOINT_2] "
                        "STEP_LINE (" +
                            at(kFirst + 2) + "); an output has one driver"));
+}
+
+// The examples show both forms: the panel mill's addresses, the Pi mill's bare lines.
+TEST(GpioLineKeysExamplesTest, BothFormsOfTheExamplesLoad) {
+  const std::filesystem::path examples = CNCD_CONFIG_EXAMPLES_DIR;
+  for (const char* name : {"gpio_panel_mill.ini", "gpio_pi_mill.ini", "gpio_vcd_mill.ini"}) {
+    const auto result = load_machine_config(examples / name);
+    EXPECT_TRUE(result.ok()) << name << ::testing::PrintToString(strings(result.problems));
+    EXPECT_TRUE(result.warnings.empty())
+        << name << ::testing::PrintToString(strings(result.warnings));
+    ASSERT_TRUE(result.config && result.config->ini) << name;
+    const IniFile& ini = *result.config->ini;
+    const bool addresses = std::string(name) == "gpio_panel_mill.ini";
+    EXPECT_EQ(ini.value("JOINT_0", "ENABLE_LINE"), addresses ? "gpio:!GPIO22" : "GPIO22") << name;
+    EXPECT_EQ(ini.find("JOINT_0", "ENABLE_ACTIVE_LOW") != nullptr, !addresses) << name;
+  }
+  const auto panel = load_machine_config(examples / "gpio_panel_mill.ini");
+  ASSERT_TRUE(panel.ok());
+  EXPECT_EQ(panel.config->ini->value("GPIO", "ESTOP_LINE"), "gpio:GPIO4");
+  const auto pi = load_machine_config(examples / "gpio_pi_mill.ini");
+  ASSERT_TRUE(pi.ok());
+  EXPECT_EQ(pi.config->ini->value("GPIO", "ESTOP_LINE"), "GPIO4");
 }
 
 }  // namespace

@@ -179,6 +179,40 @@ TEST(GpioConfig, AddressFormOfTheLineKeysReadsAsTheBareForm) {
   EXPECT_EQ(seen[1], expected) << "the address form with '!'";
 }
 
+// The panel example writes its estop and enable lines as addresses; the driver takes them.
+TEST(GpioConfig, ThePanelExamplesAddressesConfigureTheDriver) {
+  TempDir dir;
+  const std::filesystem::path ini = copy_example_machine(dir.path(), "gpio_panel_mill");
+  std::string text = slurp(ini);
+  const std::string chip = "CHIP = vcd:/tmp/cncd-panel.vcd";
+  ASSERT_NE(text.find(chip), std::string::npos);
+  text.replace(text.find(chip), chip.size(), "CHIP = vcd:" + (dir.path() / "p.vcd").string());
+  dir.write(ini.filename().string(), text);
+  const auto loaded = config::load_machine_config(ini);
+  ASSERT_TRUE(loaded.ok());
+  GpioDriver driver;
+  driver.use_manual_clock(true);
+  ASSERT_EQ(driver.configure(*loaded.config, {0, 1, 2}), "");
+  auto* vcd = dynamic_cast<drivers::VcdBackend*>(driver.backend());
+  ASSERT_NE(vcd, nullptr);
+  driver.enable();
+  std::int64_t now_ns = 0;
+  for (const bool pressed : {false, true, false}) {
+    vcd->set_input_level(4, pressed);  // ESTOP_LINE = gpio:GPIO4: high is pressed
+    for (int i = 0; i < 5; ++i)
+      driver.run_base_period(now_ns += loaded.config->base_period_ns);
+    MachineInputs in;  // read_inputs only ever sets a flag: each driver adds its own
+    driver.read_inputs(in);
+    EXPECT_EQ(in.estop, pressed) << "pressed " << pressed;
+  }
+  driver.disable();
+  std::map<std::string, int> level;
+  for (const VcdChange& c : read_vcd(dir.path() / "p.vcd"))
+    level[c.signal] = c.level;
+  for (const char* enable : {"j0_enable", "j1_enable", "j2_enable"})
+    EXPECT_EQ(level[enable], 1) << enable << ": gpio:! is active low, high while off";
+}
+
 TEST(GpioConfig, BadKeysAreReportedWithFileAndLine) {
   TempDir dir;
   const auto ini =
