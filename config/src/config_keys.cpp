@@ -290,29 +290,39 @@ constexpr std::array kMachineKeys{
              "GPIO chip of the step/dir lines: gpiochip0, /dev/gpiochip0, a label, or vcd:FILE to "
              "record the outputs to a value change dump instead of driving hardware"),
     line_key("GPIO", "ESTOP_LINE",
-             "Line (offset or name) of the external estop input; empty: none"),
+             "Line of the external estop input: LINE (offset or name), gpio:LINE, or gpio:!LINE "
+             "for active low (= ESTOP_ACTIVE_LOW = 1); empty: none"),
     active_low_key("GPIO", "ESTOP_ACTIVE_LOW",
                    "The estop input is asserted at low level (normally closed to ground)"),
-    line_key("GPIO", "PROBE_LINE", "Line (offset or name) of the probe input; empty: none"),
+    line_key("GPIO", "PROBE_LINE",
+             "Line of the probe input: LINE, gpio:LINE or gpio:!LINE (active low); empty: none. "
+             "[CNCD] PROBE_INPUT takes a sim: probe too"),
     active_low_key("GPIO", "PROBE_ACTIVE_LOW", "The probe input is asserted at low level"),
     integer_key(
         "GPIO", "DEBOUNCE_NS", "0", 0, 1'000'000'000, "ns",
         "A switch input must hold a new level this long before it counts; 0 = one base period"),
-    line_key("JOINT_n", "STEP_LINE", "gpio: line (offset or name) of the step output"),
+    line_key("JOINT_n", "STEP_LINE",
+             "gpio: line of the step output: LINE (offset or name) or gpio:LINE"),
     line_key("JOINT_n", "DIR_LINE",
-             "gpio: line of the direction output (high = negative direction)"),
-    line_key("JOINT_n", "ENABLE_LINE", "gpio: line of the drive enable output; empty: none"),
+             "gpio: line of the direction output, LINE or gpio:LINE (high = negative direction)"),
+    line_key("JOINT_n", "ENABLE_LINE",
+             "gpio: line of the drive enable output: LINE, gpio:LINE, or gpio:!LINE for "
+             "ENABLE_ACTIVE_LOW = 1; empty: none"),
     active_low_key("JOINT_n", "ENABLE_ACTIVE_LOW",
                    "gpio: the enable output is low when the drive is enabled"),
-    line_key("JOINT_n", "HOME_SWITCH_LINE", "gpio: line of the home switch input; empty: none"),
+    line_key("JOINT_n", "HOME_SWITCH_LINE",
+             "gpio: line of the home switch input: LINE, gpio:LINE or gpio:!LINE (active low); "
+             "empty: none"),
     active_low_key("JOINT_n", "HOME_SWITCH_ACTIVE_LOW",
                    "gpio: the home switch reads low when pressed"),
     line_key("JOINT_n", "MIN_LIMIT_LINE",
-             "gpio: line of the minimum limit switch input; empty: none"),
+             "gpio: line of the minimum limit switch input: LINE, gpio:LINE or gpio:!LINE "
+             "(active low); empty: none"),
     active_low_key("JOINT_n", "MIN_LIMIT_ACTIVE_LOW",
                    "gpio: the minimum limit switch reads low when tripped"),
     line_key("JOINT_n", "MAX_LIMIT_LINE",
-             "gpio: line of the maximum limit switch input; empty: none"),
+             "gpio: line of the maximum limit switch input: LINE, gpio:LINE or gpio:!LINE "
+             "(active low); empty: none"),
     active_low_key("JOINT_n", "MAX_LIMIT_ACTIVE_LOW",
                    "gpio: the maximum limit switch reads low when tripped"),
     position_key(

@@ -50,7 +50,8 @@ constexpr KeySpec real_key(std::string_view section, std::string_view key,
   return {section, key, KeyType::real, default_value, min, max, false, unit, "", help};
 }
 
-// Line (offset or name) of a GPIO input or output; empty: none.
+// Line of a GPIO input or output: a bare line (offset or name) or a gpio: address
+// (parse_gpio_line_key); empty: none.
 constexpr KeySpec line_key(std::string_view section, std::string_view key, std::string_view help) {
   return text_key(section, key, "", help);
 }

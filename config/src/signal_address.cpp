@@ -162,6 +162,47 @@ std::string parse_signal_address(std::string_view text, SignalAddress& out) {
   return error;
 }
 
+std::string line_active_low_key(std::string_view key) {
+  if (key == "STEP_LINE" || key == "DIR_LINE" || !key.ends_with("_LINE")) return "";
+  return std::string(key.substr(0, key.size() - 5)) + "_ACTIVE_LOW";
+}
+
+std::string parse_gpio_line_key(std::string_view key, std::string_view value,
+                                std::optional<bool> active_low, GpioLineKey& out) {
+  const std::string_view written = strip_trailing_comment(value);
+  // A bare line is taken as written, as before addresses: a chip's line names may hold blanks.
+  if (written.find(':') == std::string_view::npos) {
+    out = GpioLineKey{std::string(written), active_low.value_or(false)};
+    return "";
+  }
+  const std::string quoted = "'" + printable(written) + "': ";
+  SignalAddress a;
+  if (std::string e = parse_signal_address(written, a); !e.empty()) return quoted + e;
+  const std::string low_key = line_active_low_key(key);
+  if (a.kind != SignalAddress::Kind::gpio) {
+    const bool output = key == "STEP_LINE" || key == "DIR_LINE" || key == "ENABLE_LINE";
+    std::string why = quoted + (output ? "this output is driven" : "this input is read") +
+                      " in the gpio driver's base thread, so it takes only a gpio line (LINE" +
+                      (low_key.empty() ? " or gpio:LINE)" : ", gpio:LINE or gpio:!LINE)");
+    if (key == "PROBE_LINE") why += "; [CNCD] PROBE_INPUT takes a gpio: or sim: probe";
+    return why;
+  }
+  if (a.active_low && low_key.empty()) {
+    const std::string name(key.substr(0, key.size() - 5));
+    return quoted + std::string(key) + " takes no '!': there is no " + name + "_ACTIVE_LOW" +
+           (key == "DIR_LINE" ? " (a negative SCALE reverses the direction)" : "");
+  }
+  if (a.active_low && active_low) {
+    if (*active_low) {
+      return quoted + "active low is given twice, by '!' and by " + low_key + " = 1: give it once";
+    }
+    return quoted + "'!' makes the line active low, but " + low_key +
+           " = 0 says it is not: give the polarity once, by '!' or by " + low_key;
+  }
+  out = GpioLineKey{a.line, a.active_low || active_low.value_or(false)};
+  return "";
+}
+
 namespace {
 
 // The kind of event an evdev address's code gives (parse_signal_address checked the name).

@@ -198,4 +198,20 @@ SignalAddress TypedReader::signal(std::string_view section, std::string_view key
   return address;
 }
 
+std::optional<GpioLineKey> TypedReader::gpio_line(std::string_view section, std::string_view key) {
+  const IniEntry* e = entry(section, key);
+  if (e == nullptr || failed(section, key)) return std::nullopt;
+  // A bad *_ACTIVE_LOW value is its own key's problem (boolean()); here it counts as not given.
+  std::optional<bool> active_low;
+  if (const std::string low_key = line_active_low_key(key); !low_key.empty()) {
+    if (const auto v = ini_.value(section, low_key))
+      active_low = parse_bool(strip_trailing_comment(*v));
+  }
+  GpioLineKey line;
+  const std::string error = parse_gpio_line_key(key, e->value, active_low, line);
+  if (error.empty()) return line;
+  problem(section, key, error);
+  return std::nullopt;
+}
+
 }  // namespace cncd::config

@@ -35,6 +35,10 @@ class TypedReader {
   // address of kind none. With `bare_is_gpio`, a value without a kind ("17", "!17") is a
   // gpio line.
   SignalAddress signal(std::string_view section, std::string_view key, bool bare_is_gpio = false);
+  // What a line key of [GPIO] or a step/dir joint names, with its *_ACTIVE_LOW key
+  // (parse_gpio_line_key); nullopt when the key is absent or refused. The first call records the
+  // refusal; later ones only give nullopt, so every check may ask.
+  std::optional<GpioLineKey> gpio_line(std::string_view section, std::string_view key);
 
   // The first entry of the key (every one marked used), nullptr when absent.
   const IniEntry* entry(std::string_view section, std::string_view key);

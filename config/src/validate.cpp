@@ -117,10 +117,12 @@ void check_gpio_joint(TypedReader& r, const MachineConfig& c, const std::string&
                           "MAX_LIMIT_ACTIVE_LOW"})
     r.boolean(s, key);
   for (const char* key : {"ENABLE_LINE", "HOME_SWITCH_LINE", "MIN_LIMIT_LINE", "MAX_LIMIT_LINE"})
-    r.text(s, key);
+    r.gpio_line(s, key);
   for (const char* key : {"STEP_LINE", "DIR_LINE"}) {
-    const auto v = r.text(s, key);
-    if (!v || v->empty()) r.problem(s, key, "missing: DRIVER = gpio needs a line offset or name");
+    const auto v = r.gpio_line(s, key);
+    if (!r.failed(s, key) && (!v || v->line.empty())) {
+      r.problem(s, key, "missing: DRIVER = gpio needs a line offset or name");
+    }
   }
   if (j.scale == 0 && !r.failed(s, "SCALE")) {
     r.problem(s, r.given(s, "SCALE") ? "SCALE" : "DRIVER",
@@ -178,10 +180,10 @@ void check_modbus_bus(TypedReader& r, const std::string& s) {
 void check_drivers(TypedReader& r, const MachineConfig& c) {
   if (r.ini().has_section("GPIO")) {
     r.text("GPIO", "CHIP");
-    r.text("GPIO", "ESTOP_LINE");
-    r.text("GPIO", "PROBE_LINE");
     r.boolean("GPIO", "ESTOP_ACTIVE_LOW");
     r.boolean("GPIO", "PROBE_ACTIVE_LOW");
+    r.gpio_line("GPIO", "ESTOP_LINE");
+    r.gpio_line("GPIO", "PROBE_LINE");
     r.integer("GPIO", "DEBOUNCE_NS");
   }
   for (const auto& header : r.ini().sections()) {

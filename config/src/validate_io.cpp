@@ -229,11 +229,11 @@ struct Taken {
 void reserve_gpio_lines(TypedReader& r, const MachineConfig& c,
                         std::map<std::string, Taken>& taken) {
   const auto reserve = [&](const std::string& section, const char* key, bool output) {
-    const IniEntry* e = r.ini().find(section, key);
-    if (e == nullptr) return;
-    const std::string line(trim(strip_trailing_comment(e->value)));
-    if (!line.empty())
-      taken.emplace("gpio line " + line, Taken{label(section, key), e->source, output});
+    const auto line = r.gpio_line(section, key);
+    if (line && !line->line.empty()) {
+      taken.emplace("gpio line " + line->line,
+                    Taken{label(section, key), r.where(section, key), output});
+    }
   };
   if (r.ini().has_section("GPIO")) {
     reserve("GPIO", "ESTOP_LINE", false);

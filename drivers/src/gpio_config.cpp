@@ -2,6 +2,7 @@
 // and the spindle from their addresses (non-RT).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "cncd/drivers/gpio_driver.hpp"
@@ -217,30 +218,42 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
   std::vector<GpioLine> input_lines;
   std::vector<std::pair<bool, int>> input_specs;  // active_low, line
   std::set<int> used;
-  const auto line = [&](const std::string& section, const char* key, bool required) -> int {
-    const auto spec = ini.text(section, key);
-    if (!spec || spec->empty()) {
+  // The line a key names; `active_low` gets its polarity (a '!' or the key's *_ACTIVE_LOW).
+  const auto line = [&](const std::string& section, const char* key, bool required,
+                        bool* active_low = nullptr) -> int {
+    const std::string low_key = config::line_active_low_key(key);
+    std::optional<bool> low;
+    if (!low_key.empty() && ini.has(section, low_key)) low = ini.boolean(section, low_key);
+    config::GpioLineKey spec;
+    std::string why =
+        config::parse_gpio_line_key(key, ini.text(section, key).value_or(""), low, spec);
+    if (!why.empty()) {
+      ini.fail(section, key, why);
+      return -1;
+    }
+    if (spec.line.empty()) {
       if (required) ini.fail(section, key, "missing: a line offset or name");
       return -1;
     }
-    std::string why;
-    const int offset = backend_->find_line(*spec, why);
+    const int offset = backend_->find_line(spec.line, why);
     if (offset < 0) {
       ini.fail(section, key, why);
       return -1;
     }
     if (!used.insert(offset).second) {
-      ini.fail(section, key, "line " + *spec + " is already used by another signal");
+      ini.fail(section, key, "line " + spec.line + " is already used by another signal");
       return -1;
     }
+    if (active_low != nullptr) *active_low = spec.active_low;
     return offset;
   };
-  const auto add_input = [&](const std::string& section, const char* key, const char* low_key,
+  const auto add_input = [&](const std::string& section, const char* key,
                              const std::string& name) -> int {
-    const int offset = line(section, key, false);
+    bool active_low = false;
+    const int offset = line(section, key, false, &active_low);
     if (offset < 0) return -1;
     input_lines.push_back(GpioLine{offset, name});
-    input_specs.emplace_back(ini.boolean(section, low_key), offset);
+    input_specs.emplace_back(active_low, offset);
     return static_cast<int>(input_lines.size()) - 1;
   };
 
@@ -263,14 +276,13 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
       jl.dir_output = static_cast<int>(outputs.size());
       outputs.push_back(GpioOutput{o, prefix + "dir"});
     }
-    if (const int o = line(s, "ENABLE_LINE", false); o >= 0) {
+    if (const int o = line(s, "ENABLE_LINE", false, &jl.enable_active_low); o >= 0) {
       jl.enable_output = static_cast<int>(outputs.size());
       outputs.push_back(GpioOutput{o, prefix + "enable"});
     }
-    jl.enable_active_low = ini.boolean(s, "ENABLE_ACTIVE_LOW");
-    jl.home = add_input(s, "HOME_SWITCH_LINE", "HOME_SWITCH_ACTIVE_LOW", prefix + "home");
-    jl.min_limit = add_input(s, "MIN_LIMIT_LINE", "MIN_LIMIT_ACTIVE_LOW", prefix + "min_limit");
-    jl.max_limit = add_input(s, "MAX_LIMIT_LINE", "MAX_LIMIT_ACTIVE_LOW", prefix + "max_limit");
+    jl.home = add_input(s, "HOME_SWITCH_LINE", prefix + "home");
+    jl.min_limit = add_input(s, "MIN_LIMIT_LINE", prefix + "min_limit");
+    jl.max_limit = add_input(s, "MAX_LIMIT_LINE", prefix + "max_limit");
     if (jl.home >= 0) capabilities_ |= kCapHomeSwitch;
     if (jl.min_limit >= 0 || jl.max_limit >= 0) capabilities_ |= kCapLimitSwitches;
 
@@ -286,8 +298,8 @@ std::string GpioDriver::configure(const config::MachineConfig& machine,
     t.max_acceleration_steps = ini.real(s, "STEPGEN_MAXACCEL") * scale;
     stepgens_[k].setup(t);
   }
-  estop_input_ = add_input("GPIO", "ESTOP_LINE", "ESTOP_ACTIVE_LOW", "estop");
-  probe_input_ = add_input("GPIO", "PROBE_LINE", "PROBE_ACTIVE_LOW", "probe");
+  estop_input_ = add_input("GPIO", "ESTOP_LINE", "estop");
+  probe_input_ = add_input("GPIO", "PROBE_LINE", "probe");
   const config::SignalAddress& probe = machine.io.probe_input;
   if (probe_input_ < 0 && probe.kind == config::SignalAddress::Kind::gpio) {
     std::string why;

@@ -125,6 +125,94 @@ TEST_F(GpioInputs, ActiveLowInputsAssertWhenTheLoopOpens) {
   EXPECT_FALSE(feedback(0).min_limit);
 }
 
+// "gpio:!N" on a line key is "N" with the key's *_ACTIVE_LOW = 1, "gpio:N" is "N": both
+// machines read the same levels the same way.
+TEST(GpioConfig, AddressFormOfTheLineKeysReadsAsTheBareForm) {
+  struct Form {
+    std::string joint;
+    std::string gpio;
+  };
+  const Form forms[] = {
+      {"ENABLE_LINE = 2\nENABLE_ACTIVE_LOW = 1\nMIN_LIMIT_LINE = 3\nMIN_LIMIT_ACTIVE_LOW = 1\n"
+       "MAX_LIMIT_LINE = 4\n",
+       "ESTOP_LINE = 40\nESTOP_ACTIVE_LOW = 1\nPROBE_LINE = 41\n"},
+      {"ENABLE_LINE = gpio:!2\nMIN_LIMIT_LINE = gpio:!3\nMAX_LIMIT_LINE = gpio:GPIO4\n",
+       "ESTOP_LINE = gpio:!40\nPROBE_LINE = GPIO:41   # a touch plate\n"}};
+  // What each machine reads, level by level: estop, probe, min limit, max limit.
+  std::vector<std::vector<bool>> seen[2];
+  // The levels the (inactive) enable line was written.
+  std::vector<int> enable[2];
+  for (int f = 0; f < 2; ++f) {
+    TempDir dir;
+    const auto loaded = load_machine(
+        dir, 1, "DRIVER = gpio\nSCALE = 100\nSTEP_LINE = 0\nDIR_LINE = 1\n" + forms[f].joint,
+        "[GPIO]\nCHIP = vcd:" + (dir.path() / "in.vcd").string() + "\n" + forms[f].gpio, kBaseNs);
+    ASSERT_TRUE(loaded.ok());
+    GpioDriver driver;
+    driver.use_manual_clock(true);
+    ASSERT_EQ(driver.configure(*loaded.config, {0}), "") << "form " << f;
+    auto* vcd = dynamic_cast<drivers::VcdBackend*>(driver.backend());
+    ASSERT_NE(vcd, nullptr);
+    driver.enable();
+    std::int64_t now_ns = 0;
+    for (const bool level : {true, false, true}) {
+      for (const int line : {3, 4, 40, 41})
+        vcd->set_input_level(line, level);
+      for (int i = 0; i < 5; ++i)
+        driver.run_base_period(now_ns += kBaseNs);
+      MachineInputs in;
+      driver.read_inputs(in);
+      JointFeedback fb[1];
+      driver.read(fb, 1);
+      seen[f].push_back({in.estop, in.probe, fb[0].min_limit, fb[0].max_limit});
+    }
+    driver.disable();
+    for (const VcdChange& c : read_vcd(dir.path() / "in.vcd"))
+      if (c.signal == "j0_enable") enable[f].push_back(c.level);
+  }
+  EXPECT_EQ(enable[1], enable[0]);
+  ASSERT_FALSE(enable[0].empty());
+  EXPECT_EQ(enable[0].back(), 1) << "an active-low enable is high while the machine is off";
+  const std::vector<std::vector<bool>> expected = {
+      {false, true, false, true}, {true, false, true, false}, {false, true, false, true}};
+  EXPECT_EQ(seen[0], expected) << "the bare form with *_ACTIVE_LOW";
+  EXPECT_EQ(seen[1], expected) << "the address form with '!'";
+}
+
+// The panel example writes its estop and enable lines as addresses; the driver takes them.
+TEST(GpioConfig, ThePanelExamplesAddressesConfigureTheDriver) {
+  TempDir dir;
+  const std::filesystem::path ini = copy_example_machine(dir.path(), "gpio_panel_mill");
+  std::string text = slurp(ini);
+  const std::string chip = "CHIP = vcd:/tmp/cncd-panel.vcd";
+  ASSERT_NE(text.find(chip), std::string::npos);
+  text.replace(text.find(chip), chip.size(), "CHIP = vcd:" + (dir.path() / "p.vcd").string());
+  dir.write(ini.filename().string(), text);
+  const auto loaded = config::load_machine_config(ini);
+  ASSERT_TRUE(loaded.ok());
+  GpioDriver driver;
+  driver.use_manual_clock(true);
+  ASSERT_EQ(driver.configure(*loaded.config, {0, 1, 2}), "");
+  auto* vcd = dynamic_cast<drivers::VcdBackend*>(driver.backend());
+  ASSERT_NE(vcd, nullptr);
+  driver.enable();
+  std::int64_t now_ns = 0;
+  for (const bool pressed : {false, true, false}) {
+    vcd->set_input_level(4, pressed);  // ESTOP_LINE = gpio:GPIO4: high is pressed
+    for (int i = 0; i < 5; ++i)
+      driver.run_base_period(now_ns += loaded.config->base_period_ns);
+    MachineInputs in;  // read_inputs only ever sets a flag: each driver adds its own
+    driver.read_inputs(in);
+    EXPECT_EQ(in.estop, pressed) << "pressed " << pressed;
+  }
+  driver.disable();
+  std::map<std::string, int> level;
+  for (const VcdChange& c : read_vcd(dir.path() / "p.vcd"))
+    level[c.signal] = c.level;
+  for (const char* enable : {"j0_enable", "j1_enable", "j2_enable"})
+    EXPECT_EQ(level[enable], 1) << enable << ": gpio:! is active low, high while off";
+}
+
 TEST(GpioConfig, BadKeysAreReportedWithFileAndLine) {
   TempDir dir;
   const auto ini =

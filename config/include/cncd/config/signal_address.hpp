@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -50,5 +51,26 @@ struct SignalAddress {
 // `source` is left to the caller. Returns "" when it parsed, else what is wrong (then `out` is
 // unchanged). Any thread may call it.
 std::string parse_signal_address(std::string_view text, SignalAddress& out);
+
+// What a line key of [GPIO] or of a step/dir joint names (ESTOP_LINE, PROBE_LINE, STEP_LINE,
+// DIR_LINE, ENABLE_LINE, HOME_SWITCH_LINE, MIN_LIMIT_LINE, MAX_LIMIT_LINE). These keys predate
+// signal addresses: their value is a bare line ("GPIO4", "17") or a gpio: address, and
+// "gpio:!LINE" stands for the key's *_ACTIVE_LOW = 1.
+struct GpioLineKey {
+  std::string line;         // offset or name; empty: not connected
+  bool active_low = false;  // the '!' or the *_ACTIVE_LOW key
+};
+
+// The key that makes the line of `key` active low ("ESTOP_LINE": "ESTOP_ACTIVE_LOW"), or ""
+// for STEP_LINE and DIR_LINE, which have none.
+std::string line_active_low_key(std::string_view key);
+
+// Reads `value`, the value of the line key `key`; `active_low` is the value of its *_ACTIVE_LOW
+// key when that is given. Returns "" and fills `out`, else what is wrong (then `out` is
+// unchanged): a '!' the key cannot take or that its *_ACTIVE_LOW key gives again, or an
+// address of another kind (the gpio driver reads and drives these lines in its base thread).
+// Every reader of these keys goes through it, so that they all see the same line.
+std::string parse_gpio_line_key(std::string_view key, std::string_view value,
+                                std::optional<bool> active_low, GpioLineKey& out);
 
 }  // namespace cncd::config
