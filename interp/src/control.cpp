@@ -10,9 +10,9 @@
 #include "interp_state.hpp"
 
 namespace cncd::interp {
-namespace {
 
-// The O-word of a raw line without evaluating anything: used while skipping lines.
+// The O-word of a raw line without evaluating anything: used while skipping lines. A bare
+// O-word (a program number, or the start of a Fanuc subprogram) has kind none.
 bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
   std::size_t i = 0;
   auto skip_blanks = [&] {
@@ -55,6 +55,10 @@ bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
   skip_blanks();
   while (i < line.size() && std::isalpha(static_cast<unsigned char>(line[i])))
     word += lower(i++);
+  if (word.empty()) {
+    kind = OKind::none;
+    return !name.empty();
+  }
   static constexpr std::pair<const char*, OKind> kWords[] = {
       {"sub", OKind::sub},        {"endsub", OKind::endsub}, {"call", OKind::call},
       {"do", OKind::do_},         {"while", OKind::while_},  {"endwhile", OKind::endwhile},
@@ -70,8 +74,6 @@ bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
   }
   return false;
 }
-
-}  // namespace
 
 std::string o_label(const std::string& name) {
   return std::isdigit(static_cast<unsigned char>(name.empty() ? 'x' : name[0])) ? "o" + name
@@ -132,7 +134,9 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
     if (find_indexed_sub(name, offset)) return true;
   } else {
     while (source().read_line(line_)) {
-      if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
+      if (!scan_o_word(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
+      if (kind == OKind::none) fail("Fanuc 'O....' subroutine must be called with 'M98'");
+      if (kind == OKind::sub) {
         subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
         source().seek(offset, line_number);
         return true;
@@ -173,6 +177,7 @@ void Interpreter::Impl::do_call() {
     }
     it = subs_.find(name);
   }
+  if (it->second.fanuc) fail("Fanuc 'O....' subroutine must be called with 'M98'");
   if (calls_.size() >= 64) fail("Too many nested subroutine calls");
   CallFrame frame;
   frame.name = name;
@@ -206,7 +211,7 @@ void Interpreter::Impl::do_return(bool has_value, double value) {
   calls_.pop_back();
   control_.resize(frame.control_depth);
   parameters_.pop_scope();
-  for (int i = 0; i < 30; ++i)
+  for (int i = 0; i < 30 && !frame.fanuc; ++i)
     parameters_.set(i + 1, frame.saved_parameters[static_cast<std::size_t>(i)]);
   last_value_ = has_value ? value : 0.0;
   value_returned_ = has_value;
@@ -251,6 +256,8 @@ void Interpreter::Impl::handle_o_word() {
     }
     case OKind::endsub:
     case OKind::return_:
+      if (!calls_.empty() && calls_.back().fanuc)
+        fail("Fanuc 'O....' subroutine definition must end with 'M99'");
       do_return(block_.has_o_value, block_.o_value);
       return;
     case OKind::call:

@@ -377,6 +377,7 @@ bool Interpreter::Impl::do_stop() {
       return true;
     case 2:
     case 30:
+    case 99:  // M99 in the main program: LinuxCNC ends it as M2 does
       program_end_reset();
       ended_ = true;
       return true;

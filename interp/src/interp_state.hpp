@@ -124,6 +124,7 @@ struct SubInfo {
   std::int64_t offset = 0;
   int line_before = 0;
   bool found_by_search = false;
+  bool fanuc = false;  // a bare "O100" line: called by M98, ended by M99
 };
 
 struct CallFrame {
@@ -134,6 +135,12 @@ struct CallFrame {
   std::size_t control_depth = 0;
   std::size_t nx_loop_depth = 0;              // Numeryx for loops open in the caller
   std::array<double, 30> saved_parameters{};  // the caller's #1-#30
+  // M98: a Fanuc-style subprogram, which shares #1-#30 with its caller, ends with M99 and runs
+  // `repeats_left` more times from `sub_offset` before it returns.
+  bool fanuc = false;
+  int repeats_left = 0;
+  std::int64_t sub_offset = 0;
+  int sub_line_before = 0;
 };
 
 class CanonSink;
@@ -146,6 +153,8 @@ void rotate_xy(Pose& pose, double degrees);
 double unit_factor(Units from, Units to);
 // An O-word name as messages write it: "o100", "o<probe>".
 std::string o_label(const std::string& name);
+// The O-word of a raw line, read without evaluating anything; kind none for a bare O-word.
+bool scan_o_word(const std::string& line, std::string& name, OKind& kind);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {
@@ -276,6 +285,11 @@ struct Interpreter::Impl {
   void handle_o_word();
   void do_call();
   void do_return(bool has_value, double value);
+  // fanuc_subs.cpp: M98 and M99. True when the line was an M98 call or an M99 return.
+  bool handle_fanuc_codes();
+  void do_m98();
+  void do_m99();
+  bool find_fanuc_sub(const std::string& name);
   void skip_block(const std::string& name, std::initializer_list<OKind> stops);
   bool find_indexed_sub(const std::string& name, std::int64_t offset);
   bool find_sub(const std::string& name);

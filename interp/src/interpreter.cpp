@@ -259,6 +259,7 @@ void Interpreter::Impl::run_line() {
     const auto& [name, value] = block_.named_assignments[static_cast<std::size_t>(i)];
     parameters_.set_named(name, value);
   }
+  if (handle_fanuc_codes()) return;
   if (block_.o_kind != OKind::none) {
     handle_o_word();
     return;
