@@ -1,4 +1,5 @@
 // The plan simulation's figures as cncd-check --plan prints them.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -87,7 +88,9 @@ std::string plan_json(const config::MachineConfig& machine, const PlanSimResult&
   // When each line first starts moving, in program order.
   nlohmann::json lines = nlohmann::json::array();
   std::set<std::int32_t> seen;
-  for (std::size_t i = 0; i < result.move_line.size(); ++i) {
+  // The moves planned and the moves started can differ in number: only those with both count.
+  const std::size_t moves = std::min(result.move_line.size(), result.move_start_s.size());
+  for (std::size_t i = 0; i < moves; ++i) {
     if (!std::isfinite(result.move_start_s[i]) || !seen.insert(result.move_line[i]).second)
       continue;
     lines.push_back({result.move_line[i], result.move_start_s[i]});

@@ -1,11 +1,13 @@
 // The offline plan simulation (plan_sim) and cncd-check --plan: cycle time against the bounds
 // worked out by hand, peaks within the limits, path deviation, per-move start times, errors
 // naming file and line, budgets, the trajectory CSV.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -254,6 +256,30 @@ TEST_F(PlanSimTest, CncdCheckPlanRefusesBadUseAndReportsProgramErrors) {
                    ini_.string(), good.string()});
   EXPECT_EQ(r.exit_status, 1);
   EXPECT_NE(r.err.find("cannot write /nonexistent/dir/t.csv"), std::string::npos) << r.err;
+}
+
+// A move refused mid-program leaves moves planned that never start: the report's line start
+// times list only the lines that started, each within the run (X30, planned but never handed
+// to the servo loop, has no start time).
+TEST_F(PlanSimTest, ARefusedMoveLeavesOnlyTheLinesThatStartedInTheReport) {
+  const auto r = simulate("G21 G90\nG1 X10 F600\nG1 X20\nG1 X30\nG1 Y900\nM2\n");
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 5);
+  ASSERT_EQ(r.move_line, (std::vector<std::int32_t>{2, 3, 4}));
+  ASSERT_LT(r.move_start_s.size(), r.move_line.size());
+  std::vector<int> started;
+  for (std::size_t i = 0; i < r.move_start_s.size(); ++i) {
+    if (std::isfinite(r.move_start_s[i])) started.push_back(r.move_line[i]);
+  }
+  const auto report = nlohmann::json::parse(pipeline::plan_json(machine(), r));
+  std::vector<int> lines;
+  for (const auto& entry : report["line_start_s"]) {
+    lines.push_back(entry[0].get<int>());
+    EXPECT_GE(entry[1].get<double>(), 0.0);
+    EXPECT_LE(entry[1].get<double>(), r.cycle_time_s);
+  }
+  EXPECT_EQ(lines, started);
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), 4), 0);
 }
 
 }  // namespace
