@@ -12,36 +12,6 @@ namespace cncd::daemon {
 
 using Clock = std::chrono::steady_clock;
 
-namespace {
-
-// The feed loop's target: the motion controller's queue, counting the moves it takes.
-class ControllerTarget final : public pipeline::MoveTarget {
- public:
-  ControllerTarget(motion::MotionController& motion, std::uint64_t& enqueued,
-                   std::uint64_t& actions)
-      : motion_(motion), enqueued_(enqueued), actions_(actions) {}
-  Push push(const motion::Move& move) override {
-    switch (motion_.enqueue(move)) {
-      case motion::MotionController::EnqueueResult::full:
-        return Push::full;
-      case motion::MotionController::EnqueueResult::refused:
-        return Push::refused;
-      default:
-        ++(move.kind == motion::Move::Kind::action ? actions_ : enqueued_);
-        return Push::accepted;
-    }
-  }
-  // What does not fit yet goes out before the next move.
-  void flush() override { motion_.flush(); }
-
- private:
-  motion::MotionController& motion_;
-  std::uint64_t& enqueued_;
-  std::uint64_t& actions_;
-};
-
-}  // namespace
-
 // One interpreter for the daemon's life: like LinuxCNC's, its parameters and offsets carry
 // from one program to the next.
 Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& answers)
@@ -49,21 +19,21 @@ Task::Task(const config::MachineConfig& config, EventLog& events, TaskAnswers& a
       events_(events),
       answers_(answers),
       motion_(config),
-      feeder_(std::make_unique<pipeline::ProgramFeeder>(
-          pipeline::machine_units(config),
+      interp_(std::make_unique<interp::Interpreter>(
+          with_probe_writer(pipeline::interpreter_options(config), probe_writer_))),
+      runner_(std::make_unique<pipeline::ProgramRunner>(
+          *interp_, pipeline::machine_units(config),
           [&events](int line, const std::string& text) {
             events.add("info", "message", "line " + std::to_string(line) + ": " + text);
           },
           &config)),
-      interp_(std::make_unique<interp::Interpreter>(
-          with_probe_writer(pipeline::interpreter_options(config), probe_writer_))),
       saved_tools_(interp_->tools()),
       saved_parameters_(interp_->persistent_parameters()),
       estimator_(config),
       opener_(config),
       previewer_(config) {
   program_dialect_ = interp_->dialect();  // before any program: the machine's
-  feeder_->on_warning([this](int line, const std::string& text) {
+  runner_->feeder().on_warning([this](int line, const std::string& text) {
     const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
     events_.add("warning", "program", where + ":" + std::to_string(line) + ": " + text);
   });
@@ -151,13 +121,12 @@ void Task::run_program(int from_line, bool step) {
   // The file may have been changed since it was opened.
   program_dialect_ = interp_->dialect();
   start_run(Mode::automatic, status);
-  skip_to_line_ = from_line > 1 ? from_line : 0;
-  from_top_ = skip_to_line_ == 0;
-  run_from_line_ = skip_to_line_;
+  runner_->skip_to(from_line, status.commanded, tool_at_start_);
+  from_top_ = !runner_->skipping();
+  run_from_line_ = from_top_ ? 0 : from_line;
   approach_done_s_.reset();
-  skip_moved_ = false;
   stepping_ = step;
-  step_budget_ = step ? 1 : 0;
+  runner_->single_step(step, 1);
   // Both clocks read now: `status` may be older (opening the program takes its time).
   started_at_ = Clock::now();
   started_cycles_ = motion_.status().rt.cycles;
@@ -165,14 +134,15 @@ void Task::run_program(int from_line, bool step) {
   motion_s_ = 0;
   last_result_.clear();
   last_error_.clear();
-  events_.add("info", "program",
-              program_path_ + (skip_to_line_ > 0 ? " started from line " + std::to_string(from_line)
-                                                 : std::string(" started")));
+  events_.add(
+      "info", "program",
+      program_path_ + (runner_->skipping() ? " started from line " + std::to_string(from_line)
+                                           : std::string(" started")));
   feed();
   // Ended in error before any of its moves reached the motion controller (the planner refused
   // the first one, the machine having been moved since the program was checked; a run from a
   // line the program never reaches): that is this request's answer, not a success.
-  if (exec_ == ExecState::idle && last_result_ == "error" && moves_enqueued_ == 0) {
+  if (exec_ == ExecState::idle && last_result_ == "error" && runner_->moves_queued() == 0) {
     throw TaskError(TaskErrorKind::program, last_error_);
   }
 }
@@ -211,16 +181,10 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   interp::Pose position{};
   std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
   interp_->set_machine_position(position);
-  feeder_->start_program(&status.commanded, mode == Mode::mdi);
-  feeder_->tool = interp_->state().tool_in_spindle;
+  runner_->start(&status.commanded, mode == Mode::mdi, interp_->state().tool_in_spindle);
   path_errors_base_ = status.path_errors;
-  input_wait_pending_ = false;
   input_waits_seen_ = status.input_waits;
-  probe_pending_ = false;
   probes_seen_ = status.probe.done;
-  interp_done_ = false;
-  moves_enqueued_ = 0;
-  actions_enqueued_ = 0;
   actions_done_base_ = status.actions_done;
   moves_done_base_ = status.moves_done;
   motion_.discard();
@@ -228,8 +192,6 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   paused_s_ = 0;
   set_exec(ExecState::running);
   stepping_ = false;
-  step_budget_ = 0;
-  skip_to_line_ = 0;
 }
 
 void Task::finish_program(const std::string& ended, const std::string& why) {
@@ -269,10 +231,8 @@ void Task::finish_program(const std::string& ended, const std::string& why) {
     mdi_token_ = 0;
     return;
   }
-  feeder_->pending.clear();
   set_exec(ExecState::idle);
   stepping_ = false;
-  skip_to_line_ = 0;
   moves_completed_ = motion_.status().moves_done - moves_done_base_;
   elapsed_s_ = std::chrono::duration<double>(Clock::now() - started_at_).count();
   motion_s_ = servo_seconds_since(started_cycles_);
@@ -290,51 +250,27 @@ void Task::finish_program(const std::string& ended, const std::string& why) {
 void Task::feed() {
   // Bounded work per call keeps the control socket responsive: a run from a far line reads
   // every line before it, thousands a poll when they hardly move.
-  constexpr int kMaxBlocksPerPoll = 2000;
-  const auto until = Clock::now() + std::chrono::milliseconds(2);
-  for (int blocks = 0; blocks < kMaxBlocksPerPoll; ++blocks) {
-    if ((blocks & 63) == 63 && Clock::now() > until) return;
-    ControllerTarget target(motion_, moves_enqueued_, actions_enqueued_);
-    const pipeline::Drained drained = feeder_->drain(target);
-    if (drained.result == pipeline::MoveTarget::Push::full) return;
-    if (drained.result == pipeline::MoveTarget::Push::refused) {
-      motion_.abort();
-      finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
-                                  std::to_string(drained.line) + ": " + motion_.enqueue_error());
+  pipeline::ProgramRunner::Budget budget;
+  budget.max_blocks = 2000;
+  budget.until = Clock::now() + std::chrono::milliseconds(2);
+  if (runner_->advance(motion_, budget) == pipeline::ProgramRunner::Outcome::error) {
+    motion_.abort();
+    finish_with(runner_->error());
+  }
+}
+
+void Task::finish_with(const pipeline::ProgramRunner::Error& error) {
+  using Kind = pipeline::ProgramRunner::Error::Kind;
+  const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
+  switch (error.kind) {
+    case Kind::interpreter:
+      finish_program("error", error.interp ? error.interp->to_string() : error.message);
       return;
-    }
-    // The move held back for look-ahead goes out when no more come for now, so that the
-    // path ends at rest and the program's end, a stop or a step is seen.
-    if (interp_done_ || feeder_->stop_seen || input_wait_pending_ || probe_pending_ ||
-        (stepping_ && step_budget_ == 0)) {
-      motion_.flush();
+    case Kind::ends_before_line:
+      finish_program("error", where + ": " + error.message);
       return;
-    }
-    const auto step = interp_->step(*feeder_);
-    if (step == interp::Interpreter::Step::error) {
-      const auto& error = interp_->error();
-      motion_.abort();
-      finish_program("error", error ? error->to_string() : "interpreter error");
-      return;
-    }
-    if (stepping_) --step_budget_;
-    if (skip_to_line_ > 0 && !skip_before_start(step == interp::Interpreter::Step::end)) return;
-    if (feeder_->input_wait_seen) {
-      feeder_->input_wait_seen = false;
-      input_wait_pending_ = skip_to_line_ == 0;  // a skipped line's wait is dropped with it
-    }
-    if (feeder_->probe_seen) {
-      feeder_->probe_seen = false;
-      probe_pending_ = skip_to_line_ == 0;
-    }
-    if (feeder_->unsupported) {
-      motion_.abort();
-      finish_program("error", (mode_ == Mode::mdi ? std::string("MDI") : program_path_) + ":" +
-                                  std::to_string(feeder_->unsupported->line) + ": " +
-                                  feeder_->unsupported->why);
-      return;
-    }
-    if (step == interp::Interpreter::Step::end) interp_done_ = true;
+    default:
+      finish_program("error", where + ":" + std::to_string(error.line) + ": " + error.message);
   }
 }
 
@@ -380,13 +316,13 @@ void Task::poll() {
     return;
   }
   if (!poll_holds(status)) return;
-  if (input_wait_pending_ && status.input_waits > input_waits_seen_) {
+  if (runner_->waiting_input() && status.input_waits > input_waits_seen_) {
     // The machine has waited for the M66: its answer is #5399 for the lines that follow.
     input_waits_seen_ = status.input_waits;
     interp_->set_input_result(status.input_result);
-    input_wait_pending_ = false;
+    runner_->input_done();
   }
-  if (probe_pending_ && status.probe.done > probes_seen_ && status.queued == 0 &&
+  if (runner_->waiting_probe() && status.probe.done > probes_seen_ && status.queued == 0 &&
       status.motion == motion::MotionState::idle) {
     // The probing move is over: where it tripped goes to #5061-#5070, and the interpreter
     // reads on from where the machine stopped.
@@ -397,33 +333,32 @@ void Task::poll() {
     interp::Pose at{};
     std::copy(status.commanded.begin(), status.commanded.end(), at.begin());
     interp_->set_machine_position(at);
-    feeder_->set_position(status.commanded);
-    probe_pending_ = false;
+    runner_->probe_done(status.commanded);
   }
   // Run from line: the remaining time counts from when the traverse to the line has ended.
-  if (skip_moved_ && !approach_done_s_ && status.moves_done > moves_done_base_)
+  if (runner_->skipped_motion() && !approach_done_s_ && status.moves_done > moves_done_base_)
     approach_done_s_ = moving_s();
   if (exec_ == ExecState::paused) return;
   feed();
   if (exec_ != ExecState::running) return;
   // Counting completed moves (rather than looking at an empty queue) cannot mistake the instant
   // between enqueue and the servo thread picking a move up for the end of the program.
-  const bool drained = feeder_->pending.empty() &&
-                       status.moves_done - moves_done_base_ >= moves_enqueued_ &&
-                       status.actions_done - actions_done_base_ >= actions_enqueued_ &&
+  const bool drained = runner_->drained() &&
+                       status.moves_done - moves_done_base_ >= runner_->moves_queued() &&
+                       status.actions_done - actions_done_base_ >= runner_->actions_queued() &&
                        status.motion == motion::MotionState::idle;
   if (!drained) return;
-  if (feeder_->stop_seen) {
+  if (runner_->stopped()) {
     // M0/M1/M60 reached: the machine has stopped at that point; resume continues.
-    feeder_->stop_seen = false;
+    runner_->clear_stop();
     set_exec(ExecState::paused);
     events_.add("info", "program",
                 fmt::format("stopped by M0/M1/M60 at line {}", interp_->current_line()));
     return;
   }
-  if (interp_done_) {
+  if (runner_->ended()) {
     finish_program("done", "");
-  } else if (stepping_ && step_budget_ == 0) {
+  } else if (stepping_ && runner_->step_over()) {
     set_exec(ExecState::paused);  // program.step: the line has been carried out
   }
 }

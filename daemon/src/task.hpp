@@ -18,7 +18,7 @@
 #include "cncd/drivers/sim_driver.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/motion/controller.hpp"
-#include "cncd/pipeline/feeder.hpp"
+#include "cncd/pipeline/program_runner.hpp"
 #include "event_log.hpp"
 #include "panel_rules.hpp"
 #include "persist.hpp"
@@ -73,7 +73,7 @@ class Task {
   // program.preview: the open program's toolpath at `tolerance` (0: the machine's default),
   // answered under `token` once worked out in the background (task_open.cpp).
   void preview_program(double tolerance, std::uint64_t token);
-  // Runs the open program; from_line > 1 runs it from that line (see skip_before_start);
+  // Runs the open program; from_line > 1 runs it from that line (see ProgramRunner::skip_to);
   // `step` runs its first line only, as program.step does.
   void run_program(int from_line = 0, bool step = false);
   // Runs one more line of the program (from idle: the first), then pauses; resume runs on.
@@ -184,20 +184,18 @@ class Task {
   // The servo status when the machine may run a program or MDI block: on, at rest and homed
   // (unless NO_FORCE_HOMING); throws TaskError naming what is missing `before` that.
   motion::Status ready_status(const char* before) const;
-  // Run from line: called after each block while lines before skip_to_line_ are read. Drops
-  // their motion (modal state, offsets and tool stay as they left them) and, at the first
-  // block of the wanted line, puts a traverse from where the machine stands to where that
-  // line starts in front of its moves. Returns false when the run has ended.
-  bool skip_before_start(bool program_ended);
+  // Ends the run at the runner's error.
+  void finish_with(const pipeline::ProgramRunner::Error& error);
 
   const config::MachineConfig& config_;
   EventLog& events_;
   TaskAnswers& answers_;
   motion::MotionController motion_;
-  std::unique_ptr<pipeline::ProgramFeeder> feeder_;
   // Before interp_, which writes through it.
   std::shared_ptr<QueuedProbeWriter> probe_writer_ = std::make_shared<QueuedProbeWriter>();
   std::unique_ptr<interp::Interpreter> interp_;
+  // Reads the program (or MDI block) into motion_'s queue.
+  std::unique_ptr<pipeline::ProgramRunner> runner_;
   std::vector<interp::ToolEntry> saved_tools_;  // the tool table as its file holds it
   std::vector<double> saved_parameters_;        // the persistent parameters as the file holds them
   ExecState exec_ = ExecState::idle;
@@ -209,30 +207,21 @@ class Task {
   std::shared_ptr<const interp::SubroutineIndex> program_subs_;  // of the open program
   // The dialect the open program is read in; with none open, the machine's (MDI's).
   interp::Dialect program_dialect_ = interp::Dialect::linuxcnc;
-  bool interp_done_ = false;
-  std::uint64_t moves_enqueued_ = 0;     // moves handed to motion since the program started
   std::uint64_t moves_done_base_ = 0;    // motion's completed-move count when it started
-  std::uint64_t actions_enqueued_ = 0;   // actions (spindle, outputs, waits) handed to motion
   std::uint64_t actions_done_base_ = 0;  // motion's completed-action count when it started
   std::uint64_t moves_completed_ = 0;    // moves the last finished run completed
   std::string last_result_;              // "done" | "aborted" | "error" | "" (never ran)
   std::string last_error_;
-  int skip_to_line_ = 0;     // run from line: first line that moves, 0 = none
-  bool skip_moved_ = false;  // a skipped line moved: skip_end_ is where it ended
-  motion::AxisPose skip_end_{};
   std::uint64_t path_errors_base_ = 0;  // motion's path error count when the run started
-  // M66 read: the interpreter waits to read on until the machine has waited and #5399 holds
-  // its answer (motion's count of ended input waits passes input_waits_seen_).
-  bool input_wait_pending_ = false;
+  // M66 read: the runner waits to read on until the machine has waited and #5399 holds its
+  // answer (motion's count of ended input waits passes input_waits_seen_).
   std::uint64_t input_waits_seen_ = 0;
   // G38.x read: likewise until the probing move is over (motion's count of ended probing moves
   // passes probes_seen_) and #5061-#5070 hold where it tripped.
-  bool probe_pending_ = false;
   std::uint64_t probes_seen_ = 0;
   UserMProcess user_m_;            // the user M code running, if any
   std::uint32_t user_m_hold_ = 0;  // the hold it answers
   bool stepping_ = false;          // program.step: one line, then pause
-  int step_budget_ = 0;            // lines the interpreter may still read in this step
   std::chrono::steady_clock::time_point started_at_{};
   double elapsed_s_ = 0;
   // The run on the servo clock: servo periods since program.run (rt.cycles) x the period. Falls
@@ -242,7 +231,7 @@ class Task {
   PlanEstimator estimator_;  // the open program's running time, worked out in the background
   bool from_top_ = false;    // the run started at the program's first line
   int run_from_line_ = 0;    // run from line: the line it started at
-  int tool_at_start_ = 0;    // run from line: the tool in the spindle when it started
+  int tool_at_start_ = 0;    // the tool in the spindle when the run started
   // Run from line with a traverse to the line's start: the moving time when it ended.
   std::optional<double> approach_done_s_;
   std::chrono::steady_clock::time_point paused_since_{};

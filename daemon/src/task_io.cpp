@@ -43,8 +43,8 @@ WaitReport Task::wait_report(const motion::Status& s) const {
                                 s.wait.index);
       break;
     case motion::WaitStatus::Kind::tool_change: {
-      const auto hold = feeder_->holds.find(s.wait.hold_id);
-      out.tool = hold != feeder_->holds.end() ? hold->second.tool : 0;
+      const auto* hold = runner_->feeder().hold(s.wait.hold_id);
+      out.tool = hold != nullptr ? hold->tool : 0;
       std::string what;
       if (const auto entry = interp_->tool(out.tool); entry && !entry->comment.empty())
         what = " (" + entry->comment + ")";
@@ -52,10 +52,9 @@ WaitReport Task::wait_report(const motion::Status& s) const {
       break;
     }
     case motion::WaitStatus::Kind::user_m: {
-      const auto hold = feeder_->holds.find(s.wait.hold_id);
-      out.message = hold != feeder_->holds.end()
-                        ? fmt::format("running {}", hold->second.user.executable)
-                        : std::string("running a user M code");
+      const auto* hold = runner_->feeder().hold(s.wait.hold_id);
+      out.message = hold != nullptr ? fmt::format("running {}", hold->user.executable)
+                                    : std::string("running a user M code");
       break;
     }
     case motion::WaitStatus::Kind::none:
@@ -69,8 +68,8 @@ void Task::tool_change_done(int tool) {
   if (exec_ == ExecState::idle || s.wait.kind != motion::WaitStatus::Kind::tool_change)
     throw TaskError(TaskErrorKind::wrong_state,
                     fmt::format("no tool change is waiting: T{} is not asked for", tool));
-  const auto hold = feeder_->holds.find(s.wait.hold_id);
-  const int wanted = hold != feeder_->holds.end() ? hold->second.tool : 0;
+  const auto* hold = runner_->feeder().hold(s.wait.hold_id);
+  const int wanted = hold != nullptr ? hold->tool : 0;
   // An answer meant for another change (a second Enter, a confirmation sent before this
   // prompt was seen) must not let this one go on.
   if (tool != wanted) {
@@ -79,7 +78,7 @@ void Task::tool_change_done(int tool) {
   }
   events_.add("info", "tool", fmt::format("tool T{} put in", wanted));
   motion_.release_hold(s.wait.hold_id);
-  if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
+  runner_->feeder().erase_hold(s.wait.hold_id);
 }
 
 void Task::wait_done(const std::string& kind) {
@@ -110,18 +109,16 @@ void Task::wait_done(const std::string& kind) {
 // while it skips the lines before the one it runs from. A run that ended as written has made
 // every change it read.
 void Task::untake_tool_changes(bool ended_as_written) {
-  const auto first = std::find_if(feeder_->holds.begin(), feeder_->holds.end(), [](const auto& h) {
+  const auto& holds = runner_->feeder().holds();
+  const auto first = std::find_if(holds.begin(), holds.end(), [](const auto& h) {
     return h.second.kind == motion::IoAction::Hold::tool_change;
   });
   const int read = interp_->state().tool_in_spindle;
-  const int in_spindle = ended_as_written                ? read
-                         : first != feeder_->holds.end() ? first->second.tool_before
-                         : skip_to_line_ > 0             ? tool_at_start_
-                                                         : read;
-  for (auto it = feeder_->holds.begin(); it != feeder_->holds.end();) {
-    it = it->second.kind == motion::IoAction::Hold::tool_change ? feeder_->holds.erase(it)
-                                                                : std::next(it);
-  }
+  const int in_spindle = ended_as_written       ? read
+                         : first != holds.end() ? first->second.tool_before
+                         : runner_->skipping()  ? tool_at_start_
+                                                : read;
+  runner_->feeder().erase_tool_changes();
   if (in_spindle == read) return;
   interp_->set_tool_in_spindle(in_spindle);
   events_.add("warning", "tool",
@@ -133,11 +130,11 @@ bool Task::poll_holds(const motion::Status& s) {
   if (user_m_.running() || user_m_hold_ != 0) {
     const auto result = user_m_.poll();
     if (!result) return true;
-    const auto hold = feeder_->holds.find(user_m_hold_);
-    const int line = hold != feeder_->holds.end() ? hold->second.line : 0;
+    const auto* hold = runner_->feeder().hold(user_m_hold_);
+    const int line = hold != nullptr ? hold->line : 0;
     const std::uint32_t id = user_m_hold_;
     user_m_hold_ = 0;
-    if (hold != feeder_->holds.end()) feeder_->holds.erase(hold);
+    runner_->feeder().erase_hold(id);
     if (!result->empty()) {
       motion_.abort();
       finish_program(
@@ -148,18 +145,18 @@ bool Task::poll_holds(const motion::Status& s) {
     return true;
   }
   if (s.wait.kind != motion::WaitStatus::Kind::user_m) return true;
-  const auto hold = feeder_->holds.find(s.wait.hold_id);
-  if (hold == feeder_->holds.end()) return true;
-  const interp::UserMCode& user = hold->second.user;
+  const auto* hold = runner_->feeder().hold(s.wait.hold_id);
+  if (hold == nullptr) return true;
+  const interp::UserMCode& user = hold->user;
   const std::string problem =
       user_m_.start(user.executable, user.p, user.q, config_.io.user_m_timeout_s);
   if (!problem.empty()) {
     motion_.abort();
-    finish_program("error", fmt::format("{}:{}: {} {}", program_path_, hold->second.line,
-                                        user.executable, problem));
+    finish_program(
+        "error", fmt::format("{}:{}: {} {}", program_path_, hold->line, user.executable, problem));
     return false;
   }
-  spdlog::info("line {}: running {} {:f} {:f}", hold->second.line, user.executable, user.p, user.q);
+  spdlog::info("line {}: running {} {:f} {:f}", hold->line, user.executable, user.p, user.q);
   user_m_hold_ = s.wait.hold_id;
   return true;
 }

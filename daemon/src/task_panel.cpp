@@ -187,13 +187,13 @@ void Task::panel_switches(const motion::Status& status) {
       !stepping_) {
     // Switched on mid-run: the run pauses once the blocks already read are carried out.
     stepping_ = true;
-    step_budget_ = 0;
+    runner_->single_step(true, 0);
     events_.add("info", "command", "SINGLE_BLOCK on: the program pauses after this block");
   }
   panel_.single_block = single;
   // Unwired, M1 always stops and block delete is the interpreter's default.
-  feeder_->optional_stop =
-      !panel_wired(PanelInput::optional_stop) || panel_level(PanelInput::optional_stop, status);
+  runner_->feeder().set_optional_stop(!panel_wired(PanelInput::optional_stop) ||
+                                      panel_level(PanelInput::optional_stop, status));
   interp_->set_block_delete(panel_wired(PanelInput::block_delete)
                                 ? panel_level(PanelInput::block_delete, status)
                                 : interp::InterpOptions{}.block_delete);
@@ -332,7 +332,7 @@ PanelReport Task::panel_report(const motion::Status& status) const {
   out.mpg_jogging = status.panel.mpg_jogging;
   out.door = door_open(status);
   out.single_block = panel_level(PanelInput::single_block, status);
-  out.optional_stop = feeder_->optional_stop;
+  out.optional_stop = runner_->feeder().optional_stop();
   out.block_delete = panel_wired(PanelInput::block_delete)
                          ? panel_level(PanelInput::block_delete, status)
                          : interp::InterpOptions{}.block_delete;

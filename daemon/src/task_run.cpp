@@ -19,6 +19,7 @@ void Task::resume() {
     throw TaskError(TaskErrorKind::wrong_state, "the program is not paused");
   refuse_if_door_open();
   stepping_ = false;
+  runner_->single_step(false, 0);
   motion_.resume();
   set_exec(ExecState::running);
 }
@@ -27,44 +28,6 @@ void Task::abort(std::uint64_t token) {
   motion_.abort();
   if (exec_ != ExecState::idle) finish_program("aborted", "aborted by request");
   if (token != 0) abort_tokens_.push_back(token);
-}
-
-bool Task::skip_before_start(bool program_ended) {
-  if (interp_->current_line() < skip_to_line_) {
-    if (program_ended) {
-      motion_.abort();
-      finish_program("error", program_path_ + ": the program ends at line " +
-                                  std::to_string(interp_->current_line()) + ", before line " +
-                                  std::to_string(skip_to_line_));
-      return false;
-    }
-    for (const auto& move : feeder_->pending) {
-      if (move.kind == motion::Move::Kind::dwell || move.kind == motion::Move::Kind::action)
-        continue;
-      skip_end_ = move.end;
-      skip_moved_ = true;
-    }
-    feeder_->pending.clear();
-    feeder_->holds.clear();      // the tool changes and user M codes of the lines skipped
-    feeder_->stop_seen = false;  // M0/M1 before the line do not stop a run from line
-    return true;
-  }
-  if (skip_moved_) {
-    motion::Move approach;
-    approach.kind = motion::Move::Kind::traverse;
-    approach.end = skip_end_;
-    approach.line = interp_->current_line();
-    feeder_->pending.push_front(approach);
-  }
-  // The spindle and coolant as the skipped lines left them, before the machine moves there.
-  feeder_->restore_io_state();
-  // A skipped M6 (or M61) left another tool in force than the one in the spindle: its length
-  // is already in the line's positions, so the operator puts it in before anything moves.
-  if (const int in_force = interp_->state().tool_in_spindle; in_force != tool_at_start_)
-    feeder_->change_tool_first(in_force, interp_->current_line(), motion_.status().commanded,
-                               tool_at_start_);
-  skip_to_line_ = 0;
-  return true;
 }
 
 void Task::step() {
@@ -81,7 +44,7 @@ void Task::step() {
   motion_.resume();
   set_exec(ExecState::running);
   stepping_ = true;
-  step_budget_ = 1;
+  runner_->single_step(true, 1);
   feed();
 }
 

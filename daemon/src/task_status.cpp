@@ -159,11 +159,11 @@ void Task::time_estimate(std::uint64_t moves_done, ProgramReport& out) const {
       return;
     }
     const std::uint64_t k0 = first_move_.index;
-    if (skip_moved_ && !approach_done_s_) {
+    if (runner_->skipped_motion() && !approach_done_s_) {
       out.remaining_s = total - starts[k0];
       return;
     }
-    moves_done += k0 - (skip_moved_ ? 1 : 0);
+    moves_done += k0 - (runner_->skipped_motion() ? 1 : 0);
     active += starts[k0] - approach_done_s_.value_or(0.0);
   }
   if (moves_done >= starts.size()) {

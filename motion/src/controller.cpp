@@ -288,6 +288,17 @@ MotionController::EnqueueResult MotionController::flush() {
   return impl_->pump() ? EnqueueResult::queued : EnqueueResult::full;
 }
 
+MoveQueue::Push MotionController::push_move(const Move& move) {
+  switch (enqueue(move)) {
+    case EnqueueResult::full:
+      return Push::full;
+    case EnqueueResult::refused:
+      return Push::refused;
+    default:
+      return Push::accepted;
+  }
+}
+
 void MotionController::discard() {
   impl_->planner.reset(impl_->planner.end());
 }

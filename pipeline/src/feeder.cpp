@@ -9,17 +9,18 @@
 
 namespace cncd::pipeline {
 void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
-  pending.clear();
-  stop_seen = false;
-  input_wait_seen = false;
-  probe_seen = false;
-  unsupported.reset();
+  pending_.clear();
+  moves_queued_ = actions_queued_ = 0;
+  stop_seen_ = false;
+  input_wait_seen_ = false;
+  probe_seen_ = false;
+  unsupported_.reset();
   if (!mdi) {
     per_revolution_ = false;
     css_max_rpm_ = 0;
   }
   per_rev_ = 0;
-  holds.clear();
+  holds_.clear();
   sync_ = {};
   need_at_speed_ = false;
   end_ = at != nullptr ? *at : motion::AxisPose{};
@@ -28,13 +29,13 @@ void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
 motion::IoAction ProgramFeeder::spindle_action() const {
   motion::IoAction a;
   a.kind = motion::IoAction::Kind::spindle;
-  a.direction = static_cast<std::int8_t>(spindle_direction);
-  a.rpm = spindle_speed;
+  a.direction = static_cast<std::int8_t>(spindle_direction_);
+  a.rpm = spindle_speed_;
   if (css_max_rpm_ > 0) {
     // G96: S is metres (G21) or feet (G20) per minute at the tool, X0 the spindle's axis.
     constexpr double kTwoPi = 6.283185307179586;
     const double per_s = tracker_.program_units() == interp::Units::inches ? 12.0 : 1000.0;
-    a.css_numerator = spindle_speed * per_s * tracker_.length_factor() / kTwoPi;
+    a.css_numerator = spindle_speed_ * per_s * tracker_.length_factor() / kTwoPi;
     a.css_max_rpm = css_max_rpm_;
     a.css_x_origin = tracker_.machine_pose(interp::Pose{})[0];
   }
@@ -42,22 +43,22 @@ motion::IoAction ProgramFeeder::spindle_action() const {
 }
 
 void ProgramFeeder::check_speed(int line) {
-  if (machine_ == nullptr || !on_warning_ || spindle_direction == 0 || spindle_speed <= 0 ||
+  if (machine_ == nullptr || !on_warning_ || spindle_direction_ == 0 || spindle_speed_ <= 0 ||
       css_max_rpm_ > 0)
     return;
   const config::SpindleConfig& sp = machine_->spindle;
   if (!sp.present || sp.driver == config::SpindleDriver::none) return;
-  const bool reverse = spindle_direction < 0;
+  const bool reverse = spindle_direction_ < 0;
   const double lo = reverse ? sp.min_reverse_velocity : sp.min_forward_velocity;
   const double hi = reverse ? sp.max_reverse_velocity : sp.max_forward_velocity;
-  if ((spindle_speed >= lo && spindle_speed <= hi) || spindle_speed == warned_rpm_) return;
-  warned_rpm_ = spindle_speed;
-  const bool above = spindle_speed > hi;
+  if ((spindle_speed_ >= lo && spindle_speed_ <= hi) || spindle_speed_ == warned_rpm_) return;
+  warned_rpm_ = spindle_speed_;
+  const bool above = spindle_speed_ > hi;
   const std::string key =
       std::string(above ? "MAX_" : "MIN_") + (reverse ? "REVERSE" : "FORWARD") + "_VELOCITY";
   char text[200];
   std::snprintf(text, sizeof text, "S%g is %s [SPINDLE_0] %s %g: the spindle turns at %g rpm",
-                spindle_speed, above ? "above" : "below", key.c_str(), above ? hi : lo,
+                spindle_speed_, above ? "above" : "below", key.c_str(), above ? hi : lo,
                 above ? hi : lo);
   on_warning_(line, text);
 }
@@ -68,7 +69,7 @@ void ProgramFeeder::add_action(const motion::IoAction& action, int line) {
   move.action = action;
   move.line = line;
   move.path_mode = path_mode_;
-  pending.push_back(move);
+  pending_.push_back(move);
 }
 
 void ProgramFeeder::emit(const interp::CanonCommand& command) {
@@ -80,7 +81,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   // Spindle, coolant and output events are actions the servo thread does where the path
   // rests; a feed move after the spindle starts or changes speed waits until it is at speed.
   auto spindle = [&](int direction) {
-    spindle_direction = direction;
+    spindle_direction_ = direction;
     check_speed(m.line);
     add_action(spindle_action(), m.line);
     need_at_speed_ = direction != 0;
@@ -90,14 +91,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     flag = on;
     Action a;
     a.kind = Action::Kind::coolant;
-    a.flood = flood;
-    a.mist = mist;
+    a.flood = flood_;
+    a.mist = mist_;
     add_action(a, m.line);
     return false;
   };
   auto hold = [&](HoldInfo info) { add_hold(std::move(info), m.line); };
   auto tool_change = [&](int number) {
-    queue_tool_change(number, m.line, tool);
+    queue_tool_change(number, m.line, tool_);
     return false;
   };
   auto moving = [&](motion::Move& next) {
@@ -114,7 +115,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     end_ = next.end;
   };
   auto stop = [&] {
-    stop_seen = true;
+    stop_seen_ = true;
     return false;
   };
   const bool queued = std::visit(
@@ -134,12 +135,12 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               move.spindle_sync = motion::SpindleSync::thread;
               move.per_rev = per_rev_;
               move.feed = per_rev_ * nominal_rpm(end_[0]) / 60.0;
-              if (!unsupported && machine_ != nullptr) {
+              if (!unsupported_ && machine_ != nullptr) {
                 // G96 turns fastest at the end nearer the spindle's axis.
                 const double rpm = std::max(nominal_rpm(end_[0]), nominal_rpm(move.end[0]));
                 if (auto why = thread_too_fast(*machine_, end_, move.end, per_rev_, rpm,
-                                               spindle_direction, spindle_speed))
-                  unsupported = Unsupported{m.line, *why};
+                                               spindle_direction_, spindle_speed_))
+                  unsupported_ = Unsupported{m.line, *why};
               }
             } else {
               move.feed = feed_per_second();
@@ -149,9 +150,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return true;
           },
           [&](const in::RigidTap& c) {
-            if (!unsupported && machine_ != nullptr) {
+            if (!unsupported_ && machine_ != nullptr) {
               if (auto why = spindle_cannot_reverse(*machine_))
-                unsupported = Unsupported{m.line, *why};
+                unsupported_ = Unsupported{m.line, *why};
             }
             add_stop_point();
             move.kind = motion::Move::Kind::feed;
@@ -165,7 +166,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             // The tap ends where it started, the spindle turning as before: a feed move after
             // it waits until it is back at speed.
             end_ = start;
-            need_at_speed_ = spindle_direction != 0;
+            need_at_speed_ = spindle_direction_ != 0;
             return true;
           },
           [&](const in::ArcFeed& c) {
@@ -202,7 +203,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
                 break;
             }
             moving(move);
-            probe_seen = true;
+            probe_seen_ = true;
             return true;
           },
           [&](const in::SetFeedMode& c) {
@@ -213,14 +214,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             // G96 D (1e30 without D) or G97: the spindle takes the mode at once, S with it.
             css_max_rpm_ = std::isfinite(c.css_max_rpm) && c.css_max_rpm > 0 ? c.css_max_rpm : 0.0;
             add_action(spindle_action(), m.line);
-            need_at_speed_ = spindle_direction != 0;
+            need_at_speed_ = spindle_direction_ != 0;
             return false;
           },
           [&](const in::StartSpeedFeedSynch& c) {
             per_rev_ = c.feed_per_rev;
-            if (!unsupported && machine_ != nullptr) {
+            if (!unsupported_ && machine_ != nullptr) {
               if (auto why = spindle_position_missing(*machine_))
-                unsupported = Unsupported{m.line, *why};
+                unsupported_ = Unsupported{m.line, *why};
             }
             return false;
           },
@@ -248,15 +249,15 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return false;
           },
           [&](const in::ProgramStop&) { return stop(); },
-          [&](const in::OptionalProgramStop&) { return optional_stop && stop(); },
+          [&](const in::OptionalProgramStop&) { return optional_stop_ && stop(); },
           [&](const in::StartSpindleClockwise&) { return spindle(1); },
           [&](const in::StartSpindleCounterclockwise&) { return spindle(-1); },
           [&](const in::StopSpindleTurning&) { return spindle(0); },
           [&](const in::SetSpindleSpeed& c) {
-            spindle_speed = c.rpm;
+            spindle_speed_ = c.rpm;
             check_speed(m.line);
             add_action(spindle_action(), m.line);
-            need_at_speed_ = spindle_direction != 0;
+            need_at_speed_ = spindle_direction_ != 0;
             return false;
           },
           [&](const in::SetSpindleOverrideEnable& c) {
@@ -304,7 +305,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             a.mode = static_cast<std::int8_t>(c.mode);
             a.timeout_s = c.timeout_s;
             add_action(a, m.line);
-            input_wait_seen = true;
+            input_wait_seen_ = true;
             return false;
           },
           [&](const in::UserMCode& c) {
@@ -314,13 +315,13 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             hold(std::move(info));
             return false;
           },
-          [&](const in::MistOn&) { return coolant(mist, true); },
-          [&](const in::MistOff&) { return coolant(mist, false); },
-          [&](const in::FloodOn&) { return coolant(flood, true); },
-          [&](const in::FloodOff&) { return coolant(flood, false); },
+          [&](const in::MistOn&) { return coolant(mist_, true); },
+          [&](const in::MistOff&) { return coolant(mist_, false); },
+          [&](const in::FloodOn&) { return coolant(flood_, true); },
+          [&](const in::FloodOff&) { return coolant(flood_, false); },
           [&](const in::ChangeTool& c) { return tool_change(c.tool); },
           [&](const in::ChangeToolNumber& c) {
-            tool = c.tool;  // M61: the tool is already in the spindle
+            tool_ = c.tool;  // M61: the tool is already in the spindle
             return false;
           },
           [&](const in::Message& c) {
@@ -341,11 +342,11 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   move.tolerance = tolerance_;
   move.merge_tolerance =
       !alone && path_mode_ == motion::Move::PathMode::blend ? merge_tolerance_ : 0.0;
-  pending.push_back(move);
+  pending_.push_back(move);
 }
 
 double ProgramFeeder::nominal_rpm(double x) const {
-  if (css_max_rpm_ <= 0) return spindle_speed;
+  if (css_max_rpm_ <= 0) return spindle_speed_;
   const motion::IoAction a = spindle_action();
   const double radius = std::abs(x - a.css_x_origin);
   double rpm = radius > 1e-9 ? std::min(a.css_max_rpm, a.css_numerator / radius) : a.css_max_rpm;
@@ -360,28 +361,30 @@ double ProgramFeeder::feed_per_second() const {
   return (per_revolution_ ? f * nominal_rpm(end_[0]) : f) / 60.0;
 }
 
-Drained ProgramFeeder::drain(MoveTarget& target) {
-  while (!pending.empty()) {
-    if (!target.ready()) return {MoveTarget::Push::full, 0};
-    const motion::Move& move = pending.front();
+Drained ProgramFeeder::drain(motion::MoveQueue& queue) {
+  using Push = motion::MoveQueue::Push;
+  while (!pending_.empty()) {
+    if (!queue.ready()) return {Push::full, 0};
+    const motion::Move& move = pending_.front();
     if (stop_point(move)) {
-      target.flush();
-      pending.pop_front();
+      queue.end_path();
+      pending_.pop_front();
       continue;
     }
-    const MoveTarget::Push result = target.push(move);
-    if (result != MoveTarget::Push::accepted) return {result, move.line};
-    pending.pop_front();
+    const Push result = queue.push_move(move);
+    if (result != Push::accepted) return {result, move.line};
+    ++(move.kind == motion::Move::Kind::action ? actions_queued_ : moves_queued_);
+    pending_.pop_front();
   }
   return {};
 }
 
 void ProgramFeeder::add_stop_point() {
-  if (!pending.empty() && stop_point(pending.back())) return;
+  if (!pending_.empty() && stop_point(pending_.back())) return;
   motion::Move stop;
   stop.kind = motion::Move::Kind::dwell;
   stop.dwell_s = 0;
-  pending.push_back(stop);
+  pending_.push_back(stop);
 }
 
 }  // namespace cncd::pipeline

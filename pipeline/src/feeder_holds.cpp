@@ -1,5 +1,6 @@
 // The feeder's holds (a tool change, a user M code) and what a run from a line puts in front of
 // its first move: the tool, spindle and coolant the skipped lines left in force.
+#include <map>
 #include <utility>
 
 #include "cncd/pipeline/feeder.hpp"
@@ -12,12 +13,33 @@ void ProgramFeeder::add_hold(HoldInfo info, int line) {
   a.hold = info.kind;
   a.hold_id = next_hold_id_++;
   info.line = line;
-  holds[a.hold_id] = std::move(info);
+  holds_[a.hold_id] = std::move(info);
   add_action(a, line);
 }
 
+const HoldInfo* ProgramFeeder::hold(std::uint32_t id) const {
+  const auto found = holds_.find(id);
+  return found != holds_.end() ? &found->second : nullptr;
+}
+
+void ProgramFeeder::erase_tool_changes() {
+  std::erase_if(holds_,
+                [](const auto& h) { return h.second.kind == motion::IoAction::Hold::tool_change; });
+}
+
+bool ProgramFeeder::drop_pending(motion::AxisPose& end) {
+  bool moved = false;
+  for (const auto& move : pending_) {
+    if (move.kind == motion::Move::Kind::dwell || move.kind == motion::Move::Kind::action) continue;
+    end = move.end;
+    moved = true;
+  }
+  pending_.clear();
+  return moved;
+}
+
 void ProgramFeeder::queue_tool_change(int number, int line, int before) {
-  tool = number;
+  tool_ = number;
   const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
   if (change != nullptr && change->has_position) {
     // LinuxCNC's TOOL_CHANGE_POSITION: one traverse there, machine coordinates; the axes it
@@ -31,7 +53,7 @@ void ProgramFeeder::queue_tool_change(int number, int line, int before) {
       const auto k = static_cast<std::size_t>(i);
       if (change->position_given[k]) there.end[k] = change->position[k];
     }
-    pending.push_back(there);
+    pending_.push_back(there);
     end_ = there.end;
   }
   HoldInfo info;
@@ -44,7 +66,7 @@ void ProgramFeeder::queue_tool_change(int number, int line, int before) {
 void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPose& at,
                                       int in_spindle) {
   std::deque<motion::Move> rest;
-  rest.swap(pending);
+  rest.swap(pending_);
   const motion::AxisPose end = end_;
   end_ = at;
   if (machine_ == nullptr || !machine_->tool_change.with_spindle_on) {
@@ -54,7 +76,7 @@ void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPo
   }
   queue_tool_change(number, line, in_spindle);
   end_ = end;
-  pending.insert(pending.end(), rest.begin(), rest.end());
+  pending_.insert(pending_.end(), rest.begin(), rest.end());
 }
 
 void ProgramFeeder::restore_io_state() {
@@ -68,16 +90,16 @@ void ProgramFeeder::restore_io_state() {
   push(spindle_action());
   motion::IoAction coolant;
   coolant.kind = motion::IoAction::Kind::coolant;
-  coolant.flood = flood;
-  coolant.mist = mist;
+  coolant.flood = flood_;
+  coolant.mist = mist_;
   push(coolant);
-  if (spindle_direction != 0) {
+  if (spindle_direction_ != 0) {
     motion::IoAction at_speed;
     at_speed.kind = motion::IoAction::Kind::wait_at_speed;
     push(at_speed);
   }
   need_at_speed_ = false;
-  pending.insert(pending.begin(), front.begin(), front.end());
+  pending_.insert(pending_.begin(), front.begin(), front.end());
 }
 
 }  // namespace cncd::pipeline

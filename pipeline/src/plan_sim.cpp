@@ -12,9 +12,9 @@
 #include "cncd/drivers/sim_driver.hpp"
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/servo_loop.hpp"
-#include "cncd/pipeline/feeder.hpp"
 #include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/plan_geometry.hpp"
+#include "cncd/pipeline/program_runner.hpp"
 
 namespace cncd::pipeline {
 namespace {
@@ -28,9 +28,9 @@ double thread_cpu_s() {
 }
 
 // One simulation run: the interpreter feeding the planner and the servo loop as the daemon's
-// Task::feed() does, the loop stepped in virtual time. Operator messages are not passed on:
-// the simulation must not log them as if the program ran.
-class Simulation final : MoveTarget {
+// the daemon's task does (through ProgramRunner), the loop stepped in virtual time. Operator
+// messages are not passed on: the simulation must not log them as if the program ran.
+class Simulation final : motion::MoveQueue {
  public:
   Simulation(const config::MachineConfig& machine, std::string program,
              const PlanSimOptions& options, PlanSimResult& result)
@@ -39,8 +39,10 @@ class Simulation final : MoveTarget {
         options_(options),
         result_(result),
         interp_(options.interp),
-        feeder_(machine_units(machine), {}, &machine),
-        planner_(machine) {}
+        runner_(interp_, machine_units(machine), {}, &machine),
+        planner_(machine) {
+    runner_.read_through_waits(true);
+  }
 
   void run() {
     if (auto error = interp_.open(program_)) {
@@ -48,14 +50,14 @@ class Simulation final : MoveTarget {
       return;
     }
     if (!start_machine()) return;
-    feeder_.start_program(&previous_);
+    runner_.start(&previous_, false, 0);
     std::uint64_t& cycle = cycle_;
     for (;;) {
       if (!feed()) return;
       const motion::Status before = loop_->status();
       const std::uint64_t done_before = before.segments_done - base_;
       const std::uint64_t moves_before = before.moves_done - moves_base_;
-      if (interp_done_ && feeder_.pending.empty() && !planner_.holding() &&
+      if (runner_.ended() && runner_.drained() && !planner_.holding() &&
           planner_.output().empty() && done_before >= pushed_ &&
           before.motion == motion::MotionState::idle)
         break;
@@ -140,44 +142,46 @@ class Simulation final : MoveTarget {
   }
 
   // Fills the segment queue as far as it goes, reading the program as needed. False on error.
-  // As Task::feed() does: the planner holds the newest move back for look-ahead and is
-  // flushed at stop points, program stops and the program's end.
+  // The planner holds the newest move back for look-ahead and is flushed at stop points,
+  // program stops and the program's end, as in the daemon.
   bool feed() {
-    for (int blocks = 0;; ++blocks) {
-      const Drained drained = feeder_.drain(*this);
-      if (drained.result == Push::full) return true;
-      if (drained.result == Push::refused) return false;
-      if (interp_done_) planner_.flush();
-      if (!pump() || interp_done_) return true;
-      // A program reading thousands of blocks without a move still answers the budget.
-      if ((blocks & 4095) == 4095 && over_budget(interp_.current_line())) return false;
-      const auto step = interp_.step(feeder_);
-      if (step == interp::Interpreter::Step::error) {
-        const auto& error = interp_.error();
-        result_.error = error ? CheckProblem{error->file, error->line, error->message}
-                              : CheckProblem{program_, interp_.current_line(), "interpreter error"};
-        return false;
+    using Outcome = ProgramRunner::Outcome;
+    ProgramRunner::Budget budget;
+    budget.max_blocks = 4096;
+    for (;;) {
+      switch (runner_.advance(*this, budget)) {
+        case Outcome::needs_room:
+          return true;
+        case Outcome::ended:
+          pump();
+          return true;
+        case Outcome::stop:
+          // M0/M1/M60 wait for the operator: the estimate leaves that time out, but the machine
+          // comes to rest there.
+          runner_.clear_stop();
+          break;
+        case Outcome::error:
+          fail(runner_.error());
+          return false;
+        default:
+          // A program reading thousands of blocks without a move still answers the budget.
+          if (over_budget(interp_.current_line())) return false;
+          break;
       }
-      if (feeder_.unsupported) {
-        result_.error = CheckProblem{program_, feeder_.unsupported->line, feeder_.unsupported->why};
-        return false;
-      }
-      // M0/M1/M60 wait for the operator: the estimate leaves that time out, but the machine
-      // comes to rest there.
-      if (feeder_.stop_seen) {
-        motion::Move stop;
-        stop.kind = motion::Move::Kind::dwell;
-        feeder_.pending.push_back(stop);
-      }
-      feeder_.stop_seen = false;
-      if (step == interp::Interpreter::Step::end) interp_done_ = true;
     }
   }
 
-  // MoveTarget: the next move goes to the planner once its output is in the servo loop's ring.
+  void fail(const ProgramRunner::Error& error) {
+    using Kind = ProgramRunner::Error::Kind;
+    if (error.kind == Kind::refused) return;  // push_move() has said why
+    result_.error = error.interp ? CheckProblem{error.interp->file, error.line, error.message}
+                                 : CheckProblem{program_, error.line, error.message};
+  }
+
+  // MoveQueue: the next move goes to the planner once its output is in the servo loop's ring.
   bool ready() override { return pump(); }
 
-  Push push(const motion::Move& programmed) override {
+  Push push_move(const motion::Move& programmed) override {
     // No operator changes tools and no input changes here: holds and input waits take no time.
     motion::Move move = programmed;
     using Action = motion::IoAction::Kind;
@@ -202,7 +206,8 @@ class Simulation final : MoveTarget {
     return Push::accepted;
   }
 
-  void flush() override { planner_.flush(); }
+  void end_path() override { planner_.flush(); }
+  std::string refusal() const override { return result_.error ? result_.error->message : ""; }
 
   // Hands the planner's final segments to the servo loop; false when the ring is full.
   bool pump() {
@@ -301,7 +306,7 @@ class Simulation final : MoveTarget {
   const PlanSimOptions& options_;
   PlanSimResult& result_;
   interp::Interpreter interp_;
-  ProgramFeeder feeder_;
+  ProgramRunner runner_;
   motion::Planner planner_;
   drivers::SimDriver sim_;
   std::unique_ptr<motion::ServoLoop> loop_;
@@ -311,7 +316,6 @@ class Simulation final : MoveTarget {
   std::uint64_t moves_base_ = 0;       // moves done before the program
   motion::AxisPose programmed_end_{};  // where the last programmed move ends
   std::uint64_t pushed_ = 0;           // segments queued by the program
-  bool interp_done_ = false;
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};
   std::deque<motion::Segment> window_;  // queued segments from index window_first_ on

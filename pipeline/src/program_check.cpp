@@ -10,7 +10,7 @@
 
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/soft_limits.hpp"
-#include "cncd/pipeline/feeder.hpp"
+#include "cncd/pipeline/program_runner.hpp"
 
 namespace cncd::pipeline {
 
@@ -42,31 +42,30 @@ config::MachineConfig every_axis(interp::Units units) {
   return machine;
 }
 
-// Reads the program as the daemon's task does: the canonical commands go through the same
-// ProgramFeeder into machine moves, and an arc is the planner's own segment, so its reach is
-// judged on the geometry the machine will follow.
-class CheckSink final : public interp::CanonSink {
+// Reads the program as the daemon's task does: ProgramRunner takes the canonical commands
+// through the same feeder into machine moves, which come here, and an arc is the planner's own
+// segment, so its reach is judged on the geometry the machine will follow. Every canonical
+// command is seen here first (emit), for the trace and the counts.
+class CheckSink final : public interp::CanonSink, public motion::MoveQueue {
  public:
   CheckSink(const CheckOptions& options, CheckReport& report, std::string file)
       : options_(options),
         report_(report),
         file_(std::move(file)),
         machine_(options.machine ? *options.machine : every_axis(options.interp.machine_units)),
-        planner_(machine_),
-        feeder_(options.interp.machine_units, {}, &machine_) {}
+        planner_(machine_) {}
+
+  const config::MachineConfig& machine() const { return machine_; }
+  // The runner's feeder, whose offsets place a program's first move.
+  void follow(const ProgramFeeder& feeder) { feeder_ = &feeder; }
 
   // What stops the program besides the interpreter: a spindle the machine lacks.
-  std::optional<interp::InterpError> refusal;
+  std::optional<interp::InterpError> stops_it;
 
   // With CheckOptions::find_holes, the holes so far.
   const std::vector<Hole>& holes() const { return holes_.holes(); }
 
-  void start_at(const Pose& machine) {
-    position_ = machine;
-    motion::AxisPose at{};
-    std::copy(machine.begin(), machine.end(), at.begin());
-    feeder_.start_program(&at);
-  }
+  void start_at(const Pose& machine) { position_ = machine; }
 
   void emit(const CanonCommand& command) override {
     if (options_.trace) options_.trace->emit(command);
@@ -80,35 +79,34 @@ class CheckSink final : public interp::CanonSink {
                    [](const auto&) {},
                },
                command.op);
-    feeder_.emit(command);
-    if (feeder_.unsupported && !refusal) {
-      refusal = interp::InterpError{file_, feeder_.unsupported->line, 0, feeder_.unsupported->why};
-    }
-    while (!feeder_.pending.empty()) {
-      const motion::Move move = feeder_.pending.front();
-      feeder_.pending.pop_front();
-      switch (move.kind) {
-        case motion::Move::Kind::traverse:
-        case motion::Move::Kind::feed:
-          line(move);
-          break;
-        case motion::Move::Kind::arc:
-          arc(move);
-          break;
-        case motion::Move::Kind::dwell:
-          break;
-        case motion::Move::Kind::action:
-          if (move.action.kind == motion::IoAction::Kind::spindle && move.action.direction != 0 &&
-              machine_.spindle.driver == config::SpindleDriver::none && !refusal) {
-            refusal = interp::InterpError{
-                file_, move.line, 0,
-                std::string(move.action.direction > 0 ? "M3" : "M4") +
-                    " starts a spindle the machine does not have ([SPINDLE_0] DRIVER = none)"};
-          }
-          break;
-      }
-    }
   }
+
+  Push push_move(const motion::Move& move) override {
+    switch (move.kind) {
+      case motion::Move::Kind::traverse:
+      case motion::Move::Kind::feed:
+        line(move);
+        break;
+      case motion::Move::Kind::arc:
+        arc(move);
+        break;
+      case motion::Move::Kind::dwell:
+        break;
+      case motion::Move::Kind::action:
+        if (move.action.kind == motion::IoAction::Kind::spindle && move.action.direction != 0 &&
+            machine_.spindle.driver == config::SpindleDriver::none && !stops_it) {
+          stops_it = interp::InterpError{
+              file_, move.line, 0,
+              std::string(move.action.direction > 0 ? "M3" : "M4") +
+                  " starts a spindle the machine does not have ([SPINDLE_0] DRIVER = none)"};
+        }
+        break;
+    }
+    return Push::accepted;
+  }
+  // Nothing is held back for look-ahead here, and nothing is refused.
+  void end_path() override {}
+  std::string refusal() const override { return {}; }
 
  private:
   void line(const motion::Move& move) {
@@ -149,7 +147,8 @@ class CheckSink final : public interp::CanonSink {
   void ensure_start() {
     if (started_) return;
     started_ = true;
-    if (!options_.start_machine) position_ = feeder_.tracker().machine_pose(Pose{});
+    if (!options_.start_machine && feeder_ != nullptr)
+      position_ = feeder_->tracker().machine_pose(Pose{});
     start_ = position_;
   }
 
@@ -274,7 +273,7 @@ class CheckSink final : public interp::CanonSink {
   std::string file_;
   config::MachineConfig machine_;
   motion::Planner planner_;
-  ProgramFeeder feeder_;
+  const ProgramFeeder* feeder_ = nullptr;
   Pose position_{};
   Pose start_{};
   bool started_ = false;
@@ -295,6 +294,10 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
   report.inch_machine = options.interp.machine_units == interp::Units::inches;
   interp::Interpreter interp(options.interp);
   CheckSink sink(options, report, program.string());
+  ProgramRunner runner(interp, options.interp.machine_units, {}, &sink.machine());
+  runner.read_through_waits(true);
+  runner.tap(&sink);
+  sink.follow(runner.feeder());
   if (auto error = interp.open(program)) {
     report.error = std::move(error);
     return report;
@@ -303,6 +306,9 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
   if (options.start_machine) {
     interp.set_machine_position(*options.start_machine);
     sink.start_at(*options.start_machine);
+    motion::AxisPose at{};
+    std::copy(options.start_machine->begin(), options.start_machine->end(), at.begin());
+    runner.start(&at, false, 0);
   }
   const auto seconds = [&options] {
     if (!options.max_seconds_cpu) {
@@ -329,11 +335,21 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
                                         " blocks): the program runs too long to check"};
       break;
     }
-    const auto step = interp.step(sink);
-    if (step == interp::Interpreter::Step::error) {
-      report.error = interp.error();
-      break;
+    ProgramRunner::Budget one_block;
+    one_block.max_blocks = 1;
+    const auto outcome = runner.advance(sink, one_block);
+    if (outcome == ProgramRunner::Outcome::error) {
+      // What the failing block queued before its error is checked too.
+      runner.drain(sink);
+      const ProgramRunner::Error& error = runner.error();
+      if (error.kind == ProgramRunner::Error::Kind::interpreter) {
+        report.error = error.interp;
+        break;
+      }
+      if (!sink.stops_it)
+        sink.stops_it = interp::InterpError{program.string(), error.line, 0, error.message};
     }
+    runner.clear_stop();  // M0/M1/M60 take no time here
     ++report.blocks;
     if (options.preview != nullptr && options.preview->has_block()) {
       const interp::InterpState state = interp.state();
@@ -347,11 +363,11 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
       frame.rotation_deg = state.rotation_deg;
       options.preview->end_block(cycle, frame);
     }
-    if (sink.refusal) {
-      report.error = sink.refusal;
+    if (sink.stops_it) {
+      report.error = sink.stops_it;
       break;
     }
-    if (step == interp::Interpreter::Step::end) break;
+    if (outcome == ProgramRunner::Outcome::ended) break;
   }
   report.holes = sink.holes();
   return report;

@@ -11,16 +11,17 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
+#include "cncd/motion/move_queue.hpp"
 #include "cncd/motion/servo_loop.hpp"
 #include "cncd/motion/status.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::motion {
 
-class MotionController {
+class MotionController final : public MoveQueue {
  public:
   explicit MotionController(const config::MachineConfig& config);
-  ~MotionController();
+  ~MotionController() override;
   MotionController(const MotionController&) = delete;
   MotionController& operator=(const MotionController&) = delete;
 
@@ -51,6 +52,10 @@ class MotionController {
   // Forgets the move held back (a run that starts afresh or ended early). abort() does too.
   void discard();
   const std::string& enqueue_error() const;
+  // MoveQueue: enqueue(), flush() and enqueue_error() as a program's runner calls them.
+  Push push_move(const Move& move) override;
+  void end_path() override { flush(); }
+  std::string refusal() const override { return enqueue_error(); }
   // Free slots in the segment queue.
   std::size_t queue_space() const;
 

@@ -1,8 +1,7 @@
 // ProgramFeeder: the canonical-command sink that turns the interpreter's output into motion
 // moves (machine coordinates and units) and remembers spindle, coolant and tool state, and
-// the loop that hands those moves on (drain). The daemon's task feeds them to the motion
-// controller, the plan simulation to a planner of its own: both read a program the same way.
-// One thread at a time.
+// what the program waits for. ProgramRunner reads a program through it and hands its moves to
+// a motion::MoveQueue. One thread at a time.
 #pragma once
 
 #include <cstdint>
@@ -11,29 +10,19 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/canon.hpp"
 #include "cncd/interp/to_machine.hpp"
+#include "cncd/motion/move_queue.hpp"
 #include "cncd/motion/types.hpp"
 
 namespace cncd::pipeline {
 
-// Where drain() hands the moves: the motion controller's queue or a planner.
-class MoveTarget {
- public:
-  enum class Push { accepted, full, refused };
-  virtual ~MoveTarget() = default;
-  // Whether the next move may be handed on now (a stop point included).
-  virtual bool ready() { return true; }
-  virtual Push push(const motion::Move& move) = 0;
-  // A stop point: the move held back for look-ahead goes out, the path comes to rest there.
-  virtual void flush() = 0;
-};
-
 struct Drained {
-  MoveTarget::Push result = MoveTarget::Push::accepted;  // accepted: nothing left pending
-  int line = 0;                                          // the refused move's line
+  motion::MoveQueue::Push result = motion::MoveQueue::Push::accepted;  // accepted: none left
+  int line = 0;                                                        // the refused move's line
 };
 
 // What a hold (IoAction::Kind::hold) waits for, by its id: the task shows it and answers it.
@@ -89,42 +78,67 @@ class ProgramFeeder final : public interp::CanonSink {
   static bool stop_point(const motion::Move& move) {
     return move.kind == motion::Move::Kind::dwell && !(move.dwell_s > 0);
   }
-  // Hands the pending moves to `target` in order, flushing it at stop points, until none is
-  // left, the target has no room, or it refuses one (which stays pending).
-  Drained drain(MoveTarget& target);
+  // Hands the pending moves to `queue` in order, ending its path at stop points, until none is
+  // left, the queue has no room, or it refuses one (which stays pending).
+  Drained drain(motion::MoveQueue& queue);
   // Where the machine stands after a move that ended early (a probing move that tripped): the
   // next move starts there (machine coordinates).
   void set_position(const motion::AxisPose& at) { end_ = at; }
   // Offsets, units and feed as the commands so far left them.
   const interp::MachineTracker& tracker() const { return tracker_; }
 
-  std::deque<motion::Move> pending;  // moves the planner had no room for yet
-  bool stop_seen = false;            // M0/M1/M60 reached in the stream
-  // M1 stops only while this is true (the panel's OPTIONAL_STOP switch; none wired: always).
-  bool optional_stop = true;
-  // M66 reached in the stream: the interpreter must not read on until the machine has waited
-  // and its result is in #5399 (Interpreter::set_input_result()). The caller clears it.
-  bool input_wait_seen = false;
-  // A probing move (G38.x) reached in the stream: likewise, the interpreter must not read on
-  // until the machine has probed and Interpreter::set_probe_result() has the answer. The
-  // caller clears it.
-  bool probe_seen = false;
+  bool has_pending() const { return !pending_.empty(); }
+  // Moves and actions the queue has taken since start_program().
+  std::uint64_t moves_queued() const { return moves_queued_; }
+  std::uint64_t actions_queued() const { return actions_queued_; }
+  // Drops the pending moves (run from line: the lines before it); true with `end` set where
+  // the last of them that moves ends.
+  bool drop_pending(motion::AxisPose& end);
+  // Puts `move` in front of the pending moves.
+  void queue_first(const motion::Move& move) { pending_.push_front(move); }
+
+  // What the stream has reached since the flag was last taken: M0/M1/M60 (a stop), M66 (the
+  // interpreter must not read on until the machine has waited and its result is in #5399) and
+  // a probing move (likewise, until Interpreter::set_probe_result() has the answer).
+  bool take_stop() { return std::exchange(stop_seen_, false); }
+  bool take_input_wait() { return std::exchange(input_wait_seen_, false); }
+  bool take_probe() { return std::exchange(probe_seen_, false); }
   // Something in the stream this machine cannot run (spindle-synchronized motion): its line and
-  // why. The caller stops the program there.
+  // why. The program stops there.
   struct Unsupported {
     int line = 0;
     std::string why;
   };
-  std::optional<Unsupported> unsupported;
-  // The holds queued, by id; the caller erases those it has answered.
-  std::map<std::uint32_t, HoldInfo> holds;
-  int spindle_direction = 0;  // 1 cw, -1 ccw, 0 stopped
-  double spindle_speed = 0;   // rpm
-  bool mist = false;
-  bool flood = false;
-  int tool = 0;
+  const std::optional<Unsupported>& unsupported() const { return unsupported_; }
+
+  // The holds queued, by id; the task erases those it has answered.
+  const std::map<std::uint32_t, HoldInfo>& holds() const { return holds_; }
+  const HoldInfo* hold(std::uint32_t id) const;
+  void erase_hold(std::uint32_t id) { holds_.erase(id); }
+  void erase_tool_changes();
+  void clear_holds() { holds_.clear(); }
+
+  // M1 stops only while this is true (the panel's OPTIONAL_STOP switch; none wired: always).
+  bool optional_stop() const { return optional_stop_; }
+  void set_optional_stop(bool on) { optional_stop_ = on; }
+  // The tool in the spindle when the program starts.
+  void set_tool(int number) { tool_ = number; }
 
  private:
+  std::deque<motion::Move> pending_;  // moves the queue had no room for yet
+  std::uint64_t moves_queued_ = 0;
+  std::uint64_t actions_queued_ = 0;
+  bool stop_seen_ = false;
+  bool optional_stop_ = true;
+  bool input_wait_seen_ = false;
+  bool probe_seen_ = false;
+  std::optional<Unsupported> unsupported_;
+  std::map<std::uint32_t, HoldInfo> holds_;
+  int spindle_direction_ = 0;  // 1 cw, -1 ccw, 0 stopped
+  double spindle_speed_ = 0;   // rpm
+  bool mist_ = false;
+  bool flood_ = false;
+  int tool_ = 0;
   interp::MachineTracker tracker_;
   MessageHandler on_message_;
   // Queues a stop point (a zero dwell) where a spindle, coolant or tool event comes in the
