@@ -220,10 +220,8 @@ void Interpreter::Impl::do_g92(int code) {
     parameters_.set(5210, 1);
   } else if (code == 921 || code == 922) {
     offset = Pose{};
-    if (code == 921) {
-      write_offset_parameters(kG92Base, offset, 0x1FFU);
-      parameters_.set(5210, 0);
-    }
+    if (code == 921) write_offset_parameters(kG92Base, offset, 0x1FFU);
+    parameters_.set(5210, 0);  // G92.2 keeps the offsets' parameters but disables them
   } else {
     offset = read_offset_parameters(kG92Base);
     parameters_.set(5210, 1);
