@@ -51,6 +51,7 @@ void Interpreter::Impl::check_supported_codes() const {
       fail(not_supported('M', code * 10), b.m_column[static_cast<std::size_t>(group)]);
     }
   }
+  check_modal_state_line();
 }
 
 void Interpreter::Impl::check_block() const {

@@ -93,7 +93,7 @@ CodeInfo m_code_info(int code) {
       {19, 19, MGroup::spindle, false},    {6, 6, MGroup::tool_change, true},
       {61, 61, MGroup::tool_change, true}, {7, 9, MGroup::coolant, true},
       {48, 53, MGroup::overrides, true},   {62, 68, MGroup::io, true},
-      {70, 73, MGroup::spindle, false},    {98, 99, MGroup::stopping, true},
+      {70, 73, MGroup::spindle, true},     {98, 99, MGroup::stopping, true},
       {100, 199, MGroup::user, true},
   };
   for (const Codes& codes : kCodes) {

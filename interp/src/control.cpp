@@ -208,6 +208,7 @@ void Interpreter::Impl::do_return(bool has_value, double value) {
     fail("for #" + std::to_string(open.var) + " of line " + std::to_string(open.for_line) +
          " has no next before the end of subroutine " + o_label(frame.name));
   }
+  auto_restore_modal_state();
   calls_.pop_back();
   control_.resize(frame.control_depth);
   parameters_.pop_scope();

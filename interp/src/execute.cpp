@@ -129,23 +129,9 @@ std::string Interpreter::Impl::substitute_parameters(const std::string& text) co
 void Interpreter::Impl::do_feed_mode() {
   const int code = block_.g_code(GGroup::feed_mode);
   if (code >= 0) {
-    if (code == 930) {
-      emit_comment("interpreter: feed mode set to inverse time");
-      emit(SetFeedMode{FeedRateMode::per_minute});
-      modal_.feed_mode = FeedMode::inverse_time;
-    } else if (code == 940) {
-      emit_comment("interpreter: feed mode set to units per minute");
-      emit(SetFeedMode{FeedRateMode::per_minute});
-      modal_.feed_mode = FeedMode::units_per_minute;
-      modal_.feed_rate = 0;
-      emit(SetFeedRate{0.0});
-    } else {
-      emit_comment("interpreter: feed mode set to units per revolution");
-      emit(SetFeedMode{FeedRateMode::per_revolution});
-      modal_.feed_mode = FeedMode::units_per_rev;
-      modal_.feed_rate = 0;
-      emit(SetFeedRate{0.0});
-    }
+    set_feed_mode(code == 930   ? FeedMode::inverse_time
+                  : code == 940 ? FeedMode::units_per_minute
+                                : FeedMode::units_per_rev);
   }
   if (block_.has('f')) {
     modal_.feed_rate = block_.get('f');
@@ -153,6 +139,24 @@ void Interpreter::Impl::do_feed_mode() {
       emit(SetFeedRate{modal_.feed_rate});
     }
   }
+}
+
+// G93, G94 or G95: the feed rate starts again from 0 in the modes that keep one.
+void Interpreter::Impl::set_feed_mode(FeedMode mode) {
+  if (mode == FeedMode::inverse_time) {
+    emit_comment("interpreter: feed mode set to inverse time");
+    emit(SetFeedMode{FeedRateMode::per_minute});
+  } else if (mode == FeedMode::units_per_minute) {
+    emit_comment("interpreter: feed mode set to units per minute");
+    emit(SetFeedMode{FeedRateMode::per_minute});
+  } else {
+    emit_comment("interpreter: feed mode set to units per revolution");
+    emit(SetFeedMode{FeedRateMode::per_revolution});
+  }
+  modal_.feed_mode = mode;
+  if (mode == FeedMode::inverse_time) return;
+  modal_.feed_rate = 0;
+  emit(SetFeedRate{0.0});
 }
 
 void Interpreter::Impl::do_tool_and_spindle() {
@@ -211,7 +215,8 @@ void Interpreter::Impl::do_tool_and_spindle() {
       modal_.spindle = SpindleDir::stopped;
       emit(StopSpindleTurning{});
       break;
-    default:
+    default:  // M70-M73 share the group
+      if (block_.m_code(MGroup::spindle) >= 70) do_modal_state(block_.m_code(MGroup::spindle));
       break;
   }
 }

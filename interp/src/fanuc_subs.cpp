@@ -156,6 +156,9 @@ void Interpreter::Impl::do_m99() {
         "of their own");
   }
   if (frame.repeats_left > 0) {
+    // Each pass is a call of its own: what its M70/M73 saved ends with it.
+    auto_restore_modal_state();
+    frame.saved_modal = SavedModalState{};
     --frame.repeats_left;
     control_.resize(frame.control_depth);
     loop_back(frame.sub_offset, frame.sub_line_before);

@@ -127,6 +127,15 @@ struct SubInfo {
   bool fanuc = false;  // a bare "O100" line: called by M98, ended by M99
 };
 
+// M70/M73: the modal state one call level saved, for M72 (and, M73, its return) to restore.
+struct SavedModalState {
+  bool valid = false;
+  bool auto_restore = false;  // M73 in a subroutine: restored when it returns
+  ModalState modal;
+  Pose tool_offset{};        // G43.1's offsets
+  bool g92_applied = false;  // #5210
+};
+
 struct CallFrame {
   std::string name;
   std::size_t source = 0;  // the caller's source
@@ -141,6 +150,7 @@ struct CallFrame {
   int repeats_left = 0;
   std::int64_t sub_offset = 0;
   int sub_line_before = 0;
+  SavedModalState saved_modal;  // M70/M73 in this subroutine
 };
 
 class CanonSink;
@@ -216,6 +226,7 @@ struct Interpreter::Impl {
   std::optional<double> predefined_parameter(std::string_view name) const;
   void publish_parameters();
   void do_feed_mode();
+  void set_feed_mode(FeedMode mode);
   void do_tool_and_spindle();
   void do_coolant_and_overrides();
   // io.cpp
@@ -290,6 +301,16 @@ struct Interpreter::Impl {
   void do_m98();
   void do_m99();
   bool find_fanuc_sub(const std::string& name);
+  // modal_state.cpp: M70-M73.
+  void do_modal_state(int code);
+  void check_modal_state_line() const;
+  SavedModalState& saved_modal_state();
+  void restore_modal_state(const SavedModalState& saved);
+  void restore_modes(const SavedModalState& saved);
+  void restore_coolant(const ModalState& saved);
+  void restore_overrides(const ModalState& saved);
+  // Before a subroutine returns (endsub, return, M99): the state its M73 saved comes back.
+  void auto_restore_modal_state();
   void skip_block(const std::string& name, std::initializer_list<OKind> stops);
   bool find_indexed_sub(const std::string& name, std::int64_t offset);
   bool find_sub(const std::string& name);
@@ -360,6 +381,7 @@ struct Interpreter::Impl {
   int tool_prepped_ = -1;
   std::vector<ControlFrame> control_;
   std::vector<CallFrame> calls_;
+  SavedModalState saved_modal_top_;  // M70/M73 in the main program
   std::unordered_map<std::string, SubInfo> subs_;
   std::int64_t line_offset_ = 0;  // offset of the line being executed
   int line_before_ = 0;           // line number before it

@@ -67,6 +67,7 @@ void Interpreter::Impl::reset_modal_state() {
   g92_offset_ = parameters_.get(5210) != 0.0 ? read_offset_parameters(kG92Base) : Pose{};
   control_.clear();
   calls_.clear();
+  saved_modal_top_ = SavedModalState{};
   subs_.clear();
   preamble_done_ = false;
   ended_ = false;
