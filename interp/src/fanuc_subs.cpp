@@ -146,11 +146,7 @@ void Interpreter::Impl::do_m99() {
   if (!frame.fanuc)
     fail("'O.... endsub' or 'O.... return' must follow 'O.... sub' subroutine definition");
   // LinuxCNC stops here with an internal error ("Bug: Reached convert_stop() from M99 ...").
-  bool g_codes = false;
-  for (const int g : block_.g)
-    g_codes = g_codes || g >= 0;
-  if (block_.present != 0 || g_codes || block_.m_count > 1 || block_.has_polar_distance ||
-      block_.has_polar_angle) {
+  if (block_has_other_words()) {
     fail(
         "An M99 that ends a subprogram must be alone on its line: put the other words on a line "
         "of their own");

@@ -304,6 +304,7 @@ struct Interpreter::Impl {
   // modal_state.cpp: M70-M73.
   void do_modal_state(int code);
   void check_modal_state_line() const;
+  bool block_has_other_words() const;
   SavedModalState& saved_modal_state();
   void restore_modal_state(const SavedModalState& saved);
   void restore_modes(const SavedModalState& saved);

@@ -21,13 +21,17 @@ void Interpreter::Impl::check_modal_state_line() const {
   if (dialect_ == Dialect::numeryx)
     fail("M" + std::to_string(code) + " is not supported in the Numeryx dialect", column);
   if (code != 72) return;
+  if (block_has_other_words())
+    fail("An M72 line takes no other words: put them on a line of their own", column);
+}
+
+// Any word but N, comments and the one M code: a letter, a G code, another M code, polar words.
+bool Interpreter::Impl::block_has_other_words() const {
   bool g_codes = false;
   for (const int g : block_.g)
     g_codes = g_codes || g >= 0;
-  if (block_.present != 0 || g_codes || block_.m_count > 1 || block_.has_polar_distance ||
-      block_.has_polar_angle) {
-    fail("An M72 line takes no other words: put them on a line of their own", column);
-  }
+  return block_.present != 0 || g_codes || block_.m_count > 1 || block_.has_polar_distance ||
+         block_.has_polar_angle;
 }
 
 void Interpreter::Impl::do_modal_state(int code) {
