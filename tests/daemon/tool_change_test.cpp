@@ -73,12 +73,15 @@ class OnTerminal {
   // output meanwhile.
   int wait() {
     int status = 0;
-    for (int i = 0; i < 1200; ++i) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+    while (std::chrono::steady_clock::now() < deadline) {
       if (::waitpid(pid_, &status, WNOHANG) == pid_) {
         pid_ = -1;
         return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
       }
-      read_some();
+      // Once the terminal has closed, poll() no longer waits: the process may still be on its
+      // way out.
+      if (!read_some()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return -1;
   }
