@@ -123,6 +123,9 @@ constexpr std::array kMachineKeys{
                "thread) or sim:NAME; Modbus answers too late to stop on contact"),
     signal_key("CNCD", "ANALOG_INPUT_n",
                "Analog input n (0-15) that M66 E reads: input or holding register, or sim"),
+    real_key("CNCD", "RUN_FROM_LINE_SAFE_Z", "", -kInf, kInf, "machine units",
+             "Run from a line: the height (machine coordinates) Z rises to before X and Y move "
+             "over the line's start; empty: [AXIS_Z] MAX_LIMIT"),
     positive_key("CNCD", "USER_M_TIMEOUT", "60", "s",
                  "A user M code (M100-M199) still running after this long is stopped and the "
                  "program with it"),

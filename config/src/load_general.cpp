@@ -147,6 +147,7 @@ void load_cncd(TypedReader& r, CncdConfig& cncd) {
   }
   if (const auto v = r.integer("CNCD", "RT_PRIORITY")) cncd.rt_priority = static_cast<int>(*v);
   if (const auto v = r.integer("CNCD", "RT_CPU")) cncd.rt_cpu = static_cast<int>(*v);
+  cncd.run_from_line_safe_z = r.real("CNCD", "RUN_FROM_LINE_SAFE_Z");
   if (const auto v = r.choice("CNCD", "LOG_LEVEL")) {
     cncd.log_level = *v == "warning" ? "warn" : *v;
   }

@@ -345,6 +345,16 @@ void check_tool_change(TypedReader& r, const MachineConfig& c) {
     }
   }
   if (t.quill_up) outside(2, 0, "TOOL_CHANGE_QUILL_UP", "Z 0 (machine zero)");
+  // Run from line: the height the tool rises to must be one the machine can reach.
+  const AxisConfig& z = c.axes[2];
+  if (const auto safe = c.cncd.run_from_line_safe_z;
+      safe && z.present && !r.failed("AXIS_Z", "MIN_LIMIT") && !r.failed("AXIS_Z", "MAX_LIMIT") &&
+      (*safe < z.min_limit || *safe > z.max_limit)) {
+    r.problem("CNCD", "RUN_FROM_LINE_SAFE_Z",
+              format_number(*safe) + " is outside [AXIS_Z] MIN_LIMIT " +
+                  format_number(z.min_limit) + " to MAX_LIMIT " + format_number(z.max_limit) +
+                  ": a run from a line could not rise to it");
+  }
 }
 
 }  // namespace

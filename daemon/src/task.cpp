@@ -121,7 +121,8 @@ void Task::run_program(int from_line, bool step) {
   // The file may have been changed since it was opened.
   program_dialect_ = interp_->dialect();
   start_run(Mode::automatic, status);
-  runner_->skip_to(from_line, status.commanded, tool_at_start_);
+  runner_->skip_to(from_line, status.commanded, tool_at_start_,
+                   pipeline::run_from_line_safe_z(config_));
   from_top_ = !runner_->skipping();
   run_from_line_ = from_top_ ? 0 : from_line;
   approach_done_s_.reset();
@@ -335,8 +336,9 @@ void Task::poll() {
     interp_->set_machine_position(at);
     runner_->probe_done(status.commanded);
   }
-  // Run from line: the remaining time counts from when the traverse to the line has ended.
-  if (runner_->skipped_motion() && !approach_done_s_ && status.moves_done > moves_done_base_)
+  // Run from line: the remaining time counts from when the way to the line has ended.
+  if (runner_->skipped_motion() && !runner_->skipping() && !approach_done_s_ &&
+      status.moves_done - moves_done_base_ >= static_cast<std::uint64_t>(runner_->approach_moves()))
     approach_done_s_ = moving_s();
   if (exec_ == ExecState::paused) return;
   feed();

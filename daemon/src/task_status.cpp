@@ -7,6 +7,8 @@
 
 #include "task.hpp"
 
+#include "cncd/pipeline/modal_text.hpp"
+
 namespace cncd::daemon {
 
 namespace {
@@ -77,30 +79,6 @@ motion::AxisPose work_pose(const motion::AxisPose& machine, const interp::Interp
   return p;
 }
 
-// 593 -> "G59.3": LinuxCNC's codes are ten times the number.
-std::string code_name(char letter, int code) {
-  std::string out(1, letter);
-  out += std::to_string(code / 10);
-  if (code % 10 != 0) out += "." + std::to_string(code % 10);
-  return out;
-}
-
-// The active codes in LinuxCNC's modal-group order, without the line number and empty groups.
-std::vector<std::string> active_g_codes(const interp::InterpState& st) {
-  std::vector<std::string> out;
-  for (std::size_t i = 1; i < st.gcodes.size(); ++i) {
-    if (st.gcodes[i] >= 0) out.push_back(code_name('G', st.gcodes[i]));
-  }
-  return out;
-}
-
-std::vector<std::string> active_m_codes(const interp::InterpState& st) {
-  std::vector<std::string> out;
-  for (std::size_t i = 1; i < st.mcodes.size(); ++i) {
-    if (st.mcodes[i] >= 0) out.push_back("M" + std::to_string(st.mcodes[i]));
-  }
-  return out;
-}
 }  // namespace
 
 const char* machine_state_name(motion::MachineState state) {
@@ -114,7 +92,7 @@ const char* exec_state_name(ExecState state) {
 }
 
 std::string coord_system_name(int system) {
-  return code_name('G', system < 7 ? 530 + 10 * system : 584 + system);
+  return pipeline::code_name('G', system < 7 ? 530 + 10 * system : 584 + system);
 }
 
 void Task::set_exec(ExecState next) {
@@ -143,8 +121,8 @@ void Task::time_estimate(std::uint64_t moves_done, ProgramReport& out) const {
   // override or a hold cannot drift it away.
   double active = moving_s();
   if (!from_top_) {
-    // Run from line: the estimate from the line's first move on. The traverse to the line's
-    // start was not estimated: until it ends the whole rest of the program remains.
+    // Run from line: the estimate from the line's first move on. The way to the line's start
+    // was not estimated: until it ends the whole rest of the program remains.
     // Looked up once a run: a status request must not walk millions of moves.
     if (first_move_.lines != estimate.move_line || first_move_.line != run_from_line_) {
       const auto& lines = *estimate.move_line;
@@ -163,7 +141,7 @@ void Task::time_estimate(std::uint64_t moves_done, ProgramReport& out) const {
       out.remaining_s = total - starts[k0];
       return;
     }
-    moves_done += k0 - (runner_->skipped_motion() ? 1 : 0);
+    moves_done += k0 - static_cast<std::uint64_t>(runner_->approach_moves());
     active += starts[k0] - approach_done_s_.value_or(0.0);
   }
   if (moves_done >= starts.size()) {
@@ -284,8 +262,8 @@ TaskStatus Task::status() const {
   out.tool.length_offset = st.tool_offset;
   if (st.tool_in_spindle != 0) out.tool.entry = interp_->tool(st.tool_in_spindle);
   out.offsets = {st.coord_system, st.g5x_offset, st.rotation_deg, st.g92_offset};
-  out.gcodes = active_g_codes(st);
-  out.mcodes = active_m_codes(st);
+  out.gcodes = pipeline::active_g_codes(st);
+  out.mcodes = pipeline::active_m_codes(st);
   out.feed_rate = st.feed_rate;
   out.rt = s.rt;
   if (config_.panel.present) out.panel = panel_report(s);

@@ -404,6 +404,9 @@ void Interpreter::set_probe_result(const Pose& trip_machine, bool tripped) {
 int Interpreter::current_line() const {
   return impl_->current_line_;
 }
+int Interpreter::program_line() const {
+  return impl_->sources_.size() > 1 ? impl_->sources_.front().line_number() : impl_->current_line_;
+}
 
 Dialect Interpreter::dialect() const {
   return impl_->dialect_;

@@ -11,6 +11,7 @@ namespace cncd::pipeline {
 void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   pending_.clear();
   moves_queued_ = actions_queued_ = 0;
+  approach_moves_ = 0;
   stop_seen_ = false;
   input_wait_seen_ = false;
   probe_seen_ = false;

@@ -1,7 +1,11 @@
 // The feeder's holds (a tool change, a user M code) and what a run from a line puts in front of
 // its first move: the tool, spindle and coolant the skipped lines left in force.
+#include <algorithm>
 #include <map>
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "cncd/pipeline/feeder.hpp"
 
@@ -77,6 +81,43 @@ void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPo
   queue_tool_change(number, line, in_spindle);
   end_ = end;
   pending_.insert(pending_.end(), rest.begin(), rest.end());
+}
+
+std::optional<std::string> ProgramFeeder::approach_first(const motion::AxisPose& from,
+                                                         const motion::AxisPose& to, double safe_z,
+                                                         int line) {
+  approach_moves_ = 0;
+  if (from == to) return std::nullopt;  // already there
+  constexpr std::size_t kZ = 2;
+  const bool has_z = machine_ == nullptr || machine_->axes[kZ].present;
+  const double high = has_z ? std::max(from[kZ], safe_z) : from[kZ];
+  std::vector<motion::Move> way;
+  const auto add = [&](motion::Move::Kind kind, motion::AxisPose end) {
+    motion::Move move;
+    move.kind = kind;
+    move.end = end;
+    move.line = line;
+    move.path_mode = motion::Move::PathMode::exact_stop;  // no corner of the way is cut
+    way.push_back(move);
+  };
+  motion::AxisPose up = from;
+  up[kZ] = high;
+  if (up != from) add(motion::Move::Kind::traverse, up);
+  motion::AxisPose over = to;
+  over[kZ] = high;
+  if (over != up) add(motion::Move::Kind::traverse, over);
+  if (to != over) {
+    const double feed = feed_per_second();
+    if (!(feed > 0)) {
+      return "no feed is in force to move Z down to the line's start: set F on a line before "
+             "it";
+    }
+    add(motion::Move::Kind::feed, to);
+    way.back().feed = feed;
+  }
+  pending_.insert(pending_.begin(), way.begin(), way.end());
+  approach_moves_ = static_cast<int>(way.size());
+  return std::nullopt;
 }
 
 void ProgramFeeder::restore_io_state() {

@@ -11,6 +11,10 @@ interp::Units machine_units(const config::MachineConfig& config) {
                                                           : interp::Units::mm;
 }
 
+double run_from_line_safe_z(const config::MachineConfig& config) {
+  return config.cncd.run_from_line_safe_z.value_or(config.axes[2].max_limit);
+}
+
 interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   interp::InterpOptions options;
   options.machine_units = machine_units(config);

@@ -50,7 +50,10 @@ class Simulation final : motion::MoveQueue {
       return;
     }
     if (!start_machine()) return;
-    runner_.start(&previous_, false, 0);
+    const int tool = interp_.state().tool_in_spindle;
+    runner_.start(&previous_, false, tool);
+    if (options_.from_line > 1)
+      runner_.skip_to(options_.from_line, previous_, tool, run_from_line_safe_z(machine_));
     std::uint64_t& cycle = cycle_;
     for (;;) {
       if (!feed()) return;

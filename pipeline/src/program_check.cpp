@@ -11,6 +11,7 @@
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/soft_limits.hpp"
 #include "cncd/pipeline/program_runner.hpp"
+#include "number_text.hpp"
 
 namespace cncd::pipeline {
 
@@ -19,13 +20,6 @@ using interp::kAxes;
 using interp::Pose;
 
 namespace {
-
-std::string number(double value) {
-  char text[64];
-  // %.4f of an absurd number would print hundreds of digits.
-  std::snprintf(text, sizeof text, std::abs(value) <= 1e9 ? "%.4f" : "%.10g", value);
-  return text;
-}
 
 double xyz_distance(const Pose& a, const Pose& b) {
   return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
@@ -81,7 +75,11 @@ class CheckSink final : public interp::CanonSink, public motion::MoveQueue {
                command.op);
   }
 
+  // Run from line: the moves of the block that reaches the line, its lead-in first.
+  std::vector<motion::Move>* record = nullptr;
+
   Push push_move(const motion::Move& move) override {
+    if (record != nullptr) record->push_back(move);
     switch (move.kind) {
       case motion::Move::Kind::traverse:
       case motion::Move::Kind::feed:
@@ -178,11 +176,11 @@ class CheckSink final : public interp::CanonSink, public motion::MoveQueue {
     if (!first_report(line, axis, above)) return;
     std::string message =
         !finite
-            ? std::string(what) + ": " + letter + " " + number(value) + " is not a finite number"
-            : std::string(what) + ": " + letter + " " + number(value) + " is " +
+            ? std::string(what) + ": " + letter + " " + fixed4(value) + " is not a finite number"
+            : std::string(what) + ": " + letter + " " + fixed4(value) + " is " +
                   (above ? "above" : "below") + " [AXIS_" + letter + "] " +
                   (above ? "MAX_LIMIT " : "MIN_LIMIT ") +
-                  number(above ? limits.max_limit : limits.min_limit) + " (machine coordinates)";
+                  fixed4(above ? limits.max_limit : limits.min_limit) + " (machine coordinates)";
     report_.problems.push_back({file_, line, std::move(message)});
   }
 
@@ -308,7 +306,21 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     sink.start_at(*options.start_machine);
     motion::AxisPose at{};
     std::copy(options.start_machine->begin(), options.start_machine->end(), at.begin());
-    runner.start(&at, false, 0);
+    runner.start(&at, false, interp.state().tool_in_spindle);
+  }
+  std::vector<motion::Move> reaching;
+  if (options.from_line > 1) {
+    const interp::InterpState state = interp.state();
+    motion::AxisPose at{};
+    for (std::size_t i = 0; i < kAxes; ++i) {
+      at[i] = options.start_machine
+                  ? (*options.start_machine)[i]
+                  : state.g5x_offset[i] + state.g92_offset[i] + state.tool_offset[i];
+    }
+    // Without a machine there is no Z limit to rise to: Z stays at its height.
+    const double safe_z = options.machine ? run_from_line_safe_z(*options.machine) : at[2];
+    runner.skip_to(options.from_line, at, state.tool_in_spindle, safe_z);
+    report.from_line = FromLineReport{options.from_line, false, state, {}};
   }
   const auto seconds = [&options] {
     if (!options.max_seconds_cpu) {
@@ -330,14 +342,28 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     if (options.max_seconds > 0 && report.blocks % 16 == 15 &&
         seconds() - start > options.max_seconds) {
       report.stopped = CheckProblem{program.string(), interp.current_line(),
-                                    "check stopped after " + number(options.max_seconds) + " s (" +
+                                    "check stopped after " + fixed4(options.max_seconds) + " s (" +
                                         std::to_string(report.blocks) +
                                         " blocks): the program runs too long to check"};
       break;
     }
     ProgramRunner::Budget one_block;
     one_block.max_blocks = 1;
+    const bool skipping = runner.skipping();
+    reaching.clear();
+    sink.record = skipping ? &reaching : nullptr;
     const auto outcome = runner.advance(sink, one_block);
+    sink.record = nullptr;
+    if (skipping && outcome != ProgramRunner::Outcome::error) {
+      if (runner.skipping()) {
+        report.from_line->state = interp.state();
+      } else {
+        report.from_line->reached = true;
+        const auto lead_in = std::min(runner.lead_in(), reaching.size());
+        report.from_line->lead_in.assign(reaching.begin(),
+                                         reaching.begin() + static_cast<std::ptrdiff_t>(lead_in));
+      }
+    }
     if (outcome == ProgramRunner::Outcome::error) {
       // What the failing block queued before its error is checked too.
       runner.drain(sink);
@@ -383,56 +409,6 @@ bool names_its_dialect(const std::filesystem::path& program) {
   interp::Interpreter as_numeryx(options);
   return !as_linuxcnc.open(program) && !as_numeryx.open(program) &&
          as_linuxcnc.dialect() == as_numeryx.dialect();
-}
-
-std::string describe(const CheckReport& report) {
-  const char* unit = report.inch_machine ? "in" : "mm";
-  std::string text =
-      "moves: " + std::to_string(report.traverses + report.feeds + report.arcs) + " (" +
-      std::to_string(report.traverses) + " rapid, " + std::to_string(report.feeds) + " feed, " +
-      std::to_string(report.arcs) + " arc), " + std::to_string(report.dwells) + " dwell" +
-      (report.dwells == 1 ? "" : "s") + ", " + std::to_string(report.blocks) + " blocks\n";
-  text += std::string("extents (machine coordinates, ") + unit + "):\n";
-  bool any = false;
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    if (!report.moved[axis]) continue;
-    any = true;
-    const bool angular = axis >= 3 && axis <= 5;
-    text += std::string("  ") + config::kAxisLetters[axis] + " " + number(report.min[axis]) +
-            " .. " + number(report.max[axis]) + (angular ? " deg" : "") + "\n";
-  }
-  if (!any) text += "  (no axis moves)\n";
-  text += "tools:";
-  if (report.tools.empty()) text += " none";
-  for (const int tool : report.tools)
-    text += " T" + std::to_string(tool);
-  text += "\nfeed path: " + number(report.feed_length) + " " + unit + "\n";
-  if (!report.limits_checked) {
-    text += "soft limits: not checked (no --ini; interpreter defaults)\n";
-  } else if (report.limit_violations == 0) {
-    text += "soft limits: every move within them\n";
-  } else {
-    text += "soft limits: " + std::to_string(report.limit_violations) + " violation" +
-            (report.limit_violations == 1 ? "" : "s") + "\n";
-  }
-  return text;
-}
-
-std::string describe_holes(const CheckReport& report) {
-  std::string text = "holes: " + std::to_string(report.holes.size()) + " (machine coordinates, " +
-                     (report.inch_machine ? "in" : "mm") + ")\n";
-  char row[160];
-  std::snprintf(row, sizeof row, "%5s %7s %12s %12s %12s %12s\n", "hole", "line", "X", "Y", "top",
-                "bottom");
-  text += row;
-  for (std::size_t n = 0; n < report.holes.size(); ++n) {
-    const Hole& h = report.holes[n];
-    std::snprintf(row, sizeof row, "%5zu %7d %12s %12s %12s %12s\n", n + 1, h.line,
-                  number(h.x).c_str(), number(h.y).c_str(), number(h.top).c_str(),
-                  number(h.bottom).c_str());
-    text += row;
-  }
-  return text;
 }
 
 }  // namespace cncd::pipeline

@@ -20,11 +20,15 @@ void ProgramRunner::start(const motion::AxisPose* at, bool mdi, int tool) {
   step_budget_ = 0;
   blocks_ = 0;
   skip_to_ = 0;
+  lead_in_ = 0;
   skip_moved_ = false;
 }
 
-void ProgramRunner::skip_to(int line, const motion::AxisPose& at, int tool_in_spindle) {
+void ProgramRunner::skip_to(int line, const motion::AxisPose& at, int tool_in_spindle,
+                            double safe_z) {
+  safe_z_ = safe_z;
   skip_to_ = line > 1 ? line : 0;
+  lead_in_ = 0;
   skip_moved_ = false;
   skip_from_ = at;
   skip_end_ = at;
@@ -71,6 +75,7 @@ ProgramRunner::Outcome ProgramRunner::advance(motion::MoveQueue& queue, const Bu
       return Outcome::yielded;
     // Nothing is read ahead of what the queue can take.
     if (!queue.ready()) return Outcome::needs_room;
+    const int line_before = interp_.program_line();
     const auto step = interp_.step(sink_);
     if (step == interp::Interpreter::Step::error) {
       const auto& error = interp_.error();
@@ -79,13 +84,15 @@ ProgramRunner::Outcome ProgramRunner::advance(motion::MoveQueue& queue, const Bu
     }
     ++blocks_;
     if (stepping_) --step_budget_;
-    if (auto outcome = after_block(step == interp::Interpreter::Step::end)) return *outcome;
+    if (auto outcome = after_block(step == interp::Interpreter::Step::end, line_before))
+      return *outcome;
   }
 }
 
-std::optional<ProgramRunner::Outcome> ProgramRunner::after_block(bool program_ended) {
+std::optional<ProgramRunner::Outcome> ProgramRunner::after_block(bool program_ended,
+                                                                 int line_before) {
   if (skip_to_ > 0) {
-    if (auto outcome = skip_block(program_ended)) return outcome;
+    if (auto outcome = skip_block(program_ended, line_before)) return outcome;
   }
   // A skipped line's wait is dropped with it; its M0/M1 does not stop a run from line.
   if (feeder_.take_input_wait()) input_wait_ = skip_to_ == 0 && !through_waits_;
@@ -97,8 +104,10 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::after_block(bool program_en
   return std::nullopt;
 }
 
-std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_ended) {
-  const int line = interp_.current_line();
+std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_ended,
+                                                                int line_before) {
+  // Lines of the program's own file: a subroutine file it calls has its own numbers.
+  const int line = interp_.program_line();
   if (line < skip_to_) {
     if (program_ended) {
       return fail({Error::Kind::ends_before_line,
@@ -111,12 +120,21 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_end
     feeder_.clear_holds();  // the tool changes and user M codes of the lines skipped
     return std::nullopt;
   }
+  if (line_before < skip_to_ && line > skip_to_) {
+    // The block read past the line without running it: the line is in a subroutine's
+    // definition or a branch or loop not taken there. Starting later would not be that line.
+    return fail({Error::Kind::not_run,
+                 skip_to_,
+                 "line " + std::to_string(skip_to_) +
+                     " is not run where the program first reaches it (it is inside a "
+                     "subroutine definition, or a branch or loop skipped there): run from the "
+                     "line that calls it or from one the program runs",
+                 {}});
+  }
+  const std::size_t own = feeder_.pending_count();
   if (skip_moved_) {
-    motion::Move approach;
-    approach.kind = motion::Move::Kind::traverse;
-    approach.end = skip_end_;
-    approach.line = line;
-    feeder_.queue_first(approach);
+    if (auto why = feeder_.approach_first(skip_from_, skip_end_, safe_z_, line))
+      return fail({Error::Kind::approach, line, std::move(*why), {}});
   }
   // The spindle and coolant as the skipped lines left them, before the machine moves there.
   feeder_.restore_io_state();
@@ -124,6 +142,7 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_end
   // is already in the line's positions, so the operator puts it in before anything moves.
   if (const int in_force = interp_.state().tool_in_spindle; in_force != tool_at_start_)
     feeder_.change_tool_first(in_force, line, skip_from_, tool_at_start_);
+  lead_in_ = feeder_.pending_count() - own;
   skip_to_ = 0;
   return std::nullopt;
 }

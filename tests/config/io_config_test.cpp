@@ -244,5 +244,17 @@ TEST_F(IoConfigTest, ToolChangePositionMustBeThreeSixOrNineNumbersInsideTheLimit
                        "MIN_LIMIT 10: the tool change would leave the soft limits"));
 }
 
+TEST_F(IoConfigTest, RunFromLineSafeZDefaultsToTheTopOfZAndMustBeWithinItsLimits) {
+  const auto plain = loaded(minimal_ini());
+  EXPECT_FALSE(plain.cncd.run_from_line_safe_z);
+  const auto set = loaded(minimal_ini() + "[CNCD]\nRUN_FROM_LINE_SAFE_Z = 25.5\n");
+  EXPECT_EQ(set.cncd.run_from_line_safe_z, 25.5);
+  EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nRUN_FROM_LINE_SAFE_Z = 150\n"),
+            problem_at(43,
+                       "[CNCD] RUN_FROM_LINE_SAFE_Z: 150 is outside [AXIS_Z] MIN_LIMIT -10 to "
+                       "MAX_LIMIT 100: a run from a line could not rise to it"));
+  EXPECT_EQ(problems_of(minimal_ini() + "[CNCD]\nRUN_FROM_LINE_SAFE_Z = high\n").size(), 1u);
+}
+
 }  // namespace
 }  // namespace cncd::config::test

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/plan_sim.hpp"
 #include "daemon_process.hpp"
 
@@ -280,6 +281,113 @@ TEST_F(PlanSimTest, ARefusedMoveLeavesOnlyTheLinesThatStartedInTheReport) {
   }
   EXPECT_EQ(lines, started);
   EXPECT_EQ(std::count(lines.begin(), lines.end(), 4), 0);
+}
+
+struct Sample {
+  double t;
+  motion::AxisPose at;
+};
+
+// Run from a line, read through the same runner as the daemon: the way to the line's start on
+// the servo loop's own trajectory.
+class FromLinePlan : public PlanSimTest {
+ protected:
+  void SetUp() override {
+    PlanSimTest::SetUp();
+    options_.start_machine = interp::Pose{};
+    options_.on_sample = [this](double t, const motion::AxisPose& at, double) {
+      samples_.push_back({t, at});
+    };
+  }
+  pipeline::PlanSimResult simulate_from(const std::string& program, int from_line) {
+    options_.from_line = from_line;
+    samples_.clear();
+    return simulate(program);
+  }
+
+  std::vector<Sample> samples_;
+};
+
+constexpr const char* kPart =
+    "G21 G90\n"       // 1
+    "G0 X30 Y20\n"    // 2
+    "G1 Z-5 F1500\n"  // 3
+    "G1 X40\n"        // 4
+    "G1 Y30\n"        // 5
+    "G0 Z10\n"        // 6
+    "M2\n";           // 7
+
+// From line 5: the lines before leave the tool at X40 Y20 Z-5. Z rises to [AXIS_Z] MAX_LIMIT
+// (50) first, X and Y go over the start at that height, and Z comes down at F1500 (25 mm/s):
+// every servo period of the way is checked.
+TEST_F(FromLinePlan, ZRisesBeforeXAndYMoveAndComesDownAtTheFeed) {
+  const double safe = pipeline::run_from_line_safe_z(*loaded_.config);
+  ASSERT_EQ(safe, 50.0);
+  const auto r = simulate_from(kPart, 5);
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+  ASSERT_GT(samples_.size(), 100u);
+  bool reached_top = false, left_start = false, over_start = false;
+  for (std::size_t i = 0; i < samples_.size(); ++i) {
+    const auto& at = samples_[i].at;
+    const bool at_origin = std::hypot(at[0], at[1]) < 1e-9;
+    const bool over = std::hypot(at[0] - 40, at[1] - 20) < 1e-9;
+    if (std::abs(at[2] - safe) < 1e-9) reached_top = true;
+    if (!at_origin && !left_start) {
+      left_start = true;
+      EXPECT_TRUE(reached_top) << "X or Y moved at Z " << at[2] << ", t " << samples_[i].t;
+    }
+    if (!at_origin && !over_start && !over) {
+      EXPECT_NEAR(at[2], safe, 1e-9) << "X" << at[0] << " Y" << at[1] << ", t " << samples_[i].t;
+    }
+    if (over && left_start) over_start = true;
+    if (over_start && at[1] <= 20 + 1e-9 && i > 0) {
+      // Coming down: no faster than the feed in force (25 mm/s), never below the start.
+      const double speed = std::abs(at[2] - samples_[i - 1].at[2]) / r.period_s;
+      EXPECT_LE(speed, 25.0 * (1 + 1e-6)) << "t " << samples_[i].t;
+      EXPECT_GE(at[2], -5 - 1e-9);
+    }
+  }
+  EXPECT_TRUE(left_start && over_start);
+  // Then line 5 and line 6 as written.
+  EXPECT_NEAR(samples_.back().at[0], 40, 1e-9);
+  EXPECT_NEAR(samples_.back().at[1], 30, 1e-9);
+  EXPECT_NEAR(samples_.back().at[2], 10, 1e-9);
+}
+
+// [CNCD] RUN_FROM_LINE_SAFE_Z sets the height; a machine already higher moves over where it is.
+TEST_F(FromLinePlan, TheSafeHeightComesFromTheIniAndAHigherZStaysWhereItIs) {
+  config::MachineConfig machine = *loaded_.config;
+  machine.cncd.run_from_line_safe_z = 5.0;
+  options_.from_line = 5;
+  double top = -1e9;
+  // The way ends at Y20, where line 5 starts its move to Y30.
+  options_.on_sample = [&](double, const motion::AxisPose& at, double) {
+    if (at[1] < 20 + 1e-9) top = std::max(top, at[2]);
+  };
+  auto r = pipeline::simulate_plan(machine, dir_.write("prog.ngc", kPart), options_);
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+  EXPECT_NEAR(top, 5.0, 1e-9);
+  options_.start_machine = interp::Pose{0, 0, 30};
+  options_.from_line = 5;
+  bool moved_below_start = false;
+  options_.on_sample = [&](double, const motion::AxisPose& at, double) {
+    if (std::hypot(at[0] - 40, at[1] - 20) > 1e-9 && at[1] < 20 + 1e-9 && at[2] < 30 - 1e-9)
+      moved_below_start = true;
+  };
+  r = pipeline::simulate_plan(machine, dir_.write("prog.ngc", kPart), options_);
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+  EXPECT_FALSE(moved_below_start);
+}
+
+// The way down needs a feed: a program with none in force before or on the line is refused at
+// the line, before anything moves.
+TEST_F(FromLinePlan, NoFeedForTheWayDownIsRefusedAtTheLine) {
+  const auto r = simulate_from("G21 G90\nG0 X30 Y20 Z-5\nG0 X40\nG1 Y30 F600\nM2\n", 3);
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 3);
+  EXPECT_NE(r.error->message.find("no feed is in force"), std::string::npos) << r.error->message;
+  for (const auto& s : samples_)
+    EXPECT_EQ(s.at, motion::AxisPose{});
 }
 
 }  // namespace

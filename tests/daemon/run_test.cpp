@@ -20,10 +20,10 @@ TEST_F(MachineTest, RunFromLineKeepsModalStateOffsetsAndSkipsMotion) {
   result_of(call("program.run", {{"from_line", 5}}));
   const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
-  // The traverse to where line 5 starts (X15 Y5 in machine coordinates), line 5 (G91 kept:
-  // to X16 Y6), line 6 (G54 X0 with the origin set on line 2: machine X10). The skipped
-  // G0 of line 3 and the M0 of line 4 did nothing.
-  EXPECT_EQ(s["program"]["moves"], 3);
+  // The way to where line 5 starts (X15 Y5 in machine coordinates: Z up to the safe height,
+  // X and Y over it, Z down), line 5 (G91 kept: to X16 Y6), line 6 (G54 X0 with the origin
+  // set on line 2: machine X10). The skipped G0 of line 3 and the M0 of line 4 did nothing.
+  EXPECT_EQ(s["program"]["moves"], 5);
   EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 10.0, 1e-9);
   EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), 6.0, 1e-9);
   EXPECT_EQ(s["offsets"]["g5x"]["x"], 10.0);

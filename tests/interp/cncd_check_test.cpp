@@ -245,5 +245,67 @@ TEST_F(CncdCheckTest, AnArcIsJudgedOnThePlannersSegment) {
   EXPECT_EQ(plan.error->line, 5);
 }
 
+// --from-line prints what the lines before leave in force and what is done before the line,
+// in order: the tool, the spindle and coolant, Z up, over the start, Z down at the feed.
+TEST_F(CncdCheckTest, FromLinePrintsTheRebuiltStateAndTheWayToTheLine) {
+  const std::string program =
+      "G21 G90\nT1 M6\nS8000 M3\nM8\nG0 X30 Y20\nG1 Z-5 F1500\nG1 X40\nG1 Y30\nM2\n";
+  const auto r = check(program, {"--ini", ini_.string(), "--from-line", "8"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  const std::vector<std::string> expected{
+      "from line 8:\n",
+      "  modal: G1 G17 G40 G21 G90 G94 G54 G49 G99 G64 G97 G91.1 G8 M3 M8 M48 M53\n",
+      "  F1500.0000 S8000.0000 T1\n",
+      "    wait for the tool change\n",
+      "    spindle M3 8000.0000 rpm\n",
+      "    coolant flood\n",
+      "    wait for the spindle at speed\n",
+      "    rapid to X0.0000 Y0.0000 Z50.0000\n",
+      "    rapid to X40.0000 Y20.0000 Z50.0000\n",
+      "    feed to X40.0000 Y20.0000 Z-5.0000 at 1500.0000 mm/min\n"};
+  std::size_t at = 0;
+  for (const auto& line : expected) {
+    const auto found = r.out.find(line, at);
+    ASSERT_NE(found, std::string::npos) << line << " in order in\n" << r.out;
+    at = found + line.size();
+  }
+  // Only the moves from line 8 on are checked: X stays at 40.
+  EXPECT_NE(r.out.find("  X 40.0000 .. 40.0000\n"), std::string::npos) << r.out;
+
+  const auto past = check(program, {"--ini", ini_.string(), "--from-line", "12"});
+  EXPECT_EQ(past.exit_status, 1);
+  EXPECT_NE(past.err.find("prog.ngc:9: the program ends at line 9, before line 12"),
+            std::string::npos)
+      << past.err;
+  EXPECT_EQ(check(program, {"--from-line", "0"}).exit_status, 2);
+  EXPECT_EQ(check(program, {"--canon", "--from-line", "3"}).exit_status, 2);
+}
+
+// A line inside a subroutine's definition is passed without being run where the program first
+// reaches it: refused. A call's line and a loop's first pass start where asked.
+TEST_F(CncdCheckTest, FromALineInsideASubroutineDefinitionIsRefusedAndACallLineWorks) {
+  const std::string program =
+      "G21 G90 F1000\no100 sub\n  G1 X#1 Y5\n  G1 Z-1\n  G0 Z5\no100 endsub\nG0 Z5\n"
+      "o100 call [10]\no100 call [20]\no101 repeat [3]\n  G91 G1 X1\n  G90\n"
+      "o101 endrepeat\nM2\n";
+  const auto inside = check(program, {"--ini", ini_.string(), "--from-line", "4"});
+  EXPECT_EQ(inside.exit_status, 1);
+  EXPECT_NE(inside.err.find("prog.ngc:4: line 4 is not run where the program first reaches it"),
+            std::string::npos)
+      << inside.err;
+  const auto call = check(program, {"--ini", ini_.string(), "--from-line", "9"});
+  EXPECT_EQ(call.exit_status, 0) << call.err;
+  // The first call's moves are skipped: the way leads to where it left the tool.
+  EXPECT_NE(call.out.find("    rapid to X10.0000 Y5.0000 Z50.0000\n"
+                          "    feed to X10.0000 Y5.0000 Z5.0000 at 1000.0000 mm/min\n"),
+            std::string::npos)
+      << call.out;
+  EXPECT_NE(call.out.find("  X 10.0000 .. 23.0000\n"), std::string::npos) << call.out;
+  const auto loop = check(program, {"--ini", ini_.string(), "--from-line", "11"});
+  EXPECT_EQ(loop.exit_status, 0) << loop.err;
+  EXPECT_NE(loop.out.find("    rapid to X20.0000 Y5.0000 Z50.0000\n"), std::string::npos)
+      << loop.out;
+}
+
 }  // namespace
 }  // namespace cncd::test

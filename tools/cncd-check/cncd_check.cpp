@@ -46,6 +46,7 @@ int usage(const std::string& why) {
          "                  [-t TOOL.tbl] [-v PARAMS.var] [--max-seconds S] PROGRAM.ngc\n"
          "       cncd-check --plan [--json] [--trajectory FILE.csv] --ini FILE [...] PROGRAM.ngc\n"
          "       cncd-check --preview [--tolerance T] [--ini FILE ...] PROGRAM.ngc\n"
+         "       cncd-check --from-line N [--plan] --ini FILE [...] PROGRAM.ngc\n"
          "  --ini FILE   take units, tool table, parameter file (read only), subroutine path,\n"
          "               start-up code and the axis soft limits from the machine's INI\n"
          "  --state-dir DIR  where the machine's parameter file and tool table live\n"
@@ -70,6 +71,10 @@ int usage(const std::string& why) {
          "               leaves out, machine units (default 0.01 mm, 0.0004 in)\n"
          "  --trajectory FILE.csv  with --plan: write t, every axis and the spindle's\n"
          "               position (revolutions) per servo period\n"
+         "  --from-line N  run from line N as cncd does: check (or plan) from there on, and\n"
+         "               print the state the lines before it leave and what is done before\n"
+         "               it (tool, spindle, coolant, Z up, over the start, Z down) with\n"
+         "               the machine at program zero\n"
          "exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI\n";
   return kExitUsage;
 }
@@ -181,6 +186,7 @@ int main(int argc, char** argv) {
   config::LoadOptions load_options;
   std::string program;
   double max_seconds = 600;
+  int from_line = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
@@ -198,7 +204,7 @@ int main(int argc, char** argv) {
       inch = true;
     } else if (arg == "--ini" || arg == "--tool-units" || arg == "-t" || arg == "-v" ||
                arg == "--max-seconds" || arg == "--trajectory" || arg == "--state-dir" ||
-               arg == "--dialect" || arg == "--tolerance") {
+               arg == "--dialect" || arg == "--tolerance" || arg == "--from-line") {
       if (!has_value) return usage(arg + " needs a value");
       const std::string value = argv[++i];
       if (arg == "--ini") {
@@ -215,6 +221,12 @@ int main(int argc, char** argv) {
         tolerance = std::strtod(value.c_str(), &end);
         if (*end != '\0' || !(*tolerance > 0) || !std::isfinite(*tolerance))
           return usage("--tolerance needs a number above 0");
+      } else if (arg == "--from-line") {
+        char* end = nullptr;
+        const long line = std::strtol(value.c_str(), &end, 10);
+        if (*end != '\0' || value.empty() || line < 1 || line > 1'000'000'000)
+          return usage("--from-line needs a line number from 1 on");
+        from_line = static_cast<int>(line);
       } else if (arg == "--max-seconds") {
         char* end = nullptr;
         max_seconds = std::strtod(value.c_str(), &end);
@@ -245,6 +257,8 @@ int main(int argc, char** argv) {
   if (preview && (plan || canon || holes))
     return usage("--preview goes without --plan, --canon and --holes");
   if (tolerance && !preview) return usage("--tolerance goes with --preview");
+  if (from_line > 0 && (canon || holes || preview))
+    return usage("--from-line goes without --canon, --holes and --preview");
 
   pipeline::CheckOptions options;
   options.max_seconds = max_seconds;
@@ -296,6 +310,7 @@ int main(int argc, char** argv) {
     pipeline::PlanSimOptions plan_options;
     plan_options.interp = options.interp;
     plan_options.max_wall_s = max_seconds;
+    plan_options.from_line = from_line;
     return check_plan(*loaded->config, program, plan_options, json, trajectory);
   }
   if (preview) {
@@ -315,6 +330,7 @@ int main(int argc, char** argv) {
   interp::Rs274Printer printer(std::cout);
   if (canon) options.trace = &printer;
   options.find_holes = holes;
+  options.from_line = from_line;
   const pipeline::CheckReport report = pipeline::check_program(program, options);
   // A program that could not even be opened has nothing to summarise.
   if (!canon && (report.blocks > 0 || !report.error)) {
@@ -324,6 +340,8 @@ int main(int argc, char** argv) {
       std::cout << "dialect: " << interp::dialect_name(report.dialect) << " ("
                 << dialect_origin(options.interp, !ini.empty(), program) << ")\n"
                 << pipeline::describe(report);
+      if (report.from_line)
+        std::cout << pipeline::describe_from_line(*report.from_line, report.inch_machine);
     }
   }
   std::cout.flush();

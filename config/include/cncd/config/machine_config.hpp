@@ -185,6 +185,9 @@ struct CncdConfig {
   int control_reserve = 8;
   int rt_priority = 80;            // SCHED_FIFO priority of the servo thread
   int rt_cpu = -1;                 // CPU to pin the servo thread to, -1 = any
+  // Run from line: Z rises to this height (machine coordinates) before X and Y move over the
+  // line's start; none: [AXIS_Z] MAX_LIMIT.
+  std::optional<double> run_from_line_safe_z;
   std::string log_level = "info";  // trace|debug|info|warn|error|critical|off
   // Where the parameter, tool and position files named by relative paths live: --state-dir,
   // else [CNCD] STATE_DIR, else $STATE_DIRECTORY (systemd), else $XDG_STATE_HOME/cncd/<INI

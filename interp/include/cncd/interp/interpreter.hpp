@@ -194,6 +194,9 @@ class Interpreter {
 
   // Line number of the block last executed.
   int current_line() const;
+  // The line of the open program's own file the interpreter stands at: current_line() there,
+  // and inside a subroutine file the line of the call that entered it.
+  int program_line() const;
 
   // The dialect in effect for the open program: InterpOptions::dialect, or the one its first
   // line names.

@@ -73,6 +73,14 @@ class ProgramFeeder final : public interp::CanonSink {
   // hold for the operator); `at` is where the machine stands (machine coordinates), `in_spindle`
   // the tool it has.
   void change_tool_first(int number, int line, const motion::AxisPose& at, int in_spindle);
+  // Run from line: the way from `from`, where the machine stands, to `to`, where the lines
+  // skipped leave the tool, in front of the pending moves: Z up to `safe_z` (it stays where it
+  // is when higher), the other axes over `to` at rapid, then Z down to `to` at the feed in
+  // force. An error (nothing queued) when the way down has no feed in force.
+  std::optional<std::string> approach_first(const motion::AxisPose& from,
+                                            const motion::AxisPose& to, double safe_z, int line);
+  // The moves approach_first() queued (0 to 3).
+  int approach_moves() const { return approach_moves_; }
   // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
   // planner is flushed there.
   static bool stop_point(const motion::Move& move) {
@@ -88,14 +96,13 @@ class ProgramFeeder final : public interp::CanonSink {
   const interp::MachineTracker& tracker() const { return tracker_; }
 
   bool has_pending() const { return !pending_.empty(); }
+  std::size_t pending_count() const { return pending_.size(); }
   // Moves and actions the queue has taken since start_program().
   std::uint64_t moves_queued() const { return moves_queued_; }
   std::uint64_t actions_queued() const { return actions_queued_; }
   // Drops the pending moves (run from line: the lines before it); true with `end` set where
   // the last of them that moves ends.
   bool drop_pending(motion::AxisPose& end);
-  // Puts `move` in front of the pending moves.
-  void queue_first(const motion::Move& move) { pending_.push_front(move); }
 
   // What the stream has reached since the flag was last taken: M0/M1/M60 (a stop), M66 (the
   // interpreter must not read on until the machine has waited and its result is in #5399) and
@@ -126,6 +133,7 @@ class ProgramFeeder final : public interp::CanonSink {
 
  private:
   std::deque<motion::Move> pending_;  // moves the queue had no room for yet
+  int approach_moves_ = 0;
   std::uint64_t moves_queued_ = 0;
   std::uint64_t actions_queued_ = 0;
   bool stop_seen_ = false;

@@ -28,6 +28,9 @@ struct PlanSimOptions {
   // Where the machine stands when the program starts (machine coordinates and units); unset =
   // program zero in the coordinate system the program starts in.
   std::optional<interp::Pose> start_machine;
+  // Run from this line (> 1) as the daemon does: the lines before it read for their state,
+  // then the way to the line's start from start_machine (ProgramRunner::skip_to).
+  int from_line = 0;
   // The simulation stops (PlanSimResult::stopped) after this much wall-clock time, after this
   // much simulated machine time, or past this many moves; 0 = no limit.
   double max_wall_s = 0;

@@ -17,6 +17,7 @@
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/pipeline/holes.hpp"
 #include "cncd/pipeline/machine.hpp"
+#include "cncd/pipeline/modal_text.hpp"
 #include "cncd/pipeline/preview.hpp"
 
 namespace cncd::pipeline {
@@ -53,6 +54,9 @@ struct CheckOptions {
   bool find_holes = false;
   // Receives the path for display (cncd-check --preview, program.preview).
   PreviewBuilder* preview = nullptr;
+  // Run from this line (> 1) as the daemon does (ProgramRunner::skip_to): only the moves from
+  // the line on are checked, and CheckReport::from_line says what is rebuilt and done first.
+  int from_line = 0;
 };
 
 struct CheckReport {
@@ -82,6 +86,8 @@ struct CheckReport {
   // Moves beyond a soft limit, in program order.
   std::vector<CheckProblem> problems;
   std::size_t limit_violations = 0;  // all of them, including those not kept
+  // With CheckOptions::from_line.
+  std::optional<FromLineReport> from_line;
 
   bool ok() const { return !error && !stopped && limit_violations == 0; }
 };

@@ -31,10 +31,12 @@ class ProgramRunner {
   };
   struct Error {
     enum class Kind {
-      interpreter,      // the interpreter's error (interp set)
-      refused,          // the queue refused a move (message is its refusal())
-      unsupported,      // something this machine cannot run
-      ends_before_line  // run from line: the program ends before that line
+      interpreter,       // the interpreter's error (interp set)
+      refused,           // the queue refused a move (message is its refusal())
+      unsupported,       // something this machine cannot run
+      ends_before_line,  // run from line: the program ends before that line
+      approach,          // run from line: no way to the line's start (no feed for Z down)
+      not_run            // run from line: the program passes the line without running it
     };
     Kind kind = Kind::interpreter;
     int line = 0;
@@ -54,13 +56,19 @@ class ProgramRunner {
   // A new run of what the interpreter has open; `at` is where the machine stands (machine
   // coordinates) when known, `tool` the tool in the spindle.
   void start(const motion::AxisPose* at, bool mdi, int tool);
-  // Run from line: the blocks before `line` are read for their state, their moves dropped; at
-  // the line the spindle and coolant they leave are set, the tool they leave in force put in
-  // (the machine has `tool_in_spindle`), and one traverse goes from `at` to where they end.
-  void skip_to(int line, const motion::AxisPose& at, int tool_in_spindle);
+  // Run from line: the blocks before `line` are read for their state, their moves dropped. At
+  // the line, in this order: the tool they leave in force is put in (the machine has
+  // `tool_in_spindle`), the spindle and coolant they leave are started (the spindle at speed),
+  // Z rises from `at` to `safe_z` (machine coordinates), the other axes go over where those
+  // lines leave the tool and Z comes down to it at the feed in force.
+  void skip_to(int line, const motion::AxisPose& at, int tool_in_spindle, double safe_z);
   // Whether the lines before the start are still being read, and whether they moved.
   bool skipping() const { return skip_to_ > 0; }
   bool skipped_motion() const { return skip_moved_; }
+  // The moves of the way to the line's start (0 before it is reached or when there is none).
+  int approach_moves() const { return feeder_.approach_moves(); }
+  // The moves and actions put in front of the line's own (tool, spindle, coolant, the way).
+  std::size_t lead_in() const { return lead_in_; }
   // Single steps: after `blocks` more blocks advance() says step_done; 0 with `on` false reads
   // on freely.
   void single_step(bool on, int blocks);
@@ -112,9 +120,10 @@ class ProgramRunner {
 
   Outcome fail(Error error);
   // After a block: run from line, the waits it queued, what the machine cannot run.
-  std::optional<Outcome> after_block(bool program_ended);
+  std::optional<Outcome> after_block(bool program_ended, int line_before);
   // Run from line: drops the block's moves before the line; at the line, what goes in front.
-  std::optional<Outcome> skip_block(bool program_ended);
+  // `line_before` is the program line the block started after.
+  std::optional<Outcome> skip_block(bool program_ended, int line_before);
 
   interp::Interpreter& interp_;
   ProgramFeeder feeder_;
@@ -134,6 +143,8 @@ class ProgramRunner {
   motion::AxisPose skip_end_{};
   motion::AxisPose skip_from_{};
   int tool_at_start_ = 0;
+  double safe_z_ = 0;
+  std::size_t lead_in_ = 0;
 };
 
 }  // namespace cncd::pipeline
