@@ -11,70 +11,6 @@
 
 namespace cncd::interp {
 
-// The O-word of a raw line without evaluating anything: used while skipping lines. A bare
-// O-word (a program number, or the start of a Fanuc subprogram) has kind none.
-bool scan_o_word(const std::string& line, std::string& name, OKind& kind) {
-  std::size_t i = 0;
-  auto skip_blanks = [&] {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t'))
-      ++i;
-  };
-  auto lower = [&](std::size_t k) {
-    return static_cast<char>(std::tolower(static_cast<unsigned char>(line[k])));
-  };
-  skip_blanks();
-  if (i < line.size() && line[i] == '/') ++i;
-  skip_blanks();
-  if (i < line.size() && lower(i) == 'n') {
-    ++i;
-    while (i < line.size() && (std::isdigit(static_cast<unsigned char>(line[i])) ||
-                               line[i] == ' ' || line[i] == '.')) {
-      ++i;
-    }
-  }
-  skip_blanks();
-  if (i >= line.size() || lower(i) != 'o') return false;
-  ++i;
-  name.clear();
-  skip_blanks();
-  if (i < line.size() && line[i] == '<') {
-    ++i;
-    while (i < line.size() && line[i] != '>') {
-      if (line[i] != ' ' && line[i] != '\t') name.push_back(lower(i));
-      ++i;
-    }
-    ++i;
-  } else {
-    while (i < line.size() &&
-           (std::isdigit(static_cast<unsigned char>(line[i])) || line[i] == ' ')) {
-      if (line[i] != ' ') name.push_back(line[i]);
-      ++i;
-    }
-  }
-  std::string word;
-  skip_blanks();
-  while (i < line.size() && std::isalpha(static_cast<unsigned char>(line[i])))
-    word += lower(i++);
-  if (word.empty()) {
-    kind = OKind::none;
-    return !name.empty();
-  }
-  static constexpr std::pair<const char*, OKind> kWords[] = {
-      {"sub", OKind::sub},        {"endsub", OKind::endsub}, {"call", OKind::call},
-      {"do", OKind::do_},         {"while", OKind::while_},  {"endwhile", OKind::endwhile},
-      {"if", OKind::if_},         {"elseif", OKind::elseif}, {"else", OKind::else_},
-      {"endif", OKind::endif},    {"break", OKind::break_},  {"continue", OKind::continue_},
-      {"return", OKind::return_}, {"repeat", OKind::repeat}, {"endrepeat", OKind::endrepeat},
-  };
-  for (const auto& [text, value] : kWords) {
-    if (word == text) {
-      kind = value;
-      return true;
-    }
-  }
-  return false;
-}
-
 std::string o_label(const std::string& name) {
   return std::isdigit(static_cast<unsigned char>(name.empty() ? 'x' : name[0])) ? "o" + name
                                                                                 : "o<" + name + ">";
@@ -93,36 +29,11 @@ void Interpreter::Impl::skip_block(const std::string& name, std::initializer_lis
     }
     current_line_ = source().line_number();
     OKind kind = OKind::none;
-    if (!scan_o_word(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
+    if (!scan_o_line(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
     for (const OKind stop : stops) {
       if (kind == stop) return;
     }
   }
-}
-
-// The first definition of `name` at or after `offset` in the indexed program file: seeks
-// there, checks it is still the sub's line and registers it.
-bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t offset) {
-  const auto found = sub_index_->definitions.find(name);
-  if (found == sub_index_->definitions.end()) return false;
-  const auto& all = found->second;
-  const auto def = std::lower_bound(
-      all.begin(), all.end(), offset,
-      [](const SubroutineIndex::Definition& d, std::int64_t at) { return d.offset < at; });
-  if (def == all.end()) return false;
-  const int line_number = source().line_number();
-  source().seek(def->offset, def->line - 1);
-  OKind kind = OKind::none;
-  const bool there = source().read_line(line_) && scan_o_word(line_, o_scan_name_, kind) &&
-                     kind == OKind::sub && o_scan_name_ == name;
-  if (!there) {
-    source().seek(offset, line_number);
-    fail(source().name() + " has changed since it was opened (" + o_label(name) +
-         " sub is no longer at line " + std::to_string(def->line) + "): open it again");
-  }
-  subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
-  source().seek(offset, line_number);
-  return true;
 }
 
 bool Interpreter::Impl::find_sub(const std::string& name) {
@@ -134,7 +45,7 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
     if (find_indexed_sub(name, offset)) return true;
   } else {
     while (source().read_line(line_)) {
-      if (!scan_o_word(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
+      if (!scan_o_line(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
       if (kind == OKind::none) fail("Fanuc 'O....' subroutine must be called with 'M98'");
       if (kind == OKind::sub) {
         subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
@@ -169,16 +80,9 @@ void Interpreter::Impl::do_call() {
   const std::size_t caller = sources_.size() - 1;
   const std::int64_t return_offset = source().tell();
   const int return_line = source().line_number();
-  auto it = subs_.find(name);
-  if (it == subs_.end()) {
-    if (!find_sub(name)) {
-      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
-           "> from line: " + std::to_string(current_line_));
-    }
-    it = subs_.find(name);
-  }
-  if (it->second.fanuc) fail("Fanuc 'O....' subroutine must be called with 'M98'");
   if (calls_.size() >= 64) fail("Too many nested subroutine calls");
+  // The call takes its arguments before it looks for the sub, as rs274 does: a name computed
+  // on the way (o#1 sub) reads the arguments and the call's own local parameters.
   CallFrame frame;
   frame.name = name;
   frame.source = caller;
@@ -193,6 +97,15 @@ void Interpreter::Impl::do_call() {
   }
   calls_.push_back(frame);
   parameters_.push_scope();
+  auto it = subs_.find(name);
+  if (it == subs_.end()) {
+    if (!find_sub(name)) {
+      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
+           "> from line: " + std::to_string(current_line_));
+    }
+    it = subs_.find(name);
+  }
+  if (it->second.fanuc) fail("Fanuc 'O....' subroutine must be called with 'M98'");
   if (it->second.source != sources_.size() - 1) {
     // The sub lives in an already open file further down the stack: bring it back on top.
     fail("Subroutine " + o_label(name) + " is not reachable from here");
@@ -201,7 +114,7 @@ void Interpreter::Impl::do_call() {
 }
 
 void Interpreter::Impl::do_return(bool has_value, double value) {
-  if (calls_.empty()) fail("Return or endsub outside a subroutine");
+  if (calls_.empty()) fail(label_error("not in a subroutine definition"));
   const CallFrame frame = calls_.back();
   if (nx_loops_.size() > frame.nx_loop_depth) {
     const ForFrame& open = nx_loops_.back();
@@ -378,37 +291,6 @@ void Interpreter::Impl::loop_back(std::int64_t offset, int line_before) {
          " loop iterations without a move or dwell");
   }
   source().seek(offset, line_before);
-}
-
-std::optional<InterpError> index_program(const std::filesystem::path& program, SubroutineIndex& out,
-                                         const std::function<bool()>& cancelled) {
-  out = SubroutineIndex{};
-  LineSource source;
-  if (const std::string why = source.open_file(program); !why.empty())
-    return InterpError{program.string(), 0, 0, "Unable to open file: " + why};
-  std::string line;
-  std::string name;
-  std::size_t count = 0;
-  try {
-    for (;;) {
-      const std::int64_t offset = source.tell();
-      if (!source.read_line(line)) break;
-      if ((source.line_number() & 4095) == 0 && cancelled && cancelled())
-        return InterpError{program.string(), 0, 0, "reading the program was cancelled"};
-      OKind kind = OKind::none;
-      if (!scan_o_word(line, name, kind) || kind != OKind::sub) continue;
-      if (++count > SubroutineIndex::kMaxDefinitions) {
-        return InterpError{program.string(), source.line_number(), 0,
-                           "more than " + std::to_string(SubroutineIndex::kMaxDefinitions) +
-                               " subroutine definitions"};
-      }
-      out.definitions[name].push_back({offset, source.line_number()});
-    }
-  } catch (const Failure& failure) {
-    return InterpError{failure.file, failure.line, 0, failure.message};
-  }
-  out.lines = static_cast<std::uint64_t>(source.line_number());
-  return std::nullopt;
 }
 
 }  // namespace cncd::interp

@@ -164,7 +164,9 @@ double unit_factor(Units from, Units to);
 // An O-word name as messages write it: "o100", "o<probe>".
 std::string o_label(const std::string& name);
 // The O-word of a raw line, read without evaluating anything; kind none for a bare O-word.
-bool scan_o_word(const std::string& line, std::string& name, OKind& kind);
+// A name that is a parameter or an expression makes no O-word, or, given `computed`, one with
+// no name yet (*computed set): Interpreter::Impl::scan_o_line evaluates it.
+bool scan_o_word(const std::string& line, std::string& name, OKind& kind, bool* computed = nullptr);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {
@@ -314,6 +316,8 @@ struct Interpreter::Impl {
   void auto_restore_modal_state();
   void skip_block(const std::string& name, std::initializer_list<OKind> stops);
   bool find_indexed_sub(const std::string& name, std::int64_t offset);
+  // o_word_scan.cpp: scan_o_word, with a computed name evaluated with today's parameters.
+  bool scan_o_line(const std::string& line, std::string& name, OKind& kind);
   bool find_sub(const std::string& name);
   void skip_loop_end(const ControlFrame& frame);
   std::string label_error(const char* what) const;

@@ -8,8 +8,7 @@
 namespace cncd::interp {
 namespace {
 
-// LinuxCNC's tolerance when a real must be an integer.
-constexpr double kTolerance = 0.0001;
+constexpr double kTolerance = kIntegerTolerance;
 
 bool is_alpha(char c) {
   return c >= 'a' && c <= 'z';
@@ -224,88 +223,6 @@ void BlockParser::read_m(Block& block, int col) {
   if (++block.m_count > 4) fail("Too many m codes on line", col);
   block.m[group] = number;
   block.m_column[group] = col;
-}
-
-void BlockParser::read_o(Block& block, int col) {
-  block.o_column = col;
-  block.o_name.clear();
-  if (peek() == '<') {
-    ++pos_;
-    while (pos_ < text_.size() && text_[pos_] != '>')
-      block.o_name.push_back(text_[pos_++]);
-    if (peek() != '>') error("Named parameter not terminated");
-    ++pos_;
-  } else {
-    if (!is_digit(peek())) error("Bad format of o-word");
-    while (is_digit(peek()))
-      block.o_name.push_back(text_[pos_++]);
-  }
-  std::string keyword;
-  while (is_alpha(peek()))
-    keyword.push_back(text_[pos_++]);
-  if (keyword.empty()) {
-    read_program_number(block);
-    return;
-  }
-  struct Entry {
-    const char* word;
-    OKind kind;
-  };
-  static constexpr Entry kWords[] = {
-      {"sub", OKind::sub},        {"endsub", OKind::endsub}, {"call", OKind::call},
-      {"do", OKind::do_},         {"while", OKind::while_},  {"endwhile", OKind::endwhile},
-      {"if", OKind::if_},         {"elseif", OKind::elseif}, {"else", OKind::else_},
-      {"endif", OKind::endif},    {"break", OKind::break_},  {"continue", OKind::continue_},
-      {"return", OKind::return_}, {"repeat", OKind::repeat}, {"endrepeat", OKind::endrepeat},
-  };
-  // Keywords are matched as prefixes, like LinuxCNC: "callsub" is "call" followed by junk.
-  block.o_kind = OKind::none;
-  std::size_t matched = 0;
-  for (const auto& entry : kWords) {
-    const std::string_view word(entry.word);
-    if (word.size() > matched && keyword.compare(0, word.size(), word) == 0) {
-      block.o_kind = entry.kind;
-      matched = word.size();
-    }
-  }
-  if (block.o_kind == OKind::none) fail("Unknown control command in o word", col);
-  if (matched < keyword.size()) fail("Unexpected character after O-word", col);
-  switch (block.o_kind) {
-    case OKind::call:
-      while (peek() == '[')
-        block.call_args.push_back(read_expression());
-      break;
-    case OKind::while_:
-    case OKind::if_:
-    case OKind::elseif:
-    case OKind::repeat:
-      if (peek() != '[') error("Left bracket missing after o-word keyword");
-      block.o_value = read_expression();
-      block.has_o_value = true;
-      break;
-    case OKind::return_:
-    case OKind::endsub:
-      if (peek() == '[') {
-        block.o_value = read_expression();
-        block.has_o_value = true;
-      }
-      break;
-    default:
-      break;
-  }
-}
-
-void BlockParser::read_program_number(Block& block) {
-  // A bare O-word is a program number (Fanuc posts start with "O1234 (NAME)"): LinuxCNC
-  // ignores it, and the comments after it too (no message, no comment); anything else after
-  // it is refused.
-  const int comments_before = block.comment_count;
-  while (pos_ < text_.size()) {
-    if (peek() != '(' && peek() != ';') error("Unexpected character after O-word");
-    read_comment(block);
-  }
-  block.comment_count = comments_before;
-  block.o_kind = OKind::none;
 }
 
 void BlockParser::read_assignment(Block& block) {

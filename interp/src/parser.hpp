@@ -17,6 +17,12 @@ namespace cncd::interp {
 // kMaxNesting deep, and a number written in the program is at most kMaxNumber in magnitude.
 inline constexpr int kMaxNesting = 100;
 inline constexpr double kMaxNumber = 1e300;
+// LinuxCNC's tolerance when a real must be an integer.
+inline constexpr double kIntegerTolerance = 0.0001;
+
+// The O-word keyword `word` starts with ("callsub" is "call" followed by junk, as LinuxCNC
+// reads it), and its length in `matched`; none when it starts with no keyword.
+OKind match_o_keyword(std::string_view word, std::size_t& matched);
 
 class BlockParser {
  public:
@@ -24,6 +30,12 @@ class BlockParser {
 
   // Throws Failure with the column of the offending character.
   void parse(std::string_view line, Block& block);
+
+  // The O-word of a line that is being skipped or searched: its name, evaluated when it is a
+  // parameter or an expression (rs274 evaluates it even there), and its keyword (kind none
+  // when it has none). Nothing after the keyword is read. False without an O-word or with a
+  // keyword that is not one exactly.
+  bool read_o_head(std::string_view line, std::string& name, OKind& kind);
 
   // The syntax to read: LinuxCNC's, or the Numeryx dialect's (see numeryx_parser.cpp).
   void set_dialect(Dialect dialect) { dialect_ = dialect; }
@@ -41,6 +53,7 @@ class BlockParser {
   void add_g(Block& block, int number, int column);
   void read_m(Block& block, int column);
   void read_o(Block& block, int column);
+  void read_o_name(std::string& name);
   void read_program_number(Block& block);
   void read_assignment(Block& block);
 

@@ -141,5 +141,17 @@ TEST(ProgramNumbers, AnythingButACommentAfterABareOWordIsRefused) {
   });
 }
 
+// rs274 converts an O-word number past the int range without a check: o[3000000000] calls
+// o<-2147483648>. Such a name is refused instead.
+TEST(OWordNumbers, ANumberPastTheIntRangeIsRefused) {
+  expect_errors({
+      {"o[3000000000] call\nM2\n", "O-word number out of range (at most 2147483647 in size)"},
+      {"#1 = -2147483648\no#1 sub\no#1 endsub\nM2\n",
+       "O-word number out of range (at most 2147483647 in size)"},
+      {"o[2147483647] sub\no2147483647 endsub\no[2147483647] call\nM2\n", ""},
+      {"o[-2147483647] sub\no<-2147483647> endsub\no[-2147483647] call\nM2\n", ""},
+  });
+}
+
 }  // namespace
 }  // namespace cncd::interp

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "cncd/interp/interpreter.hpp"
@@ -126,6 +127,37 @@ TEST(ProgramFiles, ACallGoesStraightToTheIndexedDefinition) {
             program.string() + ":2: " + program.string() +
                 " has changed since it was opened (o<far> sub is no longer at line 5): open it "
                 "again");
+}
+
+// A name that is a parameter or an expression is known only when the search passes it: the
+// index keeps those lines, and a call evaluates them in file order, as a search that reads
+// every line does (with the call's arguments in #1-#30), before a fixed definition further on.
+TEST(ProgramFiles, TheIndexEvaluatesComputedNamesOnTheWay) {
+  TempDir dir;
+  auto both_ways = [&](const std::string& text) {
+    const auto program = dir.write("p.ngc", text);
+    auto index = std::make_shared<SubroutineIndex>();
+    EXPECT_FALSE(index_program(program, *index));
+    std::string outputs[2];
+    for (int indexed = 0; indexed < 2; ++indexed) {
+      Interpreter interp;
+      std::ostringstream out;
+      Rs274Printer printer(out);
+      auto error = interp.open(program, indexed ? index : nullptr);
+      if (!error) error = run_program(interp, printer);
+      outputs[indexed] = out.str() + (error ? error->to_string() : "");
+    }
+    EXPECT_EQ(outputs[0], outputs[1]);
+    return outputs[1];
+  };
+  const std::string found = both_ways(
+      "#<_n> = 100\no100 call [5]\nM2\no[#<_n> - 50] sub\no50 endsub\no#1 sub\no[#1 * 20] sub\n"
+      "G0 X#1\no100 endsub\no100 sub\nG0 X99\no100 endsub\n");
+  EXPECT_NE(found.find("STRAIGHT_TRAVERSE(5.0000,"), std::string::npos) << found;
+  EXPECT_EQ(found.find("STRAIGHT_TRAVERSE(99.0000,"), std::string::npos) << found;
+  const std::string failed =
+      both_ways("o100 call\nM2\n\no[10 / 3] sub\no100 sub\no100 endsub\n");
+  EXPECT_NE(failed.find("p.ngc:4:2: Non integer value for integer"), std::string::npos) << failed;
 }
 
 }  // namespace

@@ -95,8 +95,11 @@ struct SubroutineIndex {
   };
   // By lower-case name (digits for o123), in file order.
   std::unordered_map<std::string, std::vector<Definition>> definitions;
+  // The O-word lines whose name is a parameter or an expression (o#1 sub, o[#2*10] endsub ...),
+  // in file order: their name is known only when the search that passes them evaluates it.
+  std::vector<Definition> computed;
   std::uint64_t lines = 0;  // lines of the file, a last one without a newline counted too
-  // More definitions than this refuse the program: the index must stay small.
+  // More definitions and computed lines than this refuse the program: the index must stay small.
   static constexpr std::size_t kMaxDefinitions = 100'000;
 };
 
