@@ -2,27 +2,12 @@
 // (M62-M68), tool change, spindle, coolant, overrides, user M code, dwell, plane, units, cutter
 // compensation, tool length, coordinate system, path control, distance modes, retract mode,
 // non-modal codes, motion, stop.
-#include <cctype>
 #include <cmath>
-#include <cstdio>
 
 #include "failure.hpp"
 #include "interp_state.hpp"
 
 namespace cncd::interp {
-namespace {
-
-bool starts_with_word(const std::string& text, const char* word, std::size_t& rest) {
-  std::size_t i = 0;
-  for (; word[i] != '\0'; ++i) {
-    if (i >= text.size()) return false;
-    if (std::tolower(static_cast<unsigned char>(text[i])) != word[i]) return false;
-  }
-  rest = i;
-  return true;
-}
-
-}  // namespace
 
 void Interpreter::Impl::execute_block() {
   if (dialect_ == Dialect::numeryx) {
@@ -43,28 +28,6 @@ void Interpreter::Impl::execute_block() {
   do_stop();
 }
 
-void Interpreter::Impl::do_comment() {
-  if (block_.comment_count == 0) return;
-  // LinuxCNC acts on the last comment of a line only.
-  const std::string& text = block_.comments[static_cast<std::size_t>(block_.comment_count - 1)];
-  std::size_t rest = 0;
-  if (starts_with_word(text, "msg,", rest)) {
-    emit(Message{text.substr(rest)});
-    return;
-  }
-  if (starts_with_word(text, "debug,", rest)) {
-    emit(Message{substitute_parameters(text.substr(rest))});
-    return;
-  }
-  // PRINT and LOG comments go to the operator's terminal or a log file, not to the machine.
-  if (starts_with_word(text, "print,", rest) || starts_with_word(text, "log", rest)) return;
-  // Plain comments lose their leading blanks, as LinuxCNC prints them.
-  const std::size_t first = text.find_first_not_of(" \t");
-  const std::string plain = first == std::string::npos ? std::string() : text.substr(first);
-  probe_file_comment(plain);
-  emit_comment(plain);
-}
-
 // G96 D.. S.. (constant surface speed, D the highest rpm) and G97, before the feed mode and
 // the speed as in LinuxCNC: SET_SPINDLE_MODE(max rpm), 0 for G97; without D, 1e30.
 void Interpreter::Impl::do_spindle_mode() {
@@ -74,56 +37,6 @@ void Interpreter::Impl::do_spindle_mode() {
   modal_.css_max_rpm = 0;
   if (modal_.css) modal_.css_max_rpm = block_.has('d') ? std::fabs(block_.get('d')) : 1e30;
   emit(SetSpindleMode{modal_.css_max_rpm});
-}
-
-// (DEBUG, ...) text with #n and #<name> replaced by their values, as LinuxCNC does: six
-// decimals, "######" for an unknown name; anything else after '#' stays as written.
-std::string Interpreter::Impl::substitute_parameters(const std::string& text) const {
-  std::string out;
-  char number[64];
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c != '#' || i + 1 >= text.size()) {
-      out.push_back(c);
-      continue;
-    }
-    if (text[i + 1] == '<') {
-      const std::size_t close = text.find('>', i + 2);
-      if (close == std::string::npos) {
-        out.push_back(c);
-        continue;
-      }
-      std::string name;
-      for (std::size_t k = i + 2; k < close; ++k) {
-        if (text[k] != ' ' && text[k] != '\t') {
-          name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text[k]))));
-        }
-      }
-      const auto value = parameters_.get_named(name);
-      if (value) {
-        std::snprintf(number, sizeof number, "%f", *value);
-        out += number;
-      } else {
-        out += "######";
-      }
-      i = close;
-      continue;
-    }
-    std::size_t k = i + 1;
-    int index = 0;
-    while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) && index < 100000) {
-      index = index * 10 + (text[k] - '0');
-      ++k;
-    }
-    if (k == i + 1 || index < 1 || index >= kMaxParameter) {
-      out.push_back(c);
-      continue;
-    }
-    std::snprintf(number, sizeof number, "%f", parameters_.get(index));
-    out += number;
-    i = k - 1;
-  }
-  return out;
 }
 
 void Interpreter::Impl::do_feed_mode() {

@@ -115,6 +115,16 @@ TEST(Comments, LastCommentOfALineAndMessages) {
   EXPECT_NE(canon.find("MESSAGE(\" Hello There\")"), std::string::npos);
 }
 
+// (ABORT, ...) stops the program with its message. rs274 reports an empty one as "Unknown
+// error, bad error code"; cncd says what stopped it.
+TEST(Comments, AnAbortWithoutAMessageSaysWhatStoppedTheProgram) {
+  expect_errors({
+      {"(abort,)\nM2\n", "Program aborted by an (ABORT,) comment without a message"},
+      {"(abort, )\nM2\n", " "},
+      {"#1 = 2\n(Abort,#1)\nM2\n", "2.000000"},
+  });
+}
+
 // Fanuc-style posts put the program number first: LinuxCNC ignores a bare O-word, and the
 // comments after it.
 TEST(ProgramNumbers, ABareOWordIsIgnoredWithItsComments) {
