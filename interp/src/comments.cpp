@@ -50,18 +50,43 @@ void Interpreter::Impl::do_comment() {
   emit_comment(plain);
 }
 
-// (DEBUG, ...) text with #n and #<name> replaced by their values, as LinuxCNC does: six
-// decimals, "######" for an unknown name; anything else after '#' stays as written.
+// (DEBUG, ...) and (ABORT, ...) text with #n and #<name> replaced by their values, as rs274
+// does: "######" for an unknown name or a value too long to show; anything else after '#' stays as
+// written. A value has six decimals unless a format before it in the comment says otherwise: %d
+// none, %f four, %.Nf N (one digit). rs274 drops the '%' of a "%." that makes no format, and keeps
+// any other '%'.
 std::string Interpreter::Impl::substitute_parameters(const std::string& text) const {
   std::string out;
-  char number[64];
+  char number[400];  // %.9f of 1e300, the largest value a program can write, fits
+  int decimals = 6;
+  auto put = [&](double value) {
+    // rs274 shows a value of more than 29 characters (beyond 1e21 or so) as "######".
+    const int length = std::snprintf(number, sizeof number, "%.*f", decimals, value);
+    out += length <= 29 ? number : "######";
+  };
+  auto is_digit = [&](std::size_t k) {
+    return k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]));
+  };
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
+    const char next = i + 1 < text.size() ? text[i + 1] : '\0';
+    if (c == '%' && (next == 'd' || next == 'f')) {
+      decimals = next == 'd' ? 0 : 4;
+      ++i;
+      continue;
+    }
+    if (c == '%' && next == '.') {
+      if (is_digit(i + 2) && i + 3 < text.size() && text[i + 3] == 'f') {
+        decimals = text[i + 2] - '0';
+        i += 3;
+      }
+      continue;
+    }
     if (c != '#' || i + 1 >= text.size()) {
       out.push_back(c);
       continue;
     }
-    if (text[i + 1] == '<') {
+    if (next == '<') {
       const std::size_t close = text.find('>', i + 2);
       if (close == std::string::npos) {
         out.push_back(c);
@@ -73,10 +98,8 @@ std::string Interpreter::Impl::substitute_parameters(const std::string& text) co
           name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text[k]))));
         }
       }
-      const auto value = parameters_.get_named(name);
-      if (value) {
-        std::snprintf(number, sizeof number, "%f", *value);
-        out += number;
+      if (const auto value = parameters_.get_named(name)) {
+        put(*value);
       } else {
         out += "######";
       }
@@ -85,7 +108,7 @@ std::string Interpreter::Impl::substitute_parameters(const std::string& text) co
     }
     std::size_t k = i + 1;
     int index = 0;
-    while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) && index < 100000) {
+    while (is_digit(k) && index < 100000) {
       index = index * 10 + (text[k] - '0');
       ++k;
     }
@@ -93,8 +116,7 @@ std::string Interpreter::Impl::substitute_parameters(const std::string& text) co
       out.push_back(c);
       continue;
     }
-    std::snprintf(number, sizeof number, "%f", parameters_.get(index));
-    out += number;
+    put(parameters_.get(index));
     i = k - 1;
   }
   return out;
