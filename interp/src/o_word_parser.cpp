@@ -90,14 +90,22 @@ void BlockParser::read_o(Block& block, int col) {
   if (matched < keyword.size()) fail("Unexpected character after O-word", col);
   switch (block.o_kind) {
     case OKind::call:
-      while (peek() == '[')
-        block.call_args.push_back(read_expression());
+      // Comments may come before and between the arguments.
+      for (;;) {
+        if (peek() == '(') {
+          read_comment(block);
+        } else if (peek() == '[') {
+          block.call_args.push_back(read_expression());
+        } else {
+          break;
+        }
+      }
       break;
     case OKind::while_:
     case OKind::if_:
     case OKind::elseif:
     case OKind::repeat:
-      if (peek() != '[') error("Left bracket missing after o-word keyword");
+      if (peek() != '[') error("Left bracket missing after '" + keyword + "'");
       block.o_value = read_expression();
       block.has_o_value = true;
       break;
@@ -111,6 +119,11 @@ void BlockParser::read_o(Block& block, int col) {
     default:
       break;
   }
+  // Only comments may follow, as in rs274: the line's other words would be skipped unseen.
+  while (pos_ < text_.size()) {
+    if (peek() != '(' && peek() != ';') error("Unexpected character after O-word");
+    read_comment(block);
+  }
 }
 
 void BlockParser::read_program_number(Block& block) {
@@ -118,6 +131,9 @@ void BlockParser::read_program_number(Block& block) {
   // ignores it, and the comments after it too (no message, no comment); anything else after
   // it is refused.
   const int comments_before = block.comment_count;
+  if (pos_ < text_.size() && peek() != '(' && peek() != ';') {
+    error("Unknown control command in o word");  // rs274's words for "o<name> [1]" without call
+  }
   while (pos_ < text_.size()) {
     if (peek() != '(' && peek() != ';') error("Unexpected character after O-word");
     read_comment(block);
