@@ -28,6 +28,8 @@ void Interpreter::Impl::skip_block(const std::string& name, std::initializer_lis
            "> from line: " + std::to_string(start_line));
     }
     current_line_ = source().line_number();
+    if (at_closing_percent())
+      end_at_closing_percent(name, *stops.begin() == OKind::endsub, current_line_);
     OKind kind = OKind::none;
     if (!scan_o_line(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
     for (const OKind stop : stops) {
@@ -40,11 +42,16 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
   // Search the rest of the program file first, as LinuxCNC does, then NAME.ngc files.
   const std::int64_t offset = source().tell();
   const int line_number = source().line_number();
+  int closing_line = 0;  // the program's closing '%', where the search of its file ended
   OKind kind = OKind::none;
   if (sub_index_ && sources_.size() == 1) {
-    if (find_indexed_sub(name, offset)) return true;
+    if (find_indexed_sub(name, offset, closing_line)) return true;
   } else {
     while (source().read_line(line_)) {
+      if (at_closing_percent()) {
+        closing_line = source().line_number();
+        break;
+      }
       if (!scan_o_line(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
       if (kind == OKind::none) fail("Fanuc 'O....' subroutine must be called with 'M98'");
       if (kind == OKind::sub) {
@@ -72,6 +79,7 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
       }
     }
   }
+  if (closing_line > 0) end_at_closing_percent(name, true, closing_line);
   return false;
 }
 

@@ -315,9 +315,20 @@ struct Interpreter::Impl {
   // Before a subroutine returns (endsub, return, M99): the state its M73 saved comes back.
   void auto_restore_modal_state();
   void skip_block(const std::string& name, std::initializer_list<OKind> stops);
-  bool find_indexed_sub(const std::string& name, std::int64_t offset);
+  // `closing_line`: set to the closing '%' line when the search stopped there.
+  bool find_indexed_sub(const std::string& name, std::int64_t offset, int& closing_line);
   // o_word_scan.cpp: scan_o_word, with a computed name evaluated with today's parameters.
   bool scan_o_line(const std::string& line, std::string& name, OKind& kind);
+  // program_delimiters.cpp. True when line_ is a '%' that opens or (ended_ set) closes the
+  // program.
+  bool delimiter_line();
+  // line_, read while seeking, is the program's closing '%'.
+  bool at_closing_percent() const;
+  // Seeking `name` (a sub, else an if or loop) met the closing '%' at `line`: the program
+  // ends there, as in rs274 (FINISH, then the error).
+  [[noreturn]] void end_at_closing_percent(const std::string& name, bool sub, int line);
+  // After M2 in a program opened with '%': rs274's comment when no '%' closes it.
+  void check_percent_after_end();
   bool find_sub(const std::string& name);
   void skip_loop_end(const ControlFrame& frame);
   std::string label_error(const char* what) const;
@@ -362,12 +373,11 @@ struct Interpreter::Impl {
   std::uint64_t loops_without_motion_ = 0;
   bool preamble_done_ = false;
   bool ended_ = false;
-  bool mdi_ = false;  // executing MDI: the end of the text ends it, no M2 or % needed
-  bool opened_ = false;
-  bool skipping_percent_ = false;
-  bool seen_percent_ = false;
-  bool resend_g5x_ = false;  // set_coord_system_origin() changed the active system's origin
-  bool resend_g92_ = false;  // restore_persistent_parameters() may have changed the G92 offset
+  bool mdi_ = false;           // executing MDI: the end of the text ends it, no M2 or % needed
+  bool text_seen_ = false;     // a line that is not blank has been read: no '%' opens now
+  bool seen_percent_ = false;  // the program opened with '%': the next '%' line ends it
+  bool resend_g5x_ = false;    // set_coord_system_origin() changed the active system's origin
+  bool resend_g92_ = false;    // restore_persistent_parameters() may have changed the G92 offset
   bool resend_tool_offset_ = false;  // set_tool_in_spindle() changed the tool length offset
 
   ModalState modal_;

@@ -73,6 +73,7 @@ void Interpreter::Impl::reset_modal_state() {
   ended_ = false;
   loops_without_motion_ = 0;
   seen_percent_ = false;
+  text_seen_ = false;
   input_pending_ = false;
   probe_pending_ = false;
 }
@@ -192,23 +193,14 @@ Interpreter::Step Interpreter::Impl::step(CanonSink& sink) {
         ended_ = true;  // an MDI line needs no program end
         return Step::end;
       }
-      fail("File ended with no percent sign or program end");
+      fail(seen_percent_ ? "File ended with no percent sign"
+                         : "File ended with no percent sign or program end");
     }
     current_line_ = source.line_number();
-    if (is_percent_line(line_)) {
-      if (current_line_ == 1 && calls_.empty()) {
-        seen_percent_ = true;
-        return Step::block;
-      }
-      if (seen_percent_) {
-        emit(Finish{});
-        close_probe_file();
-        ended_ = true;
-        return Step::end;
-      }
-    }
+    if (delimiter_line()) return ended_ ? Step::end : Step::block;
     run_line();
     publish_parameters();
+    if (ended_) check_percent_after_end();
     return ended_ ? Step::end : Step::block;
   } catch (const Failure& failure) {
     error_ = make_error(failure);
@@ -332,6 +324,7 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   impl_->dialect_ = impl_->options_.dialect;
   impl_->mdi_ = true;
   impl_->ended_ = false;
+  impl_->text_seen_ = false;  // a '%' alone in MDI opens, and so does nothing, as before
   impl_->loops_without_motion_ = 0;
   impl_->control_.clear();
   impl_->calls_.clear();

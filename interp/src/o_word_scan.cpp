@@ -89,7 +89,8 @@ bool Interpreter::Impl::scan_o_line(const std::string& line, std::string& name, 
 // The first definition of `name` at or after `offset` in the indexed program file: seeks
 // there, checks it is still the sub's line and registers it. The lines with a computed O-word
 // name on the way are evaluated in order, as a search that reads every line would.
-bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t offset) {
+bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t offset,
+                                         int& closing_line) {
   using Definition = SubroutineIndex::Definition;
   auto before = [](const Definition& d, std::int64_t at) { return d.offset < at; };
   const Definition* fixed = nullptr;
@@ -111,7 +112,13 @@ bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t o
     return true;
   };
   const auto& computed = sub_index_->computed;
-  const std::int64_t limit = fixed ? fixed->offset : std::numeric_limits<std::int64_t>::max();
+  std::int64_t limit = fixed ? fixed->offset : std::numeric_limits<std::int64_t>::max();
+  const Definition& closing = sub_index_->closing_percent;
+  const bool before_end = seen_percent_ && closing.offset >= 0 && offset <= closing.offset;
+  if (before_end && closing.offset < limit) {
+    limit = closing.offset;
+    fixed = nullptr;
+  }
   for (auto it = std::lower_bound(computed.begin(), computed.end(), offset, before);
        it != computed.end() && it->offset < limit; ++it) {
     source().seek(it->offset, it->line - 1);
@@ -125,6 +132,7 @@ bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t o
       return register_here();
   }
   if (fixed == nullptr) {
+    if (before_end) closing_line = closing.line;
     source().seek(offset, line_number);
     return false;
   }
@@ -145,12 +153,22 @@ std::optional<InterpError> index_program(const std::filesystem::path& program, S
   std::string line;
   std::string name;
   std::size_t count = 0;
+  bool text_seen = false;
+  bool opened = false;
   try {
     for (;;) {
       const std::int64_t offset = source.tell();
       if (!source.read_line(line)) break;
       if ((source.line_number() & 4095) == 0 && cancelled && cancelled())
         return InterpError{program.string(), 0, 0, "reading the program was cancelled"};
+      if (out.closing_percent.offset >= 0) continue;  // past the program's end: lines only
+      if (is_percent_line(line)) {
+        if (opened) out.closing_percent = {offset, source.line_number()};
+        opened = opened || !text_seen;
+        text_seen = true;
+        continue;
+      }
+      text_seen = text_seen || line.find_first_not_of(" \t\r") != std::string::npos;
       OKind kind = OKind::none;
       bool computed = false;
       if (!scan_o_word(line, name, kind, &computed) || (!computed && kind != OKind::sub)) continue;

@@ -190,6 +190,30 @@ TEST(InterpreterApi, RestoredParametersPutTheOffsetsAndCoordinateSystemBack) {
   EXPECT_NE(out.str().find("STRAIGHT_TRAVERSE(2.0000"), std::string::npos) << out.str();
 }
 
+// A '%' alone in MDI does nothing, after a program delimited by '%' as before any program.
+TEST(InterpreterApi, APercentInMdiDoesNothing) {
+  Interpreter interp;
+  std::ostringstream out;
+  Rs274Printer printer(out);
+  for (int pass = 0; pass < 2; ++pass) {
+    ASSERT_FALSE(interp.open_mdi("%"));
+    ASSERT_FALSE(run_program(interp, printer));
+    ASSERT_FALSE(interp.open_string("\n%\nG0 X1\n%\n", "p.ngc"));
+    ASSERT_FALSE(run_program(interp, printer));
+  }
+  ASSERT_FALSE(interp.open_mdi("%"));
+  ASSERT_FALSE(run_program(interp, printer));
+  ASSERT_FALSE(interp.open_mdi("G0 X3"));
+  ASSERT_FALSE(run_program(interp, printer));
+  const std::string canon = out.str();
+  std::size_t finishes = 0;
+  for (auto at = canon.find("FINISH()"); at != std::string::npos;
+       at = canon.find("FINISH()", at + 1))
+    ++finishes;
+  EXPECT_EQ(finishes, 2U) << canon;  // the programs' own
+  EXPECT_NE(canon.find("STRAIGHT_TRAVERSE(3.0000"), std::string::npos) << canon;
+}
+
 TEST(InterpreterApi, SetToolsReplacesTheWholeTable) {
   Interpreter interp;
   ToolEntry three;

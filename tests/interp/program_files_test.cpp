@@ -129,35 +129,57 @@ TEST(ProgramFiles, ACallGoesStraightToTheIndexedDefinition) {
                 "again");
 }
 
+// `text` as p.ngc in `dir`, run without and with its index: the outputs (canon, then the error)
+// must be the same; returns the one with the index.
+std::string run_both_ways(TempDir& dir, const std::string& text) {
+  const auto program = dir.write("p.ngc", text);
+  auto index = std::make_shared<SubroutineIndex>();
+  EXPECT_FALSE(index_program(program, *index));
+  std::string outputs[2];
+  for (int indexed = 0; indexed < 2; ++indexed) {
+    Interpreter interp;
+    std::ostringstream out;
+    Rs274Printer printer(out);
+    auto error = interp.open(program, indexed ? index : nullptr);
+    if (!error) error = run_program(interp, printer);
+    outputs[indexed] = out.str() + (error ? error->to_string() : "");
+  }
+  EXPECT_EQ(outputs[0], outputs[1]);
+  return outputs[1];
+}
+
 // A name that is a parameter or an expression is known only when the search passes it: the
 // index keeps those lines, and a call evaluates them in file order, as a search that reads
 // every line does (with the call's arguments in #1-#30), before a fixed definition further on.
 TEST(ProgramFiles, TheIndexEvaluatesComputedNamesOnTheWay) {
   TempDir dir;
-  auto both_ways = [&](const std::string& text) {
-    const auto program = dir.write("p.ngc", text);
-    auto index = std::make_shared<SubroutineIndex>();
-    EXPECT_FALSE(index_program(program, *index));
-    std::string outputs[2];
-    for (int indexed = 0; indexed < 2; ++indexed) {
-      Interpreter interp;
-      std::ostringstream out;
-      Rs274Printer printer(out);
-      auto error = interp.open(program, indexed ? index : nullptr);
-      if (!error) error = run_program(interp, printer);
-      outputs[indexed] = out.str() + (error ? error->to_string() : "");
-    }
-    EXPECT_EQ(outputs[0], outputs[1]);
-    return outputs[1];
-  };
-  const std::string found = both_ways(
-      "#<_n> = 100\no100 call [5]\nM2\no[#<_n> - 50] sub\no50 endsub\no#1 sub\no[#1 * 20] sub\n"
-      "G0 X#1\no100 endsub\no100 sub\nG0 X99\no100 endsub\n");
+  const std::string found = run_both_ways(
+      dir,
+      "#<_n> = 100\no100 call [5]\nM2\no[#<_n> - 50] sub\no50 endsub\no#1 sub\no[#1 * 20] "
+      "sub\nG0 X#1\no100 endsub\no100 sub\nG0 X99\no100 endsub\n");
   EXPECT_NE(found.find("STRAIGHT_TRAVERSE(5.0000,"), std::string::npos) << found;
   EXPECT_EQ(found.find("STRAIGHT_TRAVERSE(99.0000,"), std::string::npos) << found;
   const std::string failed =
-      both_ways("o100 call\nM2\n\no[10 / 3] sub\no100 sub\no100 endsub\n");
+      run_both_ways(dir, "o100 call\nM2\n\no[10 / 3] sub\no100 sub\no100 endsub\n");
   EXPECT_NE(failed.find("p.ngc:4:2: Non integer value for integer"), std::string::npos) << failed;
+}
+
+// The lines after a closing '%' are no part of the program: the index holds nothing of them,
+// and knows whether a '%' closes the program that M2 ends.
+TEST(ProgramFiles, TheIndexStopsAtTheClosingPercent) {
+  TempDir dir;
+  const std::string late =
+      run_both_ways(dir, "\n%\no<late> call\nM2\n%\no<late> sub\nG0 X1\no<late> endsub\no#1 sub\n");
+  EXPECT_NE(late.find("FINISH()\n"), std::string::npos) << late;
+  EXPECT_NE(late.find("p.ngc:5: Failed to find sub 'Olate' before EOF"), std::string::npos) << late;
+  const std::string early =
+      run_both_ways(dir, "%\no<s> call\nM2\no<s> sub\nG0 X1\no<s> endsub\n%\n");
+  EXPECT_NE(early.find("STRAIGHT_TRAVERSE(1.0000,"), std::string::npos) << early;
+  EXPECT_EQ(early.find("percent sign missing"), std::string::npos) << early;
+  const std::string open = run_both_ways(dir, "%\nG0 X1\nM2\n(no closing percent)\n");
+  EXPECT_NE(open.find("COMMENT(\"interpreter: percent sign missing from end of file\")"),
+            std::string::npos)
+      << open;
 }
 
 }  // namespace

@@ -98,6 +98,9 @@ struct SubroutineIndex {
   // The O-word lines whose name is a parameter or an expression (o#1 sub, o[#2*10] endsub ...),
   // in file order: their name is known only when the search that passes them evaluates it.
   std::vector<Definition> computed;
+  // The '%' line that closes a program opened with '%' (offset -1: none). The lines after it
+  // are no part of the program: nothing there is indexed.
+  Definition closing_percent{-1, 0};
   std::uint64_t lines = 0;  // lines of the file, a last one without a newline counted too
   // More definitions and computed lines than this refuse the program: the index must stay small.
   static constexpr std::size_t kMaxDefinitions = 100'000;
