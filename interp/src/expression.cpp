@@ -88,6 +88,8 @@ int BlockParser::read_binary_operator() {
     if (match(word)) return static_cast<int>(op);
   }
   if (c == '\0') error("Unclosed expression");
+  if (std::string_view("aeglmnox").find(c) != std::string_view::npos)
+    error(std::string("Unknown operation name starting with ") + c);
   error("Unknown operation");
 }
 
@@ -170,6 +172,29 @@ double BlockParser::read_expression() {
   }
 }
 
+// EXISTS[#<name>] is 1 while the named parameter is defined; EXISTS[#n], with n a number, a
+// parameter (##1) or an expression (#[2+3]), is 1 for the numbers 1..5601 that a parameter
+// may have, 0 for any other integer, as in rs274.
+double BlockParser::read_exists() {
+  ++pos_;  // '['
+  if (peek() != '#') error("Expected # reading parameter");
+  ++pos_;
+  bool exists = false;
+  if (peek() == '<') {
+    read_name(name_);
+    exists = parameters_.exists_named(name_);
+  } else {
+    const int col = column();
+    const double value = read_real_value();
+    const double number = std::nearbyint(value);
+    if (std::fabs(value - number) > kTolerance) fail("Non integer value for integer", col);
+    exists = number >= 1 && number < kMaxParameter;
+  }
+  if (peek() != ']') error("Expected ] reading bracketed parameter");
+  ++pos_;
+  return exists ? 1.0 : 0.0;
+}
+
 double BlockParser::read_unary(int col) {
   std::string_view rest(text_.data() + pos_, text_.size() - pos_);
   static constexpr const char* kNames[] = {"abs", "acos", "asin",  "atan", "cos",  "exp", "fix",
@@ -177,22 +202,18 @@ double BlockParser::read_unary(int col) {
   std::string_view name;
   for (const char* candidate : kNames) {
     const std::string_view word(candidate);
-    if (rest.substr(0, word.size()) == word && rest.size() > word.size() &&
-        rest[word.size()] == '[') {
-      if (word.size() > name.size()) name = word;
-    }
+    if (rest.substr(0, word.size()) == word && word.size() > name.size()) name = word;
   }
-  if (name.empty()) fail("Unknown word where unary operation could be", col);
+  // rs274's words: a name it knows without its bracket, a word that starts as one of its names
+  // do, any other word.
+  if (name.empty()) {
+    if (std::string_view("aceflrst").find(rest.front()) != std::string_view::npos)
+      fail(std::string("Unknown word starting with ") + rest.front(), col);
+    fail("Unknown word where unary operation could be", col);
+  }
   pos_ += name.size();
-  if (name == "exists") {
-    ++pos_;  // '['
-    if (peek() != '#' || peek_at(1) != '<') error("Named parameter expected in EXISTS");
-    ++pos_;
-    read_name(name_);
-    if (peek() != ']') error("Right bracket missing after EXISTS argument");
-    ++pos_;
-    return parameters_.exists_named(name_) ? 1.0 : 0.0;
-  }
+  if (peek() != '[') error("Left bracket missing after unary operation name");
+  if (name == "exists") return read_exists();
   const double arg = read_expression();
   if (name == "atan") {
     if (peek() != '/') error("Slash missing after first atan argument");

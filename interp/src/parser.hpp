@@ -72,6 +72,7 @@ class BlockParser {
   double read_number();
   double read_expression();
   double read_unary(int column);
+  double read_exists();
   double read_parameter_value();
   int read_parameter_index();
   int read_integer_value();

@@ -125,6 +125,17 @@ TEST(Comments, AnAbortWithoutAMessageSaysWhatStoppedTheProgram) {
   });
 }
 
+// rs274 creates a named parameter as soon as it reads "#<b> =", so EXISTS on that line says 1
+// (and reading #<b> there gives 0). Its value comes only after the line: cncd says it does not
+// exist yet, as reading it there is an error.
+TEST(Exists, AParameterTheLineAssignsDoesNotExistYetOnThatLine) {
+  EXPECT_DOUBLE_EQ(x_of("[EXISTS[#<new>]] #<new> = 1"), 0.0);
+  EXPECT_EQ(error_of("#<b> = 1 #21 = EXISTS[#<b>]\nG0 X#21\nM2\n"), "");
+  EXPECT_NE(canon_of("#<b> = 1 #21 = EXISTS[#<b>]\nG0 X#21\nM2\n").find("TRAVERSE(0.0000,"),
+            std::string::npos);
+  EXPECT_EQ(error_of("#<b> = 1 #21 = #<b>\nM2\n"), "Named parameter #<b> not defined");
+}
+
 // Fanuc-style posts put the program number first: LinuxCNC ignores a bare O-word, and the
 // comments after it.
 TEST(ProgramNumbers, ABareOWordIsIgnoredWithItsComments) {
