@@ -18,7 +18,7 @@ std::string o_label(const std::string& name) {
 
 // Reads on until a line with this O-word name and one of `stops`; that line is then in
 // `line_` and is the current line.
-void Interpreter::Impl::skip_block(const std::string& name, std::initializer_list<OKind> stops) {
+OKind Interpreter::Impl::skip_block(const std::string& name, std::initializer_list<OKind> stops) {
   const int start_line = current_line_;
   for (;;) {
     line_offset_ = source().tell();
@@ -33,7 +33,7 @@ void Interpreter::Impl::skip_block(const std::string& name, std::initializer_lis
     OKind kind = OKind::none;
     if (!scan_o_line(line_, o_scan_name_, kind) || o_scan_name_ != name) continue;
     for (const OKind stop : stops) {
-      if (kind == stop) return;
+      if (kind == stop) return kind;
     }
   }
 }
@@ -72,7 +72,8 @@ bool Interpreter::Impl::find_sub(const std::string& name) {
     if (const std::string why = sub_file.open_file(file); !why.empty())
       fail("Cannot read subroutine file " + file.string() + ": " + why);
     while (sub_file.read_line(line_)) {
-      if (scan_o_word(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name) {
+      if (scan_o_word(line_, o_scan_name_, kind) == OScan::o_word && kind == OKind::sub &&
+          o_scan_name_ == name) {
         sources_.push_back(std::move(sub_file));
         subs_[name] = SubInfo{sources_.size() - 1, source().tell(), source().line_number(), true};
         return true;
@@ -192,10 +193,12 @@ void Interpreter::Impl::handle_o_word() {
       }
       // Look for a branch that runs: an elseif whose condition holds, an else, or the end.
       for (;;) {
-        skip_block(name, {OKind::elseif, OKind::else_, OKind::endif});
-        parser_.parse(line_, block_);
-        if (block_.o_kind == OKind::endif) return;
-        if (block_.o_kind == OKind::else_ || block_.o_value != 0.0) {
+        // Only an elseif is read whole (for its condition): rs274 takes "o1 endiffy" for the
+        // endif it seeks.
+        const OKind found = skip_block(name, {OKind::elseif, OKind::else_, OKind::endif});
+        if (found == OKind::endif) return;
+        if (found == OKind::elseif) parser_.parse(line_, block_);
+        if (found == OKind::else_ || block_.o_value != 0.0) {
           control_.push_back(ControlFrame{OKind::if_, name, 0, 0, 0});
           return;
         }

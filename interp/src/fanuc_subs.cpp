@@ -77,7 +77,7 @@ bool Interpreter::Impl::find_fanuc_sub(const std::string& name) {
   OKind kind = OKind::none;
   while (source().read_line(line_)) {
     if (at_closing_percent()) end_at_closing_percent(name, true, source().line_number());
-    if (!scan_o_word(line_, o_scan_name_, kind) ||
+    if (!scan_o_line(line_, o_scan_name_, kind) ||
         without_leading_zeros(o_scan_name_) != without_leading_zeros(name)) {
       continue;
     }

@@ -163,10 +163,11 @@ void rotate_xy(Pose& pose, double degrees);
 double unit_factor(Units from, Units to);
 // An O-word name as messages write it: "o100", "o<probe>".
 std::string o_label(const std::string& name);
-// The O-word of a raw line, read without evaluating anything; kind none for a bare O-word.
-// A name that is a parameter or an expression makes no O-word, or, given `computed`, one with
-// no name yet (*computed set): Interpreter::Impl::scan_o_line evaluates it.
-bool scan_o_word(const std::string& line, std::string& name, OKind& kind, bool* computed = nullptr);
+// The O-word of a raw line, read without evaluating anything: kind none for a bare O-word,
+// keywords matched as prefixes. A name that is a parameter or an expression (computed) is left
+// to Interpreter::Impl::scan_o_line, which evaluates it.
+enum class OScan { none, o_word, computed, unknown };
+OScan scan_o_word(const std::string& line, std::string& name, OKind& kind);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {
@@ -314,10 +315,12 @@ struct Interpreter::Impl {
   void restore_overrides(const ModalState& saved);
   // Before a subroutine returns (endsub, return, M99): the state its M73 saved comes back.
   void auto_restore_modal_state();
-  void skip_block(const std::string& name, std::initializer_list<OKind> stops);
+  // Reads on to the line of `name` with one of `stops` (returned); line_ holds it.
+  OKind skip_block(const std::string& name, std::initializer_list<OKind> stops);
   // `closing_line`: set to the closing '%' line when the search stopped there.
   bool find_indexed_sub(const std::string& name, std::int64_t offset, int& closing_line);
-  // o_word_scan.cpp: scan_o_word, with a computed name evaluated with today's parameters.
+  // o_word_scan.cpp: scan_o_word, with a computed name evaluated with today's parameters and
+  // an unknown keyword refused, as rs274 refuses it in the lines it skips or searches.
   bool scan_o_line(const std::string& line, std::string& name, OKind& kind);
   // program_delimiters.cpp. True when line_ is a '%' that opens or (ended_ set) closes the
   // program.

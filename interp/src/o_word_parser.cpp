@@ -159,11 +159,11 @@ bool BlockParser::read_o_head(std::string_view line, std::string& name, OKind& k
   std::string keyword;
   while (is_alpha(peek()))
     keyword.push_back(text_[pos_++]);
-  // As the skipper reads a numbered or named O-word: a keyword it does not know exactly makes
-  // no O-word line.
+  // As scan_o_word reads a numbered or named O-word: a keyword is matched as a prefix.
   std::size_t matched = 0;
   kind = match_o_keyword(keyword, matched);
-  return keyword.empty() || (kind != OKind::none && matched == keyword.size());
+  if (!keyword.empty() && kind == OKind::none) fail("Unknown control command in o word");
+  return true;
 }
 
 }  // namespace cncd::interp

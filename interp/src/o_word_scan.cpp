@@ -11,7 +11,7 @@
 
 namespace cncd::interp {
 
-bool scan_o_word(const std::string& line, std::string& name, OKind& kind, bool* computed) {
+OScan scan_o_word(const std::string& line, std::string& name, OKind& kind) {
   std::size_t i = 0;
   auto skip_blanks = [&] {
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t'))
@@ -32,16 +32,12 @@ bool scan_o_word(const std::string& line, std::string& name, OKind& kind, bool* 
       ++i;
   }
   skip_blanks();
-  if (i >= line.size() || lower(i) != 'o') return false;
+  if (i >= line.size() || lower(i) != 'o') return OScan::none;
   ++i;
   name.clear();
   kind = OKind::none;
   skip_blanks();
-  if (i < line.size() && (line[i] == '#' || line[i] == '[')) {
-    if (computed == nullptr) return false;
-    *computed = true;
-    return true;
-  }
+  if (i < line.size() && (line[i] == '#' || line[i] == '[')) return OScan::computed;
   if (i < line.size() && line[i] == '<') {
     ++i;
     while (i < line.size() && line[i] != '>') {
@@ -63,17 +59,19 @@ bool scan_o_word(const std::string& line, std::string& name, OKind& kind, bool* 
   skip_blanks();
   while (i < line.size() && std::isalpha(static_cast<unsigned char>(line[i])))
     word += lower(i++);
-  if (word.empty()) return !name.empty();
+  if (word.empty()) return name.empty() ? OScan::none : OScan::o_word;
+  // As rs274 reads a line it skips: "endiffy" is endif; "foo" is an error there.
   std::size_t matched = 0;
   kind = match_o_keyword(word, matched);
-  return kind != OKind::none && matched == word.size();
+  return kind == OKind::none ? OScan::unknown : OScan::o_word;
 }
 
 bool Interpreter::Impl::scan_o_line(const std::string& line, std::string& name, OKind& kind) {
-  bool computed = false;
-  if (!scan_o_word(line, name, kind, &computed)) return false;
-  if (!computed) return true;
+  const OScan found = scan_o_word(line, name, kind);
+  if (found == OScan::none) return false;
+  if (found == OScan::o_word) return true;
   try {
+    if (found == OScan::unknown) fail("Unknown control command in o word");
     parser_.set_dialect(dialect_);
     return parser_.read_o_head(line, name, kind);
   } catch (Failure& failure) {
@@ -122,10 +120,8 @@ bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t o
   for (auto it = std::lower_bound(computed.begin(), computed.end(), offset, before);
        it != computed.end() && it->offset < limit; ++it) {
     source().seek(it->offset, it->line - 1);
-    bool is_computed = false;
     OKind kind = OKind::none;
-    if (!source().read_line(line_) || !scan_o_word(line_, o_scan_name_, kind, &is_computed) ||
-        !is_computed) {
+    if (!source().read_line(line_) || scan_o_word(line_, o_scan_name_, kind) != OScan::computed) {
       changed(it->line);
     }
     if (scan_o_line(line_, o_scan_name_, kind) && kind == OKind::sub && o_scan_name_ == name)
@@ -138,7 +134,8 @@ bool Interpreter::Impl::find_indexed_sub(const std::string& name, std::int64_t o
   }
   source().seek(fixed->offset, fixed->line - 1);
   OKind kind = OKind::none;
-  const bool there = source().read_line(line_) && scan_o_word(line_, o_scan_name_, kind) &&
+  const bool there = source().read_line(line_) &&
+                     scan_o_word(line_, o_scan_name_, kind) == OScan::o_word &&
                      kind == OKind::sub && o_scan_name_ == name;
   if (!there) changed(fixed->line);
   return register_here();
@@ -170,8 +167,9 @@ std::optional<InterpError> index_program(const std::filesystem::path& program, S
       }
       text_seen = text_seen || line.find_first_not_of(" \t\r") != std::string::npos;
       OKind kind = OKind::none;
-      bool computed = false;
-      if (!scan_o_word(line, name, kind, &computed) || (!computed && kind != OKind::sub)) continue;
+      const OScan found = scan_o_word(line, name, kind);
+      const bool computed = found == OScan::computed;
+      if (!computed && (found != OScan::o_word || kind != OKind::sub)) continue;
       if (++count > SubroutineIndex::kMaxDefinitions) {
         return InterpError{program.string(), source.line_number(), 0,
                            "more than " + std::to_string(SubroutineIndex::kMaxDefinitions) +

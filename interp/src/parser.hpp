@@ -33,8 +33,8 @@ class BlockParser {
 
   // The O-word of a line that is being skipped or searched: its name, evaluated when it is a
   // parameter or an expression (rs274 evaluates it even there), and its keyword (kind none
-  // when it has none). Nothing after the keyword is read. False without an O-word or with a
-  // keyword that is not one exactly.
+  // when it has none; matched as a prefix, an unknown one refused). Nothing after the keyword
+  // is read. False without an O-word.
   bool read_o_head(std::string_view line, std::string& name, OKind& kind);
 
   // The syntax to read: LinuxCNC's, or the Numeryx dialect's (see numeryx_parser.cpp).
