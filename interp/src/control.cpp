@@ -106,20 +106,23 @@ void Interpreter::Impl::do_call() {
   }
   calls_.push_back(frame);
   parameters_.push_scope();
-  auto it = subs_.find(name);
-  if (it == subs_.end()) {
-    if (!find_sub(name)) {
-      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
-           "> from line: " + std::to_string(current_line_));
-    }
-    it = subs_.find(name);
-  }
-  if (it->second.fanuc) fail("Fanuc 'O....' subroutine must be called with 'M98'");
-  if (it->second.source != sources_.size() - 1) {
+  const SubInfo& sub = known_sub(name, false);
+  if (sub.fanuc) fail("Fanuc 'O....' subroutine must be called with 'M98'");
+  if (sub.source != sources_.size() - 1) {
     // The sub lives in an already open file further down the stack: bring it back on top.
     fail("Subroutine " + o_label(name) + " is not reachable from here");
   }
-  source().seek(it->second.offset, it->second.line_before);
+  source().seek(sub.offset, sub.line_before);
+}
+
+const SubInfo& Interpreter::Impl::known_sub(const std::string& name, bool fanuc) {
+  auto it = subs_.find(name);
+  if (it != subs_.end()) return it->second;
+  if (!(fanuc ? find_fanuc_sub(name) : find_sub(name))) {
+    fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
+         "> from line: " + std::to_string(current_line_));
+  }
+  return subs_.at(name);
 }
 
 void Interpreter::Impl::do_return(bool has_value, double value) {

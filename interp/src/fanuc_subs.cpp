@@ -114,17 +114,10 @@ void Interpreter::Impl::do_m98() {
   }
   if (count == 0) return;
   const std::string name = std::to_string(static_cast<long long>(p));
-  auto it = subs_.find(name);
-  if (it == subs_.end()) {
-    if (!find_fanuc_sub(name)) {
-      fail("EOF in file:" + source().name() + " seeking o-word: o<" + name +
-           "> from line: " + std::to_string(current_line_));
-    }
-    it = subs_.find(name);
-  }
-  if (!it->second.fanuc) fail("'O.... sub' subroutine must be called with 'O.... call'");
+  const SubInfo& sub = known_sub(name, true);
+  if (!sub.fanuc) fail("'O.... sub' subroutine must be called with 'O.... call'");
   if (calls_.size() >= kMaxFanucLevels) fail("Too many subroutine levels");
-  if (it->second.source != sources_.size() - 1)
+  if (sub.source != sources_.size() - 1)
     fail("Subprogram " + o_label(name) + " is not reachable from here");
   CallFrame frame;
   frame.name = name;
@@ -135,8 +128,8 @@ void Interpreter::Impl::do_m98() {
   frame.nx_loop_depth = nx_loops_.size();
   frame.fanuc = true;
   frame.repeats_left = count - 1;
-  frame.sub_offset = it->second.offset;
-  frame.sub_line_before = it->second.line_before;
+  frame.sub_offset = sub.offset;
+  frame.sub_line_before = sub.line_before;
   calls_.push_back(frame);
   parameters_.push_scope();
   source().seek(frame.sub_offset, frame.sub_line_before);

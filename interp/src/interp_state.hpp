@@ -333,6 +333,9 @@ struct Interpreter::Impl {
   // After M2 in a program opened with '%': rs274's comment when no '%' closes it.
   void check_percent_after_end();
   bool find_sub(const std::string& name);
+  // The sub (an M98 subprogram when `fanuc`) named `name`, sought when not seen yet; rs274's
+  // error when it is nowhere.
+  const SubInfo& known_sub(const std::string& name, bool fanuc);
   void skip_loop_end(const ControlFrame& frame);
   std::string label_error(const char* what) const;
   LineSource& source() { return sources_.back(); }
