@@ -105,11 +105,7 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   if (spindle_ && spindle.acceleration < 0) {
     return "[SPINDLE_0] ACCELERATION must not be negative (0 = at once)";
   }
-  spindle_acceleration_ = spindle.acceleration;
-  spindle_command_ = SpindleCommand{};
-  spindle_rpm_ = 0;
-  spindle_revolutions_ = 0;
-  spindle_acknowledged_ = 0;
+  spindle_model_.reset(spindle.acceleration, period_s_);
   return "";
 }
 
@@ -173,7 +169,7 @@ double SimDriver::load(int index) const noexcept {
 }
 
 void SimDriver::write_io(const IoCommand& command) noexcept {
-  spindle_command_ = command.spindle;
+  spindle_model_.command(command.spindle);
   store(flood_, command.flood ? 1 : 0);
   store(mist_, command.mist ? 1 : 0);
   for (std::size_t n = 0; n < digital_out_.size(); ++n)
@@ -218,24 +214,7 @@ void SimDriver::simulate_spindle(IoFeedback& feedback) noexcept {
   fb.at_speed = false;
   // The stand-in for an encoder: revolutions count the simulated position, signed.
   fb.has_position = true;
-  if (!fb.stale) {
-    const SpindleCommand& c = spindle_command_;
-    const double target = !c.enable ? 0.0 : c.reverse ? -std::abs(c.rpm) : std::abs(c.rpm);
-    // Signed speed, so a change of direction ramps through zero.
-    const double step = spindle_acceleration_ * period_s_;
-    const double before = spindle_rpm_;
-    if (spindle_acceleration_ <= 0 || std::abs(target - spindle_rpm_) <= step) {
-      spindle_rpm_ = target;
-    } else {
-      spindle_rpm_ += target > spindle_rpm_ ? step : -step;
-    }
-    spindle_revolutions_ += (before + spindle_rpm_) * 0.5 / 60.0 * period_s_;
-    // This period ran with the command: its reading answers it.
-    spindle_acknowledged_ = c.sequence;
-  }
-  fb.rpm = std::abs(spindle_rpm_);
-  fb.revolutions = spindle_revolutions_;
-  fb.acknowledged = spindle_acknowledged_;
+  spindle_model_.step(fb, fb.stale);
 }
 
 void SimDriver::read_io(IoFeedback& feedback) noexcept {

@@ -9,12 +9,12 @@
 #include <limits>
 #include <memory>
 
-#include "cncd/drivers/sim_driver.hpp"
 #include "cncd/motion/planner.hpp"
 #include "cncd/motion/servo_loop.hpp"
 #include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/plan_geometry.hpp"
 #include "cncd/pipeline/program_runner.hpp"
+#include "plan_drive.hpp"
 
 namespace cncd::pipeline {
 namespace {
@@ -118,12 +118,12 @@ class Simulation final : motion::MoveQueue {
       const int axis = config::axis_index(machine_.joints[j].axis);
       if (axis >= 0) joint_start[j] = start[static_cast<std::size_t>(axis)];
     }
-    if (auto problem = sim_.configure(machine_, joints); !problem.empty()) {
+    if (auto problem = drive_.configure(machine_, joints); !problem.empty()) {
       result_.error = CheckProblem{program_, 0, "simulated drives: " + problem};
       return false;
     }
     loop_ = std::make_unique<motion::ServoLoop>(
-        machine_, std::vector<motion::DriverBinding>{{&sim_, joints}});
+        machine_, std::vector<motion::DriverBinding>{{&drive_, joints}});
     loop_->set_start_positions(joint_start);
     loop_->commands().push(motion::Command{motion::Command::Kind::reset_estop});
     loop_->commands().push(motion::Command{motion::Command::Kind::on});
@@ -311,7 +311,7 @@ class Simulation final : motion::MoveQueue {
   interp::Interpreter interp_;
   ProgramRunner runner_;
   motion::Planner planner_;
-  drivers::SimDriver sim_;
+  PlanDrive drive_;
   std::unique_ptr<motion::ServoLoop> loop_;
   const Clock::time_point wall_start_ = Clock::now();
   std::uint64_t cycle_ = 0;            // servo periods since the program started

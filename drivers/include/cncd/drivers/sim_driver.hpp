@@ -17,6 +17,7 @@
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/quadrature.hpp"
 #include "cncd/drivers/rt.hpp"
+#include "cncd/drivers/spindle_model.hpp"
 
 namespace cncd::drivers {
 
@@ -151,13 +152,9 @@ class SimDriver final : public Driver {
 
   // The simulated spindle; state below is the servo thread's.
   bool spindle_ = false;
-  double spindle_acceleration_ = 0;  // rpm/s, 0 = at once
   std::atomic<bool> spindle_fault_{false};
   std::atomic<bool> spindle_stale_{false};
-  SpindleCommand spindle_command_{};
-  double spindle_rpm_ = 0;  // signed: negative turns in reverse
-  double spindle_revolutions_ = 0;
-  std::uint64_t spindle_acknowledged_ = 0;  // the command of the last period simulated
+  SpindleModel spindle_model_;
   // Servo thread only.
   std::array<double, kMaxJoints> commanded_{};
   std::array<double, kMaxJoints> position_{};
