@@ -14,10 +14,12 @@
 #include <signal.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -161,6 +163,7 @@ struct Phase {
   std::string name;
   std::vector<double> estop_ms;
   long overruns = 0;
+  std::vector<long> round_overruns;  // each round's window
   long cycles = 0;
   double window_s = 0;
   long frames = 0;
@@ -175,7 +178,9 @@ void measure(Phase& phase, WsClient& control, Conn& c, int samples, int window_s
   std::this_thread::sleep_for(std::chrono::seconds(window_s));
   const json after = status(c, R"("rt","exec")");
   phase.window_s += std::chrono::duration<double>(Clock::now() - t0).count();
-  phase.overruns += after["rt"]["overruns"].get<long>() - before["overruns"].get<long>();
+  const long overruns = after["rt"]["overruns"].get<long>() - before["overruns"].get<long>();
+  phase.overruns += overruns;
+  phase.round_overruns.push_back(overruns);
   phase.cycles += after["rt"]["cycles"].get<long>() - before["cycles"].get<long>();
   if (after["exec"] != "running") fail("the program ended within the window: make it longer");
   std::mt19937 random(24 + round);  // the same delays in both phases of a round
@@ -223,6 +228,24 @@ pid_t start_web(const std::string& ini, const std::string& sock, const std::stri
     _exit(127);
   }
   return pid;
+}
+
+// The chance that, were the watchers to make no difference, `with` or more of the `with +
+// without` overruns would fall in the watched windows, which had `share` of the cycles: the
+// binomial tail. Small (under 0.05) says the watchers add overruns; near 0.5 or above says the
+// counts differ by no more than chance.
+double chance_of_at_least(long with, long without, double share) {
+  const long n = with + without;
+  if (n == 0) return 1.0;
+  double tail = 0;
+  for (long k = with; k <= n; ++k) {
+    const double log_term =
+        std::lgamma(static_cast<double>(n) + 1) - std::lgamma(static_cast<double>(k) + 1) -
+        std::lgamma(static_cast<double>(n - k) + 1) + static_cast<double>(k) * std::log(share) +
+        static_cast<double>(n - k) * std::log1p(-share);
+    tail += std::exp(log_term);
+  }
+  return std::min(1.0, tail);
 }
 
 void print(const Phase& p) {
@@ -346,6 +369,19 @@ int main(int argc, char** argv) {
   else
     std::printf("overruns with/without: %ld/%ld (no ratio: none without)\n", watched.overruns,
                 alone.overruns);
+  std::printf("overruns a round, alone:");
+  for (const long n : alone.round_overruns)
+    std::printf(" %ld", n);
+  std::printf("; watched:");
+  for (const long n : watched.round_overruns)
+    std::printf(" %ld", n);
+  const double share = static_cast<double>(watched.cycles) /
+                       static_cast<double>(std::max(1L, watched.cycles + alone.cycles));
+  std::printf(
+      "\nchance of %ld or more of the %ld overruns in the watched windows if the watchers "
+      "made no difference: %.2f\n",
+      watched.overruns, watched.overruns + alone.overruns,
+      chance_of_at_least(watched.overruns, alone.overruns, share));
   std::printf("estop p99 with/without: %.2f\n",
               percentile(watched.estop_ms, 0.99) / percentile(alone.estop_ms, 0.99));
   watchers.clear();
