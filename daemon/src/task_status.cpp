@@ -203,7 +203,7 @@ TaskStatus Task::status() const {
   program.opening = opening_ ? opening_->path : std::string();
   // Between steps nothing is read ahead: the interpreter's line is the one just carried out.
   program.line = exec_ == ExecState::idle                  ? 0
-                 : stepping_ && exec_ == ExecState::paused ? interp_->current_line()
+                 : stepping_ && exec_ == ExecState::paused ? interp_->program_line()
                                                            : s.line;
   program.total_lines = program_lines_;
   program.dialect = interp::dialect_name(program_dialect_);

@@ -112,5 +112,29 @@ TEST_F(MachineTest, M60PausesLikeM0AndResumeRunsOn) {
   EXPECT_EQ(s["position"]["commanded"]["x"], 9.0);
 }
 
+// A subroutine file has its own line numbers: while it runs, the program's line is the call's
+// and the progress never passes the program's length.
+TEST_F(MachineTest, ASubroutineFileCountsAsItsCallLineInTheProgress) {
+  ready_machine();
+  std::string far = "o<far> sub\n";
+  for (int i = 1; i <= 40; ++i)
+    far += "G1 X" + std::to_string(i % 2 ? 2 : 0) + " F6000\n";
+  dir_.write("far.ngc", far + "o<far> endsub\nM2\n");
+  start_program("caller.ngc", "G21 G90\no<far> call\nG0 X5\nM2\n");
+  bool saw_call_line = false;
+  for (;;) {
+    const json s = status();
+    const int line = s["program"]["line"];
+    EXPECT_LE(line, 4) << s.dump();
+    EXPECT_LE(s["program"]["progress"].get<double>(), 1.0);
+    if (s["exec"] == "running" && line == 2 && s["motion"] == "moving") saw_call_line = true;
+    if (s["exec"] == "idle") {
+      EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+      break;
+    }
+  }
+  EXPECT_TRUE(saw_call_line);
+}
+
 }  // namespace
 }  // namespace cncd::test

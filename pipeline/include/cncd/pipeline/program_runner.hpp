@@ -109,11 +109,20 @@ class ProgramRunner {
 
  private:
   struct Sink final : interp::CanonSink {
-    explicit Sink(ProgramFeeder& to) : feeder(to) {}
+    Sink(const interp::Interpreter& from, ProgramFeeder& to) : interp(from), feeder(to) {}
     void emit(const interp::CanonCommand& command) override {
       if (tap != nullptr) tap->emit(command);
+      // Inside a subroutine file the moves carry the line of the call in the program's own
+      // file: the status, its progress and the errors count the program's lines.
+      if (const int line = interp.program_line(); line != interp.current_line()) {
+        interp::CanonCommand in_program = command;
+        in_program.line = line;
+        feeder.emit(in_program);
+        return;
+      }
       feeder.emit(command);
     }
+    const interp::Interpreter& interp;
     ProgramFeeder& feeder;
     interp::CanonSink* tap = nullptr;
   };
@@ -127,7 +136,7 @@ class ProgramRunner {
 
   interp::Interpreter& interp_;
   ProgramFeeder feeder_;
-  Sink sink_{feeder_};
+  Sink sink_{interp_, feeder_};
   Error error_;
   bool failed_ = false;
   bool ended_ = false;
