@@ -18,6 +18,12 @@ enum class Name : int {
   u,
   v,
   w,
+  abs_x,  // the position in machine coordinates (all offsets applied), program units
+  abs_y,
+  abs_z,
+  abs_a,
+  abs_b,
+  abs_c,  // LinuxCNC 2.9 has no _abs_u, _abs_v or _abs_w
   metric,
   imperial,
   absolute,
@@ -72,6 +78,12 @@ const std::unordered_map<std::string_view, Name>& names() {
       {"_u", Name::u},
       {"_v", Name::v},
       {"_w", Name::w},
+      {"_abs_x", Name::abs_x},
+      {"_abs_y", Name::abs_y},
+      {"_abs_z", Name::abs_z},
+      {"_abs_a", Name::abs_a},
+      {"_abs_b", Name::abs_b},
+      {"_abs_c", Name::abs_c},
       {"_metric", Name::metric},
       {"_imperial", Name::imperial},
       {"_absolute", Name::absolute},
@@ -128,6 +140,10 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
   if (it == names().end()) return std::nullopt;
   const Name n = it->second;
   if (n <= Name::w) return pos_[static_cast<std::size_t>(n)];
+  if (n <= Name::abs_c) {
+    return program_to_machine(
+        pos_)[static_cast<std::size_t>(static_cast<int>(n) - static_cast<int>(Name::abs_x))];
+  }
   static constexpr int kSystems[] = {540, 550, 560, 570, 580, 590, 591, 592, 593};
   const ToolEntry* selected = tools_.find(tool_prepped_);
   const ToolEntry* current = tools_.find(tool_in_spindle_);
