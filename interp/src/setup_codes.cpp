@@ -96,17 +96,29 @@ void Interpreter::Impl::set_tool_data(int l, int tool) {
   if (existing == nullptr) entry.pocket = tool;
   const double to_table = unit_factor(modal_.units, tool_table_units());
   const Pose g59_3 = read_offset_parameters(kG5xBase + 20 * 8);
+  const Pose machine = program_to_machine(pos_);
+  // L10: the offset that makes the current point read the given coordinates with this tool.
+  // The offset is in machine axes: under a rotated system the program's X and Y shift both.
+  Pose shift = pos_;
+  for (int axis = 0; axis < kAxes; ++axis) {
+    if (block_.has(kAxisLetters[axis]))
+      shift[static_cast<std::size_t>(axis)] -= block_.get(kAxisLetters[axis]);
+    else
+      shift[static_cast<std::size_t>(axis)] = 0;
+  }
+  rotate_xy(shift, rotation_deg_);
+  const bool turned = l == 10 && rotation_deg_ != 0.0 && (block_.has('x') || block_.has('y'));
   for (int axis = 0; axis < kAxes; ++axis) {
     const char letter = kAxisLetters[axis];
-    if (!block_.has(letter)) continue;
+    const bool xy = axis == kX || axis == kY;
+    if (!block_.has(letter) && !(turned && xy)) continue;
     const auto a = static_cast<std::size_t>(axis);
-    double value = block_.get(letter);
+    double value = block_.has(letter) ? block_.get(letter) : 0.0;
     if (l == 10) {
-      // The offset that makes the current point read `value` with this tool.
-      value = pos_[a] + tool_offset_[a] - value;
+      value = tool_offset_[a] + shift[a];
     } else if (l == 11) {
       // The same, measured in the G59.3 system.
-      value = pos_[a] + g92_offset_[a] + g5x_offset_[a] + tool_offset_[a] - g59_3[a] - value;
+      value = machine[a] - g59_3[a] - value;
     }
     entry.offset[a] = is_linear_axis(axis) ? value * to_table : value;
   }
