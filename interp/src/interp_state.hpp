@@ -227,6 +227,7 @@ struct Interpreter::Impl {
   void do_spindle_mode();
   std::string substitute_parameters(const std::string& text) const;
   std::optional<double> predefined_parameter(std::string_view name) const;
+  std::optional<double> ini_parameter(std::string_view name) const;
   void publish_parameters();
   void do_feed_mode();
   void set_feed_mode(FeedMode mode);

@@ -1,5 +1,8 @@
 // LinuxCNC's read-only parameters: the named ones (#<_x>, #<_metric> ...) computed on demand
 // and the numbered ones (#5400-#5410 tool, #5420-#5428 position) refreshed after each block.
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <string>
 #include <unordered_map>
 
@@ -136,6 +139,7 @@ double flag(bool value) {
 }  // namespace
 
 std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view name) const {
+  if (name.starts_with("_ini[")) return ini_parameter(name);
   const auto it = names().find(name);
   if (it == names().end()) return std::nullopt;
   const Name n = it->second;
@@ -225,6 +229,30 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
     default:
       return 0.0;
   }
+}
+
+// #<_ini[SECTION]KEY>, as LinuxCNC reads it: the name upper-cased, then the INI's own names
+// matched exactly; a value that is not wholly a number is no value.
+std::optional<double> Interpreter::Impl::ini_parameter(std::string_view name) const {
+  const auto close = name.find(']');
+  if (!options_.ini_value || close == std::string_view::npos || close + 1 >= name.size())
+    return std::nullopt;
+  std::string section(name.substr(5, close - 5));
+  std::string key(name.substr(close + 1));
+  for (auto* text : {&section, &key}) {
+    for (char& c : *text)
+      c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  const auto text = options_.ini_value(section, key);
+  if (!text) return std::nullopt;
+  const char* begin = text->c_str();
+  char* end = nullptr;
+  const double value = std::strtod(begin, &end);
+  if (end == begin) return std::nullopt;
+  while (*end == ' ' || *end == '\t')
+    ++end;
+  if (*end != '\0' || !std::isfinite(value)) return std::nullopt;
+  return value;
 }
 
 void Interpreter::Impl::publish_parameters() {

@@ -1,5 +1,10 @@
 #include "cncd/pipeline/machine.hpp"
 
+#include <memory>
+#include <string>
+
+#include "cncd/config/ini_file.hpp"
+
 namespace cncd::pipeline {
 
 // The interpreter checks program I/O indexes against the signals the machine can have.
@@ -33,6 +38,12 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
                                                                : interp::Dialect::linuxcnc;
   options.numeryx_clearance = config.numeryx_clearance;
   options.rigid_tapping = config.rigid_tapping;
+  // #<_ini[SECTION]KEY>: the INI as loaded, kept alive by the options.
+  if (std::shared_ptr<const config::IniFile> ini = config.ini) {
+    options.ini_value = [ini](const std::string& section, const std::string& key) {
+      return ini->value(section, key);
+    };
+  }
   return options;
 }
 

@@ -13,6 +13,7 @@ for name in "$@"; do
   table="$here/../interp/rs274_default.tbl"
   [ -f "$dir/tool.tbl" ] && table="$dir/tool.tbl"
   args="$args -t $table"
+  [ -f "$dir/machine.ini" ] && args="$args -i $dir/machine.ini"
   if [ -f "$dir/params.var" ]; then cp "$dir/params.var" "$work/params.var"; args="$args -v $work/params.var"; fi
   (cd "$work" && "$rs274" $args "$dir/program.ngc" 2>"$work/stderr") |
     sed -n -E 's/^ *[0-9]+ N(\.\.\.\.\.|[0-9]+ *) //p' >"$dir/expected.canon"

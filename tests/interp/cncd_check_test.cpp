@@ -307,5 +307,24 @@ TEST_F(CncdCheckTest, FromALineInsideASubroutineDefinitionIsRefusedAndACallLineW
       << loop.out;
 }
 
+// The machine's INI is there for #<_ini[SECTION]KEY>, read only.
+TEST_F(CncdCheckTest, AProgramReadsTheMachinesIniValues) {
+  const auto r =
+      check("G21\n(debug, z=#<_ini[axis_z]max_limit>)\nG0 Z#<_ini[AXIS_Z]MIN_LIMIT>\nM2\n",
+            {"--ini", ini_.string(), "--canon"});
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("MESSAGE(\" z=50.000000\")"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("STRAIGHT_TRAVERSE(0.0000, 0.0000, -100.0000"), std::string::npos) << r.out;
+  const auto assigned = check("#<_ini[AXIS_Z]MAX_LIMIT> = 5\nM2\n", {"--ini", ini_.string()});
+  EXPECT_EQ(assigned.exit_status, 1);
+  EXPECT_NE(assigned.err.find("Cannot assign to read-only parameter #<_ini[axis_z]max_limit>"),
+            std::string::npos)
+      << assigned.err;
+  // Without an INI there is no such parameter.
+  EXPECT_NE(check("(debug, #<_ini[AXIS_Z]MAX_LIMIT>)\nG0 Z#<_ini[AXIS_Z]MAX_LIMIT>\nM2\n")
+                .err.find("not defined"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace cncd::test

@@ -5,10 +5,12 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <regex>
 #include <sstream>
 #include <vector>
 
+#include "cncd/config/ini_file.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "cncd/interp/rs274_printer.hpp"
 
@@ -90,6 +92,7 @@ SessionFiles files_next_to(const std::filesystem::path& program) {
     files.tool_table = kRs274DefaultToolTable;
   }
   if (std::filesystem::exists(dir / "params.var")) files.parameter_file = dir / "params.var";
+  if (std::filesystem::exists(dir / "machine.ini")) files.ini = dir / "machine.ini";
   return files;
 }
 
@@ -101,13 +104,22 @@ SessionOutput run_ours(const std::filesystem::path& program, const SessionFiles&
     // rs274 rewrites its parameter file; work on a copy like the differential test does.
     options.parameter_file = files.parameter_file;
   }
+  if (!files.ini.empty()) {
+    std::vector<config::Problem> problems, warnings;
+    auto ini = std::make_shared<const config::IniFile>(
+        config::IniFile::read(files.ini, problems, warnings));
+    options.ini_value = [ini](const std::string& section, const std::string& key) {
+      return ini->value(section, key);
+    };
+  }
   Interpreter interp(options);
   std::ostringstream out;
   Rs274Printer printer(out);
   SessionOutput result;
   auto error = interp.open(program);
   if (!error) error = run_program(interp, printer);
-  out << "ON_RESET()\nON_RESET()\n";
+  // rs274 resets twice as it exits, once when it was given an INI.
+  out << (files.ini.empty() ? "ON_RESET()\nON_RESET()\n" : "ON_RESET()\n");
   result.canon = out.str();
   if (error) result.error = error->message;
   return result;
@@ -121,6 +133,7 @@ std::optional<SessionOutput> run_rs274(const std::filesystem::path& program,
   std::filesystem::create_directories(work);
   std::string command = std::string(kRs274) + " -g";
   if (!files.tool_table.empty()) command += " -t " + quote(files.tool_table.string());
+  if (!files.ini.empty()) command += " -i " + quote(files.ini.string());
   if (!files.parameter_file.empty()) {
     std::filesystem::copy_file(files.parameter_file, work / "params.var",
                                std::filesystem::copy_options::overwrite_existing);

@@ -17,6 +17,7 @@ struct SessionOutput {
 struct SessionFiles {
   std::filesystem::path tool_table;      // empty = none
   std::filesystem::path parameter_file;  // empty = none
+  std::filesystem::path ini;             // machine.ini, for #<_ini[...]>; empty = none
 };
 
 // A copy of the table rs274 reads when given none (LinuxCNC's sample-configs/common/tool.tbl),
@@ -24,7 +25,8 @@ struct SessionFiles {
 // handed this file, never LinuxCNC's.
 inline constexpr const char* kRs274DefaultToolTable = CNCD_RS274_DEFAULT_TOOL_TABLE;
 
-// Looks for tool.tbl and params.var next to the program; without tool.tbl, rs274's default.
+// Looks for tool.tbl, params.var and machine.ini next to the program; without tool.tbl,
+// rs274's default.
 SessionFiles files_next_to(const std::filesystem::path& program);
 
 SessionOutput run_ours(const std::filesystem::path& program, const SessionFiles& files);

@@ -83,6 +83,10 @@ struct InterpOptions {
   std::vector<std::filesystem::path> state_files;
   // Who opens and writes the probe file; null = the interpreter's thread (SyncProbeWriter).
   std::shared_ptr<ProbeFileWriter> probe_writer;
+  // The machine's INI, for #<_ini[SECTION]KEY>: the text of KEY in SECTION (names as written
+  // there, matched exactly), or nothing. Null: no INI, and no such parameter exists.
+  std::function<std::optional<std::string>(const std::string& section, const std::string& key)>
+      ini_value;
 };
 
 // Where each o<name> sub of a program file is defined, found by reading the file once
