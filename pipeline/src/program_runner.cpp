@@ -18,7 +18,6 @@ void ProgramRunner::start(const motion::AxisPose* at, bool mdi, int tool) {
   error_ = {};
   failed_ = ended_ = stop_ = probe_wait_ = input_wait_ = stepping_ = false;
   step_budget_ = 0;
-  blocks_ = 0;
   skip_to_ = 0;
   lead_in_ = 0;
   skip_moved_ = false;
@@ -82,7 +81,6 @@ ProgramRunner::Outcome ProgramRunner::advance(motion::MoveQueue& queue, const Bu
       return fail({Error::Kind::interpreter, error ? error->line : interp_.current_line(),
                    error ? error->message : "interpreter error", error});
     }
-    ++blocks_;
     if (stepping_) --step_budget_;
     if (auto outcome = after_block(step == interp::Interpreter::Step::end, line_before))
       return *outcome;

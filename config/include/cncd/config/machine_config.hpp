@@ -183,8 +183,8 @@ struct CncdConfig {
   int max_connections = 1000;
   int max_connections_per_user = 128;
   int control_reserve = 8;
-  int rt_priority = 80;            // SCHED_FIFO priority of the servo thread
-  int rt_cpu = -1;                 // CPU to pin the servo thread to, -1 = any
+  int rt_priority = 80;  // SCHED_FIFO priority of the servo thread
+  int rt_cpu = -1;       // CPU to pin the servo thread to, -1 = any
   // Run from line: Z rises to this height (machine coordinates) before X and Y move over the
   // line's start; none: [AXIS_Z] MAX_LIMIT.
   std::optional<double> run_from_line_safe_z;

@@ -99,8 +99,6 @@ class ProgramRunner {
   // Moves and actions (spindle, outputs, waits) the queue has taken since start().
   std::uint64_t moves_queued() const { return feeder_.moves_queued(); }
   std::uint64_t actions_queued() const { return feeder_.actions_queued(); }
-  // Blocks read without error since start().
-  long blocks() const { return blocks_; }
 
   // Every canonical command goes to `tap` before the feeder (a printer, a counter); null: none.
   void tap(interp::CanonSink* tap) { sink_.tap = tap; }
@@ -146,7 +144,6 @@ class ProgramRunner {
   bool through_waits_ = false;
   bool stepping_ = false;
   int step_budget_ = 0;
-  long blocks_ = 0;
   int skip_to_ = 0;
   bool skip_moved_ = false;
   motion::AxisPose skip_end_{};
