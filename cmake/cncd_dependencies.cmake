@@ -4,10 +4,12 @@ find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
-find_package(OpenSSL 3 REQUIRED)  # libcrypto: base64 of binary payloads
+find_package(OpenSSL 3 REQUIRED)  # libcrypto: base64 of binary payloads, SHA-256
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
 pkg_check_modules(GPIOD REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
+# The daemon's job history.
+pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
 # cncd-web: HTTP and WebSocket from Boost.Beast (header-only), passwords hashed with argon2id.
 find_package(Boost 1.81 REQUIRED)
 # What cncd-web and its tests build Asio with. ThreadSanitizer does not model standalone

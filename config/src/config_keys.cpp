@@ -130,6 +130,10 @@ constexpr std::array kMachineKeys{
                  "A user M code (M100-M199) still running after this long is stopped and the "
                  "program with it"),
 
+    choice_key("TELEMETRY", "PART_COUNT", "m30", "m30|m2|off",
+               "Which program end counts a part in the job history: m30 (M30 only), m2 (M2 or "
+               "M30) or off"),
+
     text_key("WEB", "LISTEN", "127.0.0.1",
              "cncd-web: the IP address it listens on; 127.0.0.1 (this machine only), 0.0.0.0 or "
              ":: (every address) or one interface's address"),

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -168,7 +169,12 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
   }
   EventLog events;
   Completions completions;
+  // Declared before the task, which writes to it up to its last run's end.
+  std::unique_ptr<JobHistory> jobs;
+  if (!config.cncd.state_dir.empty())
+    jobs = std::make_unique<JobHistory>(config.cncd.state_dir / "jobs.db");
   Task task(config, events, completions);
+  task.record_jobs(jobs.get());
   if (const auto error = task.load_files(); !error.empty()) {
     spdlog::critical("{}", error);
     return cncd::config::kExitConfig;

@@ -63,6 +63,20 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
     const auto since = params.value("since", std::uint64_t{0});
     return json{{"last_seq", events.last_seq()}, {"events", events_json(events.since(since))}};
   });
+  // Read on the job history's thread: a slow disk does not hold up the loop.
+  for (const bool stats : {false, true}) {
+    dispatcher.add(stats ? "jobs.stats" : "jobs.history",
+                   [&task, &completions, stats](const json& params, Session& session) {
+                     if (session.in_batch) {
+                       throw RpcError(kInvalidRequest, "the job history cannot be read in a batch");
+                     }
+                     const auto token = completions.next_token();
+                     task.ask_jobs(token, stats, params.value("since", 0.0),
+                                   params.value("limit", 100));
+                     session.defer_token = token;
+                     return json();
+                   });
+  }
   dispatcher.add("system.info", [&config](const json&) {
     json axes = json::array();
     json limits = json::object();

@@ -54,7 +54,7 @@ void ProgramPreviewer::request(double tolerance, std::uint64_t token) {
   const auto kept = std::find_if(cached_.begin(), cached_.end(),
                                  [&](const auto& entry) { return entry.first == tolerance; });
   if (kept != cached_.end()) {
-    ready_.emplace_back(token, PreviewResult{kept->second});
+    ready_.emplace_back(token, RawResult{kept->second});
     std::rotate(kept, kept + 1, cached_.end());  // the newest last
     return;
   }
@@ -88,7 +88,7 @@ std::vector<std::pair<std::uint64_t, TaskOutcome>> ProgramPreviewer::take() {
     const auto it = waiting_.find(result.tolerance);
     if (it != waiting_.end()) {
       for (const auto token : it->second)
-        ready_.emplace_back(token, PreviewResult{result.json});
+        ready_.emplace_back(token, RawResult{result.json});
       waiting_.erase(it);
     }
     if (cached_.size() >= kCached) cached_.erase(cached_.begin());

@@ -47,7 +47,7 @@ class ProgramPreviewer {
   // answered through take(), at once when it is kept. Throws TaskError when no program is open
   // or too many other tolerances are waited for.
   void request(double tolerance, std::uint64_t token);
-  // The answers that are ready: a serialized preview (PreviewResult) or an error.
+  // The answers that are ready: a serialized preview (RawResult) or an error.
   std::vector<std::pair<std::uint64_t, TaskOutcome>> take();
 
  private:

@@ -386,6 +386,8 @@ int rpc_code(TaskErrorKind kind) {
       return kFault;
     case TaskErrorKind::cancelled:
       return kCancelled;
+    case TaskErrorKind::unavailable:
+      return kUnavailable;
   }
   return kInternalError;
 }
@@ -398,7 +400,7 @@ void Completions::post(std::uint64_t token, TaskOutcome outcome) {
     done.error_message = error->what();
   } else if (const auto* opened = std::get_if<ProgramOpened>(&outcome)) {
     done.result = json{{"path", opened->path}};
-  } else if (auto* preview = std::get_if<PreviewResult>(&outcome)) {
+  } else if (auto* preview = std::get_if<RawResult>(&outcome)) {
     done.raw_result = std::move(preview->json);
   } else {
     done.result = json{{"ok", true}};

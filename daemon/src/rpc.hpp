@@ -37,6 +37,7 @@ enum RpcCode : int {
   kCancelled = 1009,  // cancelled before it finished (program.open: a newer open, an estop)
   kTooManyConnections = 1010,  // refused at connect: the connection limits are reached
   kAttributionRefused = 1011,  // "on_behalf_of" from a peer without control access
+  kUnavailable = 1012,         // the job history's database cannot be opened or read
 };
 
 class RpcError : public std::runtime_error {

@@ -139,6 +139,7 @@ void Task::run_program(int from_line, bool step) {
       "info", "program",
       program_path_ + (runner_->skipping() ? " started from line " + std::to_string(from_line)
                                            : std::string(" started")));
+  begin_job();
   feed();
   // Ended in error before any of its moves reached the motion controller (the planner refused
   // the first one, the machine having been moved since the program was checked; a run from a
@@ -195,7 +196,7 @@ void Task::start_run(Mode mode, const motion::Status& status) {
   stepping_ = false;
 }
 
-void Task::finish_program(const std::string& ended, const std::string& why) {
+void Task::finish_program(const std::string& ended, const std::string& why, int line) {
   user_m_.stop();
   user_m_hold_ = 0;
   untake_tool_changes(ended == "done");
@@ -239,6 +240,7 @@ void Task::finish_program(const std::string& ended, const std::string& why) {
   motion_s_ = servo_seconds_since(started_cycles_);
   last_result_ = result;
   last_error_ = error;
+  end_job(result, error, line);
   if (result == "done") {
     events_.add("info", "program",
                 fmt::format("{} finished in {:.3f} s", program_path_, elapsed_s_));
@@ -265,13 +267,14 @@ void Task::finish_with(const pipeline::ProgramRunner::Error& error) {
   const std::string where = mode_ == Mode::mdi ? std::string("MDI") : program_path_;
   switch (error.kind) {
     case Kind::interpreter:
-      finish_program("error", error.interp ? error.interp->to_string() : error.message);
+      finish_program("error", error.interp ? error.interp->to_string() : error.message, error.line);
       return;
     case Kind::ends_before_line:
       finish_program("error", where + ": " + error.message);
       return;
     default:
-      finish_program("error", where + ":" + std::to_string(error.line) + ": " + error.message);
+      finish_program("error", where + ":" + std::to_string(error.line) + ": " + error.message,
+                     error.line);
   }
 }
 
@@ -284,6 +287,7 @@ void Task::poll() {
   }
   for (auto& [token, outcome] : previewer_.take())
     answers_.post(token, std::move(outcome));
+  poll_jobs();
   const auto status = motion_.status();
   keep_positions(status);
   // An estop from the drives or an input, not machine.estop, cancels a pending open too.

@@ -20,6 +20,7 @@
 #include "cncd/motion/controller.hpp"
 #include "cncd/pipeline/program_runner.hpp"
 #include "event_log.hpp"
+#include "job_history.hpp"
 #include "panel_rules.hpp"
 #include "persist.hpp"
 #include "plan_estimate.hpp"
@@ -106,6 +107,11 @@ class Task {
   // Executes one MDI block; the answer under `token` is posted when it has finished.
   void mdi(const std::string& line, std::uint64_t token);
 
+  // Each program run goes to `history` (null: none is kept); it must outlive the task.
+  void record_jobs(JobHistory* history) { jobs_ = history; }
+  // jobs.history (stats false) and jobs.stats: answered later under `token` (task_jobs.cpp).
+  void ask_jobs(std::uint64_t token, bool stats, double since, int limit);
+
   // Feeds the planner from the interpreter, notices the end of a program, logs servo events.
   // Called every loop iteration.
   void poll();
@@ -175,7 +181,14 @@ class Task {
   void save_positions();
   // Each joint's limits, for the position file (task_persist.cpp).
   std::vector<JointRange> joint_ranges() const;
-  void finish_program(const std::string& result, const std::string& error);
+  // `line`: the program line an error is at, 0 when none.
+  void finish_program(const std::string& result, const std::string& error, int line = 0);
+  // The job history's row of a run: begun as it starts, ended with its result (task_jobs.cpp).
+  void begin_job();
+  void end_job(const std::string& result, const std::string& error, int line);
+  std::optional<double> whole_estimate() const;
+  // The job history's answers and reports (task_jobs.cpp).
+  void poll_jobs();
   // The pending open's check has ended (task_open.cpp).
   void finish_open(OpenOutcome outcome);
   // Answers the pending open, if any, with a cancelled error and `why`.
@@ -306,6 +319,8 @@ class Task {
   mutable FirstMove first_move_;
   ProgramOpener opener_;
   ProgramPreviewer previewer_;
+  JobHistory* jobs_ = nullptr;
+  std::uint64_t job_ = 0;  // the run's handle in jobs_, 0: none
 };
 
 }  // namespace cncd::daemon

@@ -21,6 +21,7 @@ enum class TaskErrorKind {
   save_failed,  // a file (tool table, parameter file) could not be written
   fault,        // the machine did not do it: a drive, its feedback or the estop input
   cancelled,    // cancelled before it finished
+  unavailable,  // a record the daemon keeps (the job history) cannot be opened or read
 };
 
 // Thrown by a command the task refuses or cannot carry out; nothing has changed then, unless
@@ -41,12 +42,12 @@ struct CommandDone {};
 struct ProgramOpened {
   std::string path;
 };
-// program.preview: the result, already serialized (it is large, and shared by every client
-// that asks for the same preview).
-struct PreviewResult {
+// program.preview, jobs.history, jobs.stats: the result, already serialized (a preview is
+// large, and shared by every client that asks for the same one).
+struct RawResult {
   std::shared_ptr<const std::string> json;
 };
-using TaskOutcome = std::variant<CommandDone, ProgramOpened, PreviewResult, TaskError>;
+using TaskOutcome = std::variant<CommandDone, ProgramOpened, RawResult, TaskError>;
 
 // Where the task posts the outcomes of the commands answered later, each under the token the
 // command was given.

@@ -21,6 +21,8 @@ void ProgramRunner::start(const motion::AxisPose* at, bool mdi, int tool) {
   skip_to_ = 0;
   lead_in_ = 0;
   skip_moved_ = false;
+  sink_.shuttled = false;
+  sink_.end_code = 0;
 }
 
 void ProgramRunner::skip_to(int line, const motion::AxisPose& at, int tool_in_spindle,

@@ -36,7 +36,7 @@ inline const std::vector<std::string>& served_methods() {
       "program.step",  "program.pause",    "program.resume",     "program.abort",   "mdi.execute",
       "override.feed", "override.rapid",   "override.spindle",   "tool.list",       "tool.set",
       "offsets.get",   "offsets.set",      "tool.change_done",   "program.preview", "jog.heartbeat",
-      "wait.done",     "sim.set"};
+      "wait.done",     "sim.set",          "jobs.history",       "jobs.stats"};
   return methods;
 }
 

@@ -84,6 +84,8 @@ class RpcParamsTest : public MachineTest {
         {"status.get", {{"fields", {"state"}}}},
         {"status.subscribe", {{"interval_ms", 1000}, {"fields", {"state"}}}},
         {"errors.list", {{"since", 0}}},
+        {"jobs.history", {{"since", 0}, {"limit", 10}}},
+        {"jobs.stats", {{"since", 1.5}}},
         {"machine.home", {{"joints", {0}}}},
         {"jog.start", {{"axis", "X"}, {"velocity", 1}, {"heartbeat_s", 0.5}}},
         {"jog.stop", {{"axis", "X"}}},

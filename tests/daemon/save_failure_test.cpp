@@ -23,9 +23,9 @@ class SaveFailureTest : public ::testing::Test {
     if (geteuid() != 0) GTEST_SKIP() << "mounting a tmpfs as the state directory needs root";
     state_ = dir_.path() / "state";
     fs::create_directories(state_);
-    // Room for the seeds, the marker and the position file, and a little more.
+    // Room for the seeds, the marker, the position file and the job history, and a little more.
     // Mode 0755: a tmpfs is 1777 by default, a state directory cncd refuses.
-    if (mount("tmpfs", state_.c_str(), "tmpfs", 0, "size=64k,mode=0755") != 0) {
+    if (mount("tmpfs", state_.c_str(), "tmpfs", 0, "size=256k,mode=0755") != 0) {
       GTEST_SKIP() << "cannot mount a tmpfs on " << state_ << ": " << std::strerror(errno);
     }
     mounted_ = true;
@@ -43,6 +43,21 @@ class SaveFailureTest : public ::testing::Test {
 
   json call(const std::string& method, const json& params = nullptr) {
     return client_.call(method, params, 30000);
+  }
+
+  // Waits until the event log has an event of `kind` whose message holds `text`.
+  bool wait_for_event(const std::string& kind, const std::string& text) {
+    json events;
+    for (int i = 0; i < 3000; ++i) {
+      events = result_of(call("errors.list"))["events"];
+      for (const auto& e : events) {
+        if (e["kind"] == kind && e["message"].get<std::string>().find(text) != std::string::npos)
+          return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "no " << kind << " event with '" << text << "' in " << events.dump();
+    return false;
   }
 
   // Takes every free block of the tmpfs.
@@ -68,8 +83,9 @@ class SaveFailureTest : public ::testing::Test {
   // temporary file left behind.
   std::vector<std::string> strays() const {
     const std::set<std::string> known = {
-        "sim_mm.var", "sim_mm.tbl", "sim_mm.position", "sim_mm.position.running",
-        "cncd.lock",  "filler",     "filler2"};
+        "sim_mm.var",  "sim_mm.tbl", "sim_mm.position", "sim_mm.position.running",
+        "cncd.lock",   "filler",     "filler2",         "jobs.db",
+        "jobs.db-wal", "jobs.db-shm"};
     std::vector<std::string> out;
     for (const auto& entry : fs::directory_iterator(state_)) {
       if (!known.contains(entry.path().filename().string()))
@@ -193,6 +209,37 @@ TEST_F(SaveFailureTest, ProgramThatSetsAnOffsetOnAFullDiskEndsInErrorAndIsUndone
   EXPECT_NE(error.find("No space left on device"), std::string::npos) << error;
   EXPECT_EQ(origin("G56"), g56);
   EXPECT_EQ(strays(), std::vector<std::string>{});
+}
+
+// The job history on a full disk: the run goes on, the problem is logged once, and the run's
+// row is written when there is room again.
+TEST_F(SaveFailureTest, AJobOnAFullDiskIsLoggedKeptAndWrittenWhenThereIsRoom) {
+  ready_machine();
+  const fs::path program = dir_.write("part.ngc", "G21 G90 F3000\nG1 X5\nM30\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  fill_disk();
+  result_of(call("program.run"));
+  json s;
+  for (int i = 0; i < 3000; ++i) {
+    s = result_of(call("status.get"));
+    if (s["exec"] == "idle") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  EXPECT_TRUE(wait_for_event("jobs", "No space left on device"));
+  EXPECT_EQ(s["state"], "on");
+  // Even a read needs room for SQLite's shared-memory file: refused, saying why.
+  const json full = call("jobs.history");
+  EXPECT_EQ(error_code(full), 1012);
+  EXPECT_NE(full.dump().find("No space left on device"), std::string::npos) << full.dump();
+  fs::remove(state_ / "filler");
+  fs::remove(state_ / "filler2");
+  EXPECT_TRUE(wait_for_event("jobs", "written again"));
+  const json jobs = result_of(call("jobs.history"))["jobs"];
+  ASSERT_EQ(jobs.size(), 1u) << jobs.dump();
+  EXPECT_EQ(jobs[0]["result"], "done");
+  EXPECT_EQ(jobs[0]["parts"], 1);
+  EXPECT_EQ(jobs[0]["program"], program.string());
 }
 
 }  // namespace

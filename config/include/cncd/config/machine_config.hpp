@@ -200,6 +200,13 @@ struct CncdConfig {
 };
 
 // [WEB]: cncd-web, the browser dashboard and WebSocket proxy (docs/web.md).
+// [TELEMETRY]: what the daemon counts and records for the shop's systems.
+struct TelemetryConfig {
+  // Which program end counts a part in the job history: M30 only, M2 or M30, or none.
+  enum class PartCount { m30, m2, off };
+  PartCount part_count = PartCount::m30;
+};
+
 struct WebConfig {
   std::string listen = "127.0.0.1";  // address to bind; any other than loopback is explicit
   int port = 8080;
@@ -281,6 +288,7 @@ struct MachineConfig {
   std::array<AxisConfig, kMaxAxes> axes;  // indexed by axis_index()
   std::vector<JointConfig> joints;        // joint_count entries
   CncdConfig cncd;
+  TelemetryConfig telemetry;
   WebConfig web;
   SpindleConfig spindle;  // [SPINDLE_0]
   ToolChangeConfig tool_change;

@@ -94,6 +94,8 @@ class ProgramRunner {
   bool waiting_probe() const { return probe_wait_; }
   bool waiting_input() const { return input_wait_; }
   bool ended() const { return ended_; }
+  // How the program ended: 30 (M30), 2 (M2), 0 (a closing '%', or not ended yet).
+  int end_code() const { return sink_.end_code; }
   // Whether no move is left for the queue.
   bool drained() const { return !feeder_.has_pending(); }
   // Moves and actions (spindle, outputs, waits) the queue has taken since start().
@@ -110,6 +112,9 @@ class ProgramRunner {
     Sink(const interp::Interpreter& from, ProgramFeeder& to) : interp(from), feeder(to) {}
     void emit(const interp::CanonCommand& command) override {
       if (tap != nullptr) tap->emit(command);
+      // M30 is a pallet shuttle and the end; M60's shuttle is followed by a stop instead.
+      if (std::holds_alternative<interp::ProgramEnd>(command.op)) end_code = shuttled ? 30 : 2;
+      shuttled = std::holds_alternative<interp::PalletShuttle>(command.op);
       // Inside a subroutine file the moves carry the line of the call in the program's own
       // file: the status, its progress and the errors count the program's lines.
       if (const int line = interp.program_line(); line != interp.current_line()) {
@@ -123,6 +128,8 @@ class ProgramRunner {
     const interp::Interpreter& interp;
     ProgramFeeder& feeder;
     interp::CanonSink* tap = nullptr;
+    bool shuttled = false;  // the last command was a pallet shuttle
+    int end_code = 0;
   };
 
   Outcome fail(Error error);
