@@ -59,6 +59,8 @@ int tools(daemon::Client& client, const Args& args, bool json_output);
 // `offsets` and `offsets set G54..G59.3 [X..W..] [R..]`
 int offsets(daemon::Client& client, const Args& args, bool json_output);
 
+// `jobs [stats] [--since YYYY-MM-DD] [--limit N]`: jobs.history, jobs.stats
+int jobs(daemon::Client& client, const Args& args, bool json_output);
 // `info`: system.info
 int info(daemon::Client& client, const Args& args, bool json_output);
 // `override feed|rapid|spindle PERCENT`

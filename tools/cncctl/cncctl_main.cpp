@@ -57,6 +57,8 @@ void usage(std::FILE* out) {
       "  offsets             list the coordinate systems G54..G59.3 and G92\n"
       "  offsets set G55 [X<origin> ...] [R<rotation>]\n"
       "                      set one coordinate system's origin (machine coordinates)\n"
+      "  jobs [stats] [--since YYYY-MM-DD] [--limit N]\n"
+      "                      the programs run: when, how they ended, cycle time, parts\n"
       "  errors [--since SEQ]\n"
       "                      list recent errors and events (those after SEQ)\n"
       "  info                cncd's version and the machine it runs\n"
@@ -244,9 +246,9 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     return kDone;
   };
   if (command == "status") return show(client, "status.get", json_output, print_status);
-  static const std::vector<std::string> kTakeArgs = {"home", "run",      "mdi",    "open",
-                                                     "step", "watch",    "tools",  "offsets",
-                                                     "jog",  "override", "errors", "tool-done"};
+  static const std::vector<std::string> kTakeArgs = {
+      "home",    "run", "mdi",      "open",   "step",      "watch", "tools",
+      "offsets", "jog", "override", "errors", "tool-done", "jobs"};
   if (args.size() > 1 &&
       std::find(kTakeArgs.begin(), kTakeArgs.end(), command) == kTakeArgs.end()) {
     std::fprintf(stderr, "cncctl: '%s' takes no arguments\n", command.c_str());
@@ -299,6 +301,7 @@ int run_command(cncd::daemon::Client& client, const std::vector<std::string>& ar
     if (json_output) std::printf("%s\n", response["result"].dump().c_str());
     return kDone;
   }
+  if (command == "jobs") return jobs(client, args, json_output);
   if (command == "errors") {
     if (args.size() != 1 && (args.size() != 3 || args[1] != "--since"))
       throw UsageError{"errors takes only --since SEQ"};
