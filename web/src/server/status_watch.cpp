@@ -7,7 +7,7 @@ namespace cncd::web {
 void StatusWatch::start() {
   if (stopped_) return;
   status_ = nlohmann::json::object();
-  upstream_ = std::make_shared<Upstream>(app_.io, app_.socket_path, 1 << 20);
+  upstream_ = std::make_shared<client::Upstream>(app_.io, app_.socket_path, 1 << 20);
   upstream_->start([this](std::string line) { on_line(line); },
                    [this](const std::string& why) {
                      app_.program_running = false;

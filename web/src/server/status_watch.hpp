@@ -23,7 +23,7 @@ class StatusWatch {
   void on_line(const std::string& line);
 
   App& app_;
-  std::shared_ptr<Upstream> upstream_;
+  std::shared_ptr<client::Upstream> upstream_;
   boost::asio::steady_timer retry_;
   nlohmann::json status_;
   bool stopped_ = false;

@@ -66,8 +66,8 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
     app_.peers.insert(this);
     spdlog::info("{} ({}) connected from {}", rpc_.identity().user, role_name(rpc_.identity().role),
                  address_);
-    upstream_ =
-        std::make_shared<Upstream>(app_.io, app_.socket_path, app_.limits.upstream_line_bytes);
+    upstream_ = std::make_shared<client::Upstream>(app_.io, app_.socket_path,
+                                                   app_.limits.upstream_line_bytes);
     std::weak_ptr<WsSession> weak = this->shared_from_this();
     upstream_->start(
         [weak](std::string line) {
@@ -183,7 +183,7 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
   std::size_t queued_bytes_ = 0;
   bool writing_ = false;
   bool closing_ = false;
-  std::shared_ptr<Upstream> upstream_;
+  std::shared_ptr<client::Upstream> upstream_;
   boost::asio::steady_timer kill_timer_;
 };
 

@@ -1,5 +1,6 @@
 // One connection to cncd's control socket: newline-delimited JSON-RPC, as cncctl speaks it.
-// Each WebSocket gets its own, so its subscriptions and request ids stay the client's own.
+// cncd-web gives each WebSocket its own, so its subscriptions and request ids stay the
+// client's own; cncd-telemetry holds one.
 #pragma once
 
 #include <cstddef>
@@ -12,7 +13,7 @@
 #include <boost/asio/local/stream_protocol.hpp>
 #include <boost/asio/streambuf.hpp>
 
-namespace cncd::web {
+namespace cncd::client {
 
 class Upstream : public std::enable_shared_from_this<Upstream> {
  public:
@@ -50,4 +51,4 @@ class Upstream : public std::enable_shared_from_this<Upstream> {
   CloseHandler on_close_;
 };
 
-}  // namespace cncd::web
+}  // namespace cncd::client

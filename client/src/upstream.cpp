@@ -4,7 +4,7 @@
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/write.hpp>
 
-namespace cncd::web {
+namespace cncd::client {
 
 namespace asio = boost::asio;
 using Protocol = asio::local::stream_protocol;
@@ -90,4 +90,4 @@ void Upstream::fail(const std::string& why) {
   if (on_close_) on_close_(why);
 }
 
-}  // namespace cncd::web
+}  // namespace cncd::client
