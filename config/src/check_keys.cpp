@@ -116,9 +116,10 @@ void check_keys(TypedReader& r) {
       check_repeated(r, entry);
       continue;
     }
-    // [CNCD], [WEB] and [PANEL] are cncd's own: an unknown key there is a problem
-    // (load_general, load_web, load_panel).
-    if (pattern == "CNCD" || pattern == "WEB" || pattern == "PANEL") continue;
+    // [CNCD], [WEB], [PANEL] and [TELEMETRY] are cncd's own: an unknown key there is a
+    // problem (load_general, load_web, load_panel, load_telemetry).
+    if (pattern == "CNCD" || pattern == "WEB" || pattern == "PANEL" || pattern == "TELEMETRY")
+      continue;
     const auto linuxcnc = linuxcnc_keys(pattern);
     if (std::find(linuxcnc.begin(), linuxcnc.end(), entry.key) != linuxcnc.end()) continue;
     if (const std::string guess = did_you_mean(entry.section, entry.key); !guess.empty()) {

@@ -133,6 +133,15 @@ constexpr std::array kMachineKeys{
     choice_key("TELEMETRY", "PART_COUNT", "m30", "m30|m2|off",
                "Which program end counts a part in the job history: m30 (M30 only), m2 (M2 or "
                "M30) or off"),
+    text_key("TELEMETRY", "MACHINE_ID", "",
+             "The machine's name in MQTT topics, MTConnect and metrics (letters, digits, - _ .); "
+             "empty: [EMC] MACHINE with other characters as _, else the INI's name"),
+    text_key("TELEMETRY", "METRICS_LISTEN", "127.0.0.1:9877",
+             "cncd-telemetry: ADDRESS:PORT of the Prometheus /metrics endpoint; off: none"),
+    text_key("TELEMETRY", "SHDR_LISTEN", "127.0.0.1",
+             "cncd-telemetry: the address the MTConnect SHDR adapter listens on"),
+    integer_key("TELEMETRY", "SHDR_PORT", "7878", 0, 65535, "",
+                "cncd-telemetry: the SHDR adapter's TCP port; 0: none"),
 
     text_key("WEB", "LISTEN", "127.0.0.1",
              "cncd-web: the IP address it listens on; 127.0.0.1 (this machine only), 0.0.0.0 or "

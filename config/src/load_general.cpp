@@ -252,10 +252,6 @@ void load_general(TypedReader& r, MachineConfig& c) {
   if (const auto v = r.real("DISPLAY", "MIN_SPINDLE_OVERRIDE")) c.min_spindle_override = *v;
   if (const auto v = r.real("DISPLAY", "MAX_SPINDLE_OVERRIDE")) c.max_spindle_override = *v;
   load_cncd(r, c.cncd);
-  if (const auto v = r.choice("TELEMETRY", "PART_COUNT")) {
-    using enum TelemetryConfig::PartCount;
-    c.telemetry.part_count = *v == "m2" ? m2 : *v == "off" ? off : m30;
-  }
 }
 
 }  // namespace cncd::config

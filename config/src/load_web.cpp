@@ -13,20 +13,14 @@ namespace {
 
 void load_listen(TypedReader& r, WebConfig& web) {
   const std::string listen(trim(strip_trailing_comment(r.text("WEB", "LISTEN").value_or(""))));
-  std::string address = listen;
-  if (address.size() > 2 && address.front() == '[' && address.back() == ']') {
-    address = address.substr(1, address.size() - 2);
-  }
-  unsigned char buffer[16];
-  if (address.empty()) {
+  if (listen.empty()) {
     r.problem("WEB", "LISTEN", "empty; give an address such as 127.0.0.1, 0.0.0.0 or ::");
-  } else if (::inet_pton(AF_INET, address.c_str(), buffer) != 1 &&
-             ::inet_pton(AF_INET6, address.c_str(), buffer) != 1) {
+  } else if (const auto address = ip_address(listen)) {
+    web.listen = *address;
+  } else {
     r.problem(
         "WEB", "LISTEN",
         "'" + printable(listen) + "' is not an IP address (e.g. 127.0.0.1, 0.0.0.0, ::1 or ::)");
-  } else {
-    web.listen = address;
   }
 }
 
@@ -125,6 +119,19 @@ void load_origins(TypedReader& r, WebConfig& web) {
 }
 
 }  // namespace
+
+std::optional<std::string> ip_address(std::string_view text) {
+  std::string address(text);
+  if (address.size() > 2 && address.front() == '[' && address.back() == ']') {
+    address = address.substr(1, address.size() - 2);
+  }
+  unsigned char buffer[16];
+  if (::inet_pton(AF_INET, address.c_str(), buffer) != 1 &&
+      ::inet_pton(AF_INET6, address.c_str(), buffer) != 1) {
+    return std::nullopt;
+  }
+  return address;
+}
 
 void load_web(TypedReader& r, MachineConfig& c) {
   WebConfig& web = c.web;

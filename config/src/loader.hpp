@@ -2,6 +2,7 @@
 // collects problems instead of stopping.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +20,10 @@ void load_program_dirs(TypedReader& reader, MachineConfig& config, const LoadOpt
 void load_state_files(TypedReader& reader, MachineConfig& config, const LoadOptions& options);
 // [WEB], cncd-web's keys (after load_program_dirs and load_state_files).
 void load_web(TypedReader& reader, MachineConfig& config);
+// [TELEMETRY], the job history's and cncd-telemetry's keys (after load_general).
+void load_telemetry(TypedReader& reader, MachineConfig& config);
+// The IP address in `text` (brackets around an IPv6 one dropped), or nullopt.
+std::optional<std::string> ip_address(std::string_view text);
 // [KINS], the joint map, [AXIS_L] and [JOINT_n]; fills the [TRAJ] limits left unset.
 void load_motion(TypedReader& reader, MachineConfig& config);
 // [SPINDLE_0] (and a warning for the [SPINDLE_n] cncd does not drive).

@@ -59,6 +59,7 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
   load_program_dirs(reader, config, options);
   load_state_files(reader, config, options);
   load_web(reader, config);
+  load_telemetry(reader, config);
   load_spindle(reader, config);
   load_io(reader, config);
   load_panel(reader, config);

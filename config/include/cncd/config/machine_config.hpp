@@ -200,11 +200,21 @@ struct CncdConfig {
 };
 
 // [WEB]: cncd-web, the browser dashboard and WebSocket proxy (docs/web.md).
-// [TELEMETRY]: what the daemon counts and records for the shop's systems.
+// [TELEMETRY]: what the daemon counts and records for the shop's systems, and what
+// cncd-telemetry serves them (cncd reads the section too, and checks it).
 struct TelemetryConfig {
   // Which program end counts a part in the job history: M30 only, M2 or M30, or none.
   enum class PartCount { m30, m2, off };
   PartCount part_count = PartCount::m30;
+  // The machine's name towards the shop: letters, digits, '-', '_' and '.'; default [EMC]
+  // MACHINE with every other character as '_', else the INI's file name without .ini.
+  std::string machine_id;
+  // Prometheus /metrics: address and port; port 0 = not served.
+  std::string metrics_address = "127.0.0.1";
+  int metrics_port = 9877;
+  // The MTConnect SHDR adapter: address and port; port 0 = not served.
+  std::string shdr_address = "127.0.0.1";
+  int shdr_port = 7878;
 };
 
 struct WebConfig {

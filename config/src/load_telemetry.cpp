@@ -1,0 +1,92 @@
+// [TELEMETRY]: the part count the daemon's job history keeps, and cncd-telemetry's keys (the
+// daemon reads them too: one file, checked whole).
+#include <string>
+
+#include "loader.hpp"
+#include "text.hpp"
+
+namespace cncd::config {
+namespace {
+
+bool id_character(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+         c == '_' || c == '.';
+}
+
+void load_machine_id(TypedReader& r, const MachineConfig& c, TelemetryConfig& t) {
+  const std::string given(
+      trim(strip_trailing_comment(r.text("TELEMETRY", "MACHINE_ID").value_or(""))));
+  if (!given.empty()) {
+    for (const char ch : given) {
+      if (!id_character(ch)) {
+        r.problem("TELEMETRY", "MACHINE_ID",
+                  "'" + printable(given) +
+                      "' may hold only letters, digits, '-', '_' and '.' (it is part of MQTT "
+                      "topics and metric labels)");
+        return;
+      }
+    }
+    t.machine_id = given;
+    return;
+  }
+  std::string id = c.machine_name.empty() ? c.path.stem().string() : c.machine_name;
+  for (char& ch : id) {
+    if (!id_character(ch)) ch = '_';
+  }
+  t.machine_id = id.empty() ? "cncd" : id;
+}
+
+// ADDRESS:PORT, or "off".
+void load_metrics_listen(TypedReader& r, TelemetryConfig& t) {
+  const std::string text(
+      trim(strip_trailing_comment(r.text("TELEMETRY", "METRICS_LISTEN").value_or(""))));
+  if (text == "off") {
+    t.metrics_port = 0;
+    return;
+  }
+  const std::size_t colon = text.rfind(':');
+  const std::string port = colon == std::string::npos ? "" : text.substr(colon + 1);
+  const auto address =
+      colon == std::string::npos ? std::nullopt : ip_address(text.substr(0, colon));
+  const bool port_ok = !port.empty() && port.size() <= 5 &&
+                       port.find_first_not_of("0123456789") == std::string::npos &&
+                       std::stoi(port) >= 1 && std::stoi(port) <= 65535;
+  if (!address || !port_ok) {
+    r.problem("TELEMETRY", "METRICS_LISTEN",
+              "'" + printable(text) +
+                  "' is not ADDRESS:PORT (e.g. 127.0.0.1:9877, [::1]:9877, 0.0.0.0:9877) or off");
+    return;
+  }
+  t.metrics_address = *address;
+  t.metrics_port = std::stoi(port);
+}
+
+}  // namespace
+
+void load_telemetry(TypedReader& r, MachineConfig& c) {
+  TelemetryConfig& t = c.telemetry;
+  if (const auto v = r.choice("TELEMETRY", "PART_COUNT")) {
+    using enum TelemetryConfig::PartCount;
+    t.part_count = *v == "m2" ? m2 : *v == "off" ? off : m30;
+  }
+  load_machine_id(r, c, t);
+  load_metrics_listen(r, t);
+  const std::string shdr(
+      trim(strip_trailing_comment(r.text("TELEMETRY", "SHDR_LISTEN").value_or(""))));
+  if (const auto address = ip_address(shdr)) {
+    t.shdr_address = *address;
+  } else {
+    r.problem("TELEMETRY", "SHDR_LISTEN",
+              "'" + printable(shdr) + "' is not an IP address (e.g. 127.0.0.1, 0.0.0.0 or ::)");
+  }
+  if (const auto v = r.integer("TELEMETRY", "SHDR_PORT")) t.shdr_port = static_cast<int>(*v);
+  for (const auto& entry : r.ini().entries()) {
+    if (entry.section == "TELEMETRY" && entry.section_occurrence == 0 &&
+        find_key_spec("TELEMETRY", entry.key) == nullptr) {
+      r.problem("TELEMETRY", entry.key,
+                "unknown key in cncd's telemetry section" + did_you_mean("TELEMETRY", entry.key));
+    }
+  }
+}
+
+}  // namespace cncd::config
