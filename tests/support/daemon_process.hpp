@@ -59,6 +59,7 @@ class BackgroundCommand {
   std::string err_so_far() const;
   // Closes its standard input and waits for it to end.
   CommandResult wait();
+  pid_t pid() const { return pid_; }
 
  private:
   TempDir dir_;
