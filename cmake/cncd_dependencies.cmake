@@ -10,6 +10,8 @@ pkg_check_modules(GPIOD REQUIRED IMPORTED_TARGET libgpiod)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
 # The daemon's job history.
 pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
+# cncd-telemetry's MQTT.
+pkg_check_modules(MOSQUITTO REQUIRED IMPORTED_TARGET libmosquitto)
 # cncd-web: HTTP and WebSocket from Boost.Beast (header-only), passwords hashed with argon2id.
 find_package(Boost 1.81 REQUIRED)
 # What cncd-web and its tests build Asio with. ThreadSanitizer does not model standalone

@@ -142,6 +142,23 @@ constexpr std::array kMachineKeys{
              "cncd-telemetry: the address the MTConnect SHDR adapter listens on"),
     integer_key("TELEMETRY", "SHDR_PORT", "7878", 0, 65535, "",
                 "cncd-telemetry: the SHDR adapter's TCP port; 0: none"),
+    text_key("TELEMETRY", "MQTT_HOST", "",
+             "cncd-telemetry: the MQTT broker's host name or address; empty: no MQTT"),
+    integer_key("TELEMETRY", "MQTT_PORT", "1883", 1, 65535, "",
+                "cncd-telemetry: the broker's port"),
+    text_key("TELEMETRY", "MQTT_USERNAME", "", "cncd-telemetry: the broker's user name"),
+    text_key("TELEMETRY", "MQTT_PASSWORD", "",
+             "cncd-telemetry: the broker's password (keep the INI unreadable to others then)"),
+    path_key("TELEMETRY", "MQTT_TLS_CA", "",
+             "cncd-telemetry: a CA certificate file: the broker is reached over TLS"),
+    choice_key("TELEMETRY", "MQTT_PROTOCOL", "5", "5|3.1.1", "cncd-telemetry: the MQTT version"),
+    text_key("TELEMETRY", "TOPIC_PREFIX", "",
+             "cncd-telemetry: the topics' prefix; empty: cncd/<MACHINE_ID>"),
+    real_key("TELEMETRY", "POSITION_HZ", "5", 0, 100, "Hz",
+             "cncd-telemetry: position messages a second; 0: none"),
+    integer_key("TELEMETRY", "EVENT_QUEUE", "10000", 1, 10000000, "",
+                "cncd-telemetry: events and jobs kept while the broker is away; beyond, the "
+                "oldest are dropped, counted and logged"),
 
     text_key("WEB", "LISTEN", "127.0.0.1",
              "cncd-web: the IP address it listens on; 127.0.0.1 (this machine only), 0.0.0.0 or "

@@ -61,6 +61,25 @@ void load_metrics_listen(TypedReader& r, TelemetryConfig& t) {
   t.metrics_port = std::stoi(port);
 }
 
+// A topic prefix names levels, never wildcards: '+' and '#' are for subscribers.
+void load_topic_prefix(TypedReader& r, TelemetryConfig& t) {
+  const std::string given(
+      trim(strip_trailing_comment(r.text("TELEMETRY", "TOPIC_PREFIX").value_or(""))));
+  if (given.empty()) {
+    t.topic_prefix = "cncd/" + t.machine_id;
+    return;
+  }
+  if (given.find_first_of("+#") != std::string::npos || given.front() == '/' ||
+      given.back() == '/' || given.find('\0') != std::string::npos) {
+    r.problem("TELEMETRY", "TOPIC_PREFIX",
+              "'" + printable(given) +
+                  "' is not a topic prefix: no '+' or '#', no '/' at either end (e.g. "
+                  "shop/bay2/mill-1)");
+    return;
+  }
+  t.topic_prefix = given;
+}
+
 }  // namespace
 
 void load_telemetry(TypedReader& r, MachineConfig& c) {
@@ -80,6 +99,16 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
               "'" + printable(shdr) + "' is not an IP address (e.g. 127.0.0.1, 0.0.0.0 or ::)");
   }
   if (const auto v = r.integer("TELEMETRY", "SHDR_PORT")) t.shdr_port = static_cast<int>(*v);
+  t.mqtt_host =
+      std::string(trim(strip_trailing_comment(r.text("TELEMETRY", "MQTT_HOST").value_or(""))));
+  if (const auto v = r.integer("TELEMETRY", "MQTT_PORT")) t.mqtt_port = static_cast<int>(*v);
+  t.mqtt_username = std::string(trim(r.text("TELEMETRY", "MQTT_USERNAME").value_or("")));
+  t.mqtt_password = std::string(r.text("TELEMETRY", "MQTT_PASSWORD").value_or(""));
+  t.mqtt_tls_ca = r.path("TELEMETRY", "MQTT_TLS_CA").value_or("");
+  if (const auto v = r.choice("TELEMETRY", "MQTT_PROTOCOL")) t.mqtt_protocol = *v == "5" ? 5 : 311;
+  load_topic_prefix(r, t);
+  if (const auto v = r.real("TELEMETRY", "POSITION_HZ")) t.position_hz = *v;
+  if (const auto v = r.integer("TELEMETRY", "EVENT_QUEUE")) t.event_queue = static_cast<int>(*v);
   for (const auto& entry : r.ini().entries()) {
     if (entry.section == "TELEMETRY" && entry.section_occurrence == 0 &&
         find_key_spec("TELEMETRY", entry.key) == nullptr) {

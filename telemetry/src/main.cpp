@@ -1,5 +1,6 @@
 // cncd-telemetry: cncd's state for a shop's systems (docs/telemetry.md). A read-only client of
-// cncd's control socket; serves Prometheus' /metrics ([TELEMETRY] METRICS_LISTEN).
+// cncd's control socket; serves Prometheus' /metrics, an MTConnect SHDR adapter and MQTT
+// ([TELEMETRY]).
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -9,12 +10,9 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
 
+#include "app.hpp"
 #include "cncd/config/machine_config.hpp"
-#include "json_read.hpp"
 #include "logging.hpp"
-#include "machine_feed.hpp"
-#include "metrics.hpp"
-#include "metrics_server.hpp"
 #include "shdr.hpp"
 #include "version.hpp"
 
@@ -129,48 +127,20 @@ int main(int argc, char** argv) {
 
   cncd::daemon::init_logging(*level);
   boost::asio::io_context io;
-  cncd::telemetry::Counters counters;
-  cncd::telemetry::MachineFeed::Listener listener;
-  listener.event = [&counters](const nlohmann::json& event) {
-    ++counters.events[{cncd::telemetry::text_at(event, "level"),
-                       cncd::telemetry::text_at(event, "kind")}];
-  };
-  cncd::telemetry::ShdrServer* shdr_out = nullptr;
-  auto changed = [&shdr_out] {
-    if (shdr_out != nullptr) shdr_out->changed();
-  };
-  listener.status = changed;
-  listener.jobs = changed;
-  listener.connection = [&changed](bool) { changed(); };
-  cncd::telemetry::MachineFeed feed(io, socket_path, listener);
-  cncd::telemetry::ShdrServer shdr(io, feed, axes);
-  if (shdr_port != 0 || !shdr_listen.empty()) {
-    if (const auto error = shdr.listen(shdr_address, shdr_port); !error.empty()) {
-      spdlog::critical("SHDR adapter: {}", error);
-      return 1;
-    }
-    shdr_out = &shdr;
-    spdlog::info("serving SHDR on {}:{}", shdr_address, shdr.port());
+  cncd::telemetry::App app(io, t, socket_path, axes);
+  cncd::telemetry::Endpoints endpoints{metrics_address, metrics_port, !metrics_listen.empty(),
+                                       shdr_address,    shdr_port,    !shdr_listen.empty()};
+  if (const auto error = app.start(endpoints); !error.empty()) {
+    spdlog::critical("{}", error);
+    return 1;
   }
-  cncd::telemetry::MetricsServer metrics(
-      io, [&] { return cncd::telemetry::prometheus_text(feed, counters, t.machine_id); });
-  if (metrics_port != 0 || !metrics_listen.empty()) {
-    if (const auto error = metrics.listen(metrics_address, metrics_port); !error.empty()) {
-      spdlog::critical("/metrics: {}", error);
-      return 1;
-    }
-    spdlog::info("serving /metrics on {}:{}", metrics_address, metrics.port());
-  }
-  feed.start();
   spdlog::info("cncd-telemetry {} for machine '{}', cncd at {}", cncd::kVersion, t.machine_id,
                socket_path);
   boost::asio::signal_set signals(io, SIGTERM, SIGINT);
   signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
     spdlog::info("signal {}: shutting down", signal);
-    feed.stop();
-    metrics.stop();
-    shdr.stop();
+    app.stop();
     io.stop();
   });
   io.run();

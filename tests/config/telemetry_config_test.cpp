@@ -39,6 +39,37 @@ TEST_F(TelemetryConfigTest, DefaultsFollowTheContract) {
   EXPECT_EQ(t.metrics_port, 9877);
   EXPECT_EQ(t.shdr_address, "127.0.0.1");
   EXPECT_EQ(t.shdr_port, 7878);
+  EXPECT_EQ(t.mqtt_host, "");
+  EXPECT_EQ(t.mqtt_port, 1883);
+  EXPECT_EQ(t.mqtt_protocol, 5);
+  EXPECT_EQ(t.topic_prefix, "cncd/test");
+  EXPECT_DOUBLE_EQ(t.position_hz, 5);
+  EXPECT_EQ(t.event_queue, 10000);
+}
+
+TEST_F(TelemetryConfigTest, MqttKeysAreRead) {
+  const auto result = load(
+      "MQTT_HOST = broker.shop\nMQTT_PORT = 8883\nMQTT_USERNAME = mill\nMQTT_PASSWORD = s3 cret\n"
+      "MQTT_TLS_CA = ca.pem\nMQTT_PROTOCOL = 3.1.1\nTOPIC_PREFIX = shop/bay2/mill-1\n"
+      "POSITION_HZ = 0\nEVENT_QUEUE = 50\n");
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  const TelemetryConfig& t = result.config->telemetry;
+  EXPECT_EQ(t.mqtt_host, "broker.shop");
+  EXPECT_EQ(t.mqtt_port, 8883);
+  EXPECT_EQ(t.mqtt_username, "mill");
+  EXPECT_EQ(t.mqtt_password, "s3 cret");
+  EXPECT_EQ(t.mqtt_tls_ca, dir_ / "ca.pem");
+  EXPECT_EQ(t.mqtt_protocol, 311);
+  EXPECT_EQ(t.topic_prefix, "shop/bay2/mill-1");
+  EXPECT_DOUBLE_EQ(t.position_hz, 0);
+  EXPECT_EQ(t.event_queue, 50);
+  for (const std::string bad : {"shop/+/mill", "shop/#", "/shop", "shop/"}) {
+    EXPECT_EQ(problem("TOPIC_PREFIX = " + bad + "\n"),
+              "[TELEMETRY] TOPIC_PREFIX: '" + bad +
+                  "' is not a topic prefix: no '+' or '#', no '/' at either end (e.g. "
+                  "shop/bay2/mill-1)")
+        << bad;
+  }
 }
 
 TEST_F(TelemetryConfigTest, EveryKeyIsRead) {
@@ -81,7 +112,8 @@ TEST_F(TelemetryConfigTest, BadValuesAreRefusedNamingTheKey) {
   EXPECT_NE(problem("SHDR_PORT = 70000\n").find("[TELEMETRY] SHDR_PORT"), std::string::npos);
   EXPECT_NE(problem("PART_COUNT = m3\n").find("[TELEMETRY] PART_COUNT"), std::string::npos);
   EXPECT_EQ(problem("TOPIC_PREFX = x\n"),
-            "[TELEMETRY] TOPIC_PREFX: unknown key in cncd's telemetry section");
+            "[TELEMETRY] TOPIC_PREFX: unknown key in cncd's telemetry section; did you mean "
+            "TOPIC_PREFIX?");
 }
 
 }  // namespace

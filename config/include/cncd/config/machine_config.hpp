@@ -215,6 +215,18 @@ struct TelemetryConfig {
   // The MTConnect SHDR adapter: address and port; port 0 = not served.
   std::string shdr_address = "127.0.0.1";
   int shdr_port = 7878;
+  // MQTT: the broker (no host: none), its credentials and TLS CA file, the protocol (5 or
+  // 311), the topics' prefix (default cncd/<machine id>), positions a second (0: none) and the
+  // events kept for the broker while it is away.
+  std::string mqtt_host;
+  int mqtt_port = 1883;
+  std::string mqtt_username;
+  std::string mqtt_password;
+  std::filesystem::path mqtt_tls_ca;
+  int mqtt_protocol = 5;
+  std::string topic_prefix;
+  double position_hz = 5;
+  int event_queue = 10000;
 };
 
 struct WebConfig {
