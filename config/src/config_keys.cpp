@@ -4,6 +4,7 @@
 
 #include "key_makers.hpp"
 #include "panel_key_specs.hpp"
+#include "telemetry_key_specs.hpp"
 
 namespace cncd::config {
 namespace {
@@ -129,36 +130,6 @@ constexpr std::array kMachineKeys{
     positive_key("CNCD", "USER_M_TIMEOUT", "60", "s",
                  "A user M code (M100-M199) still running after this long is stopped and the "
                  "program with it"),
-
-    choice_key("TELEMETRY", "PART_COUNT", "m30", "m30|m2|off",
-               "Which program end counts a part in the job history: m30 (M30 only), m2 (M2 or "
-               "M30) or off"),
-    text_key("TELEMETRY", "MACHINE_ID", "",
-             "The machine's name in MQTT topics, MTConnect and metrics (letters, digits, - _ .); "
-             "empty: [EMC] MACHINE with other characters as _, else the INI's name"),
-    text_key("TELEMETRY", "METRICS_LISTEN", "127.0.0.1:9877",
-             "cncd-telemetry: ADDRESS:PORT of the Prometheus /metrics endpoint; off: none"),
-    text_key("TELEMETRY", "SHDR_LISTEN", "127.0.0.1",
-             "cncd-telemetry: the address the MTConnect SHDR adapter listens on"),
-    integer_key("TELEMETRY", "SHDR_PORT", "7878", 0, 65535, "",
-                "cncd-telemetry: the SHDR adapter's TCP port; 0: none"),
-    text_key("TELEMETRY", "MQTT_HOST", "",
-             "cncd-telemetry: the MQTT broker's host name or address; empty: no MQTT"),
-    integer_key("TELEMETRY", "MQTT_PORT", "1883", 1, 65535, "",
-                "cncd-telemetry: the broker's port"),
-    text_key("TELEMETRY", "MQTT_USERNAME", "", "cncd-telemetry: the broker's user name"),
-    text_key("TELEMETRY", "MQTT_PASSWORD", "",
-             "cncd-telemetry: the broker's password (keep the INI unreadable to others then)"),
-    path_key("TELEMETRY", "MQTT_TLS_CA", "",
-             "cncd-telemetry: a CA certificate file: the broker is reached over TLS"),
-    choice_key("TELEMETRY", "MQTT_PROTOCOL", "5", "5|3.1.1", "cncd-telemetry: the MQTT version"),
-    text_key("TELEMETRY", "TOPIC_PREFIX", "",
-             "cncd-telemetry: the topics' prefix; empty: cncd/<MACHINE_ID>"),
-    real_key("TELEMETRY", "POSITION_HZ", "5", 0, 100, "Hz",
-             "cncd-telemetry: position messages a second; 0: none"),
-    integer_key("TELEMETRY", "EVENT_QUEUE", "10000", 1, 10000000, "",
-                "cncd-telemetry: events and jobs kept while the broker is away; beyond, the "
-                "oldest are dropped, counted and logged"),
 
     text_key("WEB", "LISTEN", "127.0.0.1",
              "cncd-web: the IP address it listens on; 127.0.0.1 (this machine only), 0.0.0.0 or "
@@ -416,7 +387,7 @@ constexpr std::array kMachineKeys{
                 "Repeats of a failed request before the drive is faulted"),
 };
 
-constexpr auto kKeys = panel_keys::with_panel_keys(kMachineKeys);
+constexpr auto kKeys = panel_keys::with_panel_keys(join_keys(kMachineKeys, kTelemetryKeys));
 
 bool matches_section(std::string_view pattern, std::string_view section) {
   if (pattern == "JOINT_n") return section.starts_with("JOINT_") && section.size() > 6;

@@ -2,6 +2,8 @@
 // range and unit that kind always has.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <string_view>
 
 #include "cncd/config/config_keys.hpp"
@@ -100,6 +102,18 @@ constexpr std::size_t axis_placeholder(std::string_view key) {
     return std::string_view::npos;
   }
   return at + 1;
+}
+
+// `a` then `b`, as one array.
+template <std::size_t N, std::size_t M>
+constexpr std::array<KeySpec, N + M> join_keys(const std::array<KeySpec, N>& a,
+                                               const std::array<KeySpec, M>& b) {
+  std::array<KeySpec, N + M> all{};
+  for (std::size_t i = 0; i < N; ++i)
+    all[i] = a[i];
+  for (std::size_t i = 0; i < M; ++i)
+    all[N + i] = b[i];
+  return all;
 }
 
 }  // namespace cncd::config::key_makers
