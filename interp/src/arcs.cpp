@@ -6,6 +6,7 @@
 #include <numbers>
 #include <string>
 
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -53,13 +54,6 @@ std::string format(const char* pattern, double a, double b) {
 
 void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
   const PlaneAxes axes = plane_axes(modal_.plane);
-  const double start1 = pos_[axes.first];
-  const double start2 = pos_[axes.second];
-  const double end1 = end[axes.first];
-  const double end2 = end[axes.second];
-  const char letter1 = static_cast<char>(std::toupper(kAxisLetters[axes.first]));
-  const char letter2 = static_cast<char>(std::toupper(kAxisLetters[axes.second]));
-  const bool inches = modal_.units == Units::inches;
   const bool radius_format = block_.has('r');
   const bool has_offsets = block_.has(axes.first_offset) || block_.has(axes.second_offset);
 
@@ -76,36 +70,86 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
     if (p < 1.0) fail("P value should be 1 or greater with G2 or G3", block_.col('p'));
     turns = to_int(p);
   }
-
-  double center1 = 0;
-  double center2 = 0;
   if (radius_format) {
     // The plane letters in order (X before Y before Z), as LinuxCNC names them.
+    const char letter1 = kAxisLetters[axes.first];
+    const char letter2 = kAxisLetters[axes.second];
     const bool first_is_later = axes.first > axes.second;
-    const char low = static_cast<char>(std::tolower(first_is_later ? letter2 : letter1));
-    const char high = static_cast<char>(std::tolower(first_is_later ? letter1 : letter2));
+    const char low = first_is_later ? letter2 : letter1;
+    const char high = first_is_later ? letter1 : letter2;
     if (!block_.has(low) && !block_.has(high)) {
       fail(std::string(1, static_cast<char>(std::toupper(low))) + " and " + high +
            " words missing for arc in " + axes.name + " plane");
     }
+  }
+  if (comp_.active()) {
+    Comp::comp_arc(*this, clockwise, end, turns);
+    return;
+  }
+  double center1 = 0;
+  double center2 = 0;
+  arc_center(clockwise, {pos_[axes.first], pos_[axes.second]}, {end[axes.first], end[axes.second]},
+             center1, center2);
+  if (modal_.feed_mode == FeedMode::inverse_time) {
+    arc_feed_rate(clockwise, turns, pos_, {center1, center2}, end);
+  }
+  ArcFeed command;
+  command.plane = modal_.plane;
+  command.set_end(end);
+  command.first_axis = center1;
+  command.second_axis = center2;
+  command.rotation = clockwise ? -turns : turns;
+  emit(command);
+  pos_ = end;
+}
+
+// Inverse time: the rate that makes the arc from `start` around `center` take 1/F minutes.
+void Interpreter::Impl::arc_feed_rate(bool clockwise, int turns, const Pose& start,
+                                      PlanePoint center, const Pose& end) {
+  const PlaneAxes axes = plane_axes(modal_.plane);
+  const double start1 = start[axes.first];
+  const double start2 = start[axes.second];
+  const double radius = std::hypot(start1 - center.a, start2 - center.b);
+  const double a0 = std::atan2(start2 - center.b, start1 - center.a);
+  const double a1 = std::atan2(end[axes.second] - center.b, end[axes.first] - center.a);
+  double sweep = clockwise ? a0 - a1 : a1 - a0;
+  if (sweep <= 1e-12) sweep += 2.0 * std::numbers::pi;
+  sweep += 2.0 * std::numbers::pi * (turns - 1);
+  set_inverse_time_rate(std::hypot(radius * sweep, end[axes.normal] - start[axes.normal]));
+}
+
+// The center of the arc from `start` to `end` (plane coordinates) the block's R or I J K
+// words give, with LinuxCNC's checks and messages.
+void Interpreter::Impl::arc_center(bool clockwise, PlanePoint start, PlanePoint end,
+                                   double& center1, double& center2) const {
+  const PlaneAxes axes = plane_axes(modal_.plane);
+  const double start1 = start.a;
+  const double start2 = start.b;
+  const double end1 = end.a;
+  const double end2 = end.b;
+  const char letter1 = static_cast<char>(std::toupper(kAxisLetters[axes.first]));
+  const char letter2 = static_cast<char>(std::toupper(kAxisLetters[axes.second]));
+  const bool inches = modal_.units == Units::inches;
+  if (block_.has('r')) {
     const double radius = block_.get('r');
-    const double d1 = end1 - start1;
-    const double d2 = end2 - start2;
-    const double chord = std::hypot(d1, d2);
-    if (chord == 0.0) fail("Current point same as end point of arc");
-    const double half = chord / 2.0;
+    if (end1 == start1 && end2 == start2) fail("Current point same as end point of arc");
     const double abs_radius = std::fabs(radius);
+    const double mid1 = (end1 + start1) / 2.0;
+    const double mid2 = (end2 + start2) / 2.0;
+    double half = std::hypot(mid1 - end1, mid2 - end2);
     const double tolerance = inches ? kRadiusToleranceInch : kRadiusToleranceInch * 25.4;
     if (half - abs_radius > tolerance) fail("Arc radius too small to reach end point");
-    const double offset =
-        abs_radius > half ? std::sqrt(abs_radius * abs_radius - half * half) : 0.0;
+    if (half / abs_radius > 1.0 - 1e-12) half = abs_radius;  // a semicircle, give or take
     // The center is right of the chord for a clockwise minor arc, left for a counterclockwise
-    // one; a negative R asks for the major arc, on the other side.
+    // one; a negative R asks for the major arc, on the other side. Worked out as LinuxCNC
+    // does, to its last bit.
     const bool right = clockwise != (radius < 0.0);
-    const double u1 = right ? d2 / chord : -d2 / chord;
-    const double u2 = right ? -d1 / chord : d1 / chord;
-    center1 = start1 + d1 / 2.0 + offset * u1;
-    center2 = start2 + d2 / 2.0 + offset * u2;
+    const long double chord_angle = std::atan2(end2 - start2, end1 - start1);
+    const long double quarter = 1.57079632679489661923132169163975144L;
+    const auto theta = static_cast<double>(right ? chord_angle - quarter : chord_angle + quarter);
+    const double offset = abs_radius * std::cos(std::asin(half / abs_radius));
+    center1 = mid1 + offset * std::cos(theta);
+    center2 = mid2 + offset * std::sin(theta);
   } else {
     const double o1 = block_.has(axes.first_offset) ? block_.get(axes.first_offset) : 0.0;
     const double o2 = block_.has(axes.second_offset) ? block_.get(axes.second_offset) : 0.0;
@@ -129,24 +173,6 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
            format(" abs_err=%.4g rel_err=%.4f%%", abs_err, rel_err * 100.0));
     }
   }
-
-  if (modal_.feed_mode == FeedMode::inverse_time) {
-    const double radius = std::hypot(start1 - center1, start2 - center2);
-    const double a0 = std::atan2(start2 - center2, start1 - center1);
-    const double a1 = std::atan2(end2 - center2, end1 - center1);
-    double sweep = clockwise ? a0 - a1 : a1 - a0;
-    if (sweep <= 1e-12) sweep += 2.0 * std::numbers::pi;
-    sweep += 2.0 * std::numbers::pi * (turns - 1);
-    set_inverse_time_rate(std::hypot(radius * sweep, end[axes.normal] - pos_[axes.normal]));
-  }
-  ArcFeed command;
-  command.plane = modal_.plane;
-  command.set_end(end);
-  command.first_axis = center1;
-  command.second_axis = center2;
-  command.rotation = clockwise ? -turns : turns;
-  emit(command);
-  pos_ = end;
 }
 
 }  // namespace cncd::interp

@@ -114,7 +114,8 @@ void Interpreter::Impl::check_word_users(int motion) const {
   };
   const bool css = b.g_code(GGroup::spindle_mode) == 960;
   const bool synced = motion == 330 || motion == 331;
-  require('d', css, "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+  require('d', css || b.g_code(GGroup::cutter_comp) > 400,
+          "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
   require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
   require('i', arc || g10 || motion == 870 || motion == 331,
@@ -123,7 +124,7 @@ void Interpreter::Impl::check_word_users(int motion) const {
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
   require('k', arc || motion == 870 || synced,
           "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
-  require('l', g10 || cycle || io == 66,
+  require('l', g10 || cycle || io == 66 || b.g_code(GGroup::cutter_comp) > 400,
           "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
           "NURBS code");
   const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||

@@ -4,6 +4,7 @@
 // non-modal codes, motion, stop.
 #include <cmath>
 
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -89,6 +90,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
   do_io();  // LinuxCNC's M codes start with group 5, before the tool change
   const int change = block_.m_code(MGroup::tool_change);
   if (change == 6) {
+    if (comp_.on()) fail("Cannot change tools with cutter radius compensation on");
     const int tool = tool_prepped_ < 0 ? tool_in_spindle_ : tool_prepped_;
     emit(StartChange{});
     if (options_.tool_change_quill_up) {
@@ -156,6 +158,11 @@ void Interpreter::Impl::do_coolant_and_overrides() {
   if (code < 0) return;
   const bool has_p = block_.has('p');
   const bool on = !has_p || block_.get('p') != 0.0;
+  if (comp_.on()) {
+    fail(code == 48 || (code != 49 && on)
+             ? "Cannot enable overrides with cutter radius compensation on"
+             : "Cannot disable overrides with cutter radius compensation on");
+  }
   switch (code) {
     case 48:
       modal_.feed_override = modal_.speed_override = true;
@@ -197,17 +204,29 @@ void Interpreter::Impl::do_dwell() {
 void Interpreter::Impl::do_modes() {
   const int plane = block_.g_code(GGroup::plane);
   if (plane >= 0) {
-    modal_.plane = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
+    const Plane next = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
+    const int column = block_.g_column[static_cast<std::size_t>(GGroup::plane)];
+    if (comp_.on() && next != modal_.plane) {
+      fail("Cannot change planes with cutter radius compensation on", column);
+    }
+    if (comp_.on() && next == Plane::yz) {
+      fail("Cutter radius compensation allowed only in XY, XZ planes", column);
+    }
+    modal_.plane = next;
     emit(SelectPlane{modal_.plane});
   }
   const int units = block_.g_code(GGroup::units);
   if (units >= 0) change_units(units == 200 ? Units::inches : Units::mm);
   const int comp = block_.g_code(GGroup::cutter_comp);
-  if (comp == 400) emit_comment("interpreter: cutter radius compensation off");
+  if (comp >= 0) Comp::comp_mode(*this, comp);
   const int length = block_.g_code(GGroup::tool_length);
-  if (length >= 0) apply_tool_length(length);
+  if (length >= 0) {
+    if (comp_.on()) fail("Cannot change tool offset with cutter radius compensation on");
+    apply_tool_length(length);
+  }
   const int system = block_.g_code(GGroup::coord_system);
   if (system >= 0) {
+    if (comp_.on()) fail("Cannot change coordinate systems with cutter radius compensation on");
     static constexpr int kSystems[] = {540, 550, 560, 570, 580, 590, 591, 592, 593};
     for (int i = 0; i < 9; ++i) {
       if (kSystems[i] != system) continue;
@@ -220,6 +239,7 @@ void Interpreter::Impl::do_modes() {
   }
   const int path = block_.g_code(GGroup::path_control);
   if (path >= 0) {
+    if (comp_.on()) fail("Cannot change control mode with cutter radius compensation on");
     if (path == 610) {
       modal_.control = MotionMode::exact_path;
     } else if (path == 611) {
@@ -249,6 +269,9 @@ void Interpreter::Impl::do_modes() {
     emit_comment("interpreter: IJK distance mode changed to incremental");
   }
   const int retract = block_.g_code(GGroup::retract);
+  if (retract >= 0 && comp_.on()) {
+    fail("Cannot change retract mode with cutter radius compensation on");
+  }
   if (retract == 980) {
     modal_.retract_r_plane = false;
     emit_comment("interpreter: retract mode set to old_z");
@@ -259,7 +282,22 @@ void Interpreter::Impl::do_modes() {
 }
 
 void Interpreter::Impl::do_non_modal() {
-  switch (block_.g_code(GGroup::non_modal)) {
+  const int code = block_.g_code(GGroup::non_modal);
+  if (comp_.on()) {
+    if (code == 280 || code == 300) fail("Cannot use g28 or g30 with cutter radius comp");
+    if (code == 281 || code == 301) {
+      fail("Cannot set reference point with cutter compensation in effect");
+    }
+    if (code == 520 || (code >= 920 && code <= 923)) {
+      fail("Cannot change axis offsets with cutter radius comp");
+    }
+    const int l = block_.has('l') ? to_int(block_.get('l')) : -1;
+    const int p = block_.has('p') ? to_int(block_.get('p')) : -1;
+    if (code == 100 && (l == 2 || l == 20) && (p == 0 || p == modal_.coord_system)) {
+      fail("Cannot change the active coordinate system with cutter radius compensation on");
+    }
+  }
+  switch (code) {
     case 100:
       do_g10();
       break;
@@ -282,7 +320,11 @@ void Interpreter::Impl::do_non_modal() {
 }
 
 bool Interpreter::Impl::do_stop() {
-  switch (block_.m_code(MGroup::stopping)) {
+  const int stop = block_.m_code(MGroup::stopping);
+  if (stop == 0 || stop == 1 || stop == 60 || stop == 2 || stop == 30 || stop == 99) {
+    Comp::comp_flush(*this);
+  }
+  switch (stop) {
     case 0:
       emit(ProgramStop{});
       return true;
@@ -306,6 +348,8 @@ bool Interpreter::Impl::do_stop() {
 
 // What M2/M30 reset, in the order LinuxCNC emits it.
 void Interpreter::Impl::program_end_reset() {
+  comp_.side = CompSide::off;
+  comp_.first_move = true;
   select_coord_system_quiet(1);
   emit_g5x();
   emit(SetXyRotation{rotation_deg_});

@@ -15,6 +15,7 @@
 
 #include "block.hpp"
 #include "cncd/interp/interpreter.hpp"
+#include "comp_state.hpp"
 #include "failure.hpp"
 #include "parameters.hpp"
 #include "parser.hpp"
@@ -265,6 +266,8 @@ struct Interpreter::Impl {
   Pose target_from_words() const;
   void straight(StraightKind kind, const Pose& end);
   void arc(bool clockwise, const Pose& end);
+  void arc_center(bool clockwise, PlanePoint start, PlanePoint end, double& c1, double& c2) const;
+  void arc_feed_rate(bool clockwise, int turns, const Pose& start, PlanePoint c, const Pose& end);
   void set_inverse_time_rate(double length);
   void emit_straight(StraightKind kind, const Pose& end);
 
@@ -352,7 +355,8 @@ struct Interpreter::Impl {
     command_.op = std::forward<Op>(op);
     emit_command(command_);
   }
-  void emit_command(const CanonCommand& command);
+  void emit_command(const CanonCommand& command);  // held back behind queued moves, or sent
+  void send_command(const CanonCommand& command);
   // Jumps back to the start of a loop; fails once loops have run max_loops_without_motion
   // times in a row without a move or dwell (an endless loop that would never end).
   void loop_back(std::int64_t offset, int line_before);
@@ -390,6 +394,8 @@ struct Interpreter::Impl {
   ModalState modal_;
   int previous_motion_ = -1;  // the motion mode before the current block
   CycleState cycle_;
+  CompState comp_;
+  struct Comp;  // cutter_comp.hpp
   NumeryxState nx_;
   std::vector<ForFrame> nx_loops_;
   int nx_cycle_distance_ = -1;  // this block's g90/g91 that belongs to the drilling cycle

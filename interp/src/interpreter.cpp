@@ -5,6 +5,7 @@
 #include <cmath>
 #include <variant>
 
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -57,6 +58,7 @@ void Interpreter::Impl::reset_modal_state() {
   modal_ = ModalState{};
   modal_.units = options_.machine_units;
   cycle_ = CycleState{};
+  comp_ = CompState{};
   nx_ = NumeryxState{};
   nx_loops_.clear();
   const int system = to_int(parameters_.get(5220));
@@ -122,6 +124,11 @@ bool finite(const CanonOp& op) {
 
 void Interpreter::Impl::emit_command(const CanonCommand& command) {
   if (!finite(command.op)) fail("Result is not a finite number (overflow)");
+  if (Comp::comp_hold_back(*this, command)) return;
+  send_command(command);
+}
+
+void Interpreter::Impl::send_command(const CanonCommand& command) {
   const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
                      std::holds_alternative<StraightFeed>(command.op) ||
                      std::holds_alternative<ArcFeed>(command.op) ||

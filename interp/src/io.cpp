@@ -50,6 +50,16 @@ void Interpreter::Impl::do_io() {
   const int column = block_.m_column[static_cast<std::size_t>(MGroup::io)];
   const std::string name = "M" + std::to_string(code);
   const double q = block_.has('q') ? block_.get('q') : -1.0;
+  if (comp_.on()) {
+    const char* what = code == 62                                ? "set motion output"
+                       : code == 63                              ? "set motion digital output"
+                       : code <= 65                              ? "set auxiliary digital output"
+                       : code == 67                              ? "set motion analog output"
+                       : code == 68                              ? "set auxiliary analog output"
+                       : block_.has('e') && block_.get('e') >= 0 ? "wait for analog input"
+                                                                 : "wait for digital input";
+    fail(std::string("Cannot ") + what + " with cutter radius compensation on", column);
+  }
   if (code >= 62 && code <= 65) {
     if (!block_.has('p')) fail("No valid P word with " + name, column);
     const int index = round_to_int(block_.get('p'));

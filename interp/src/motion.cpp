@@ -2,6 +2,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -29,7 +30,7 @@ double straight_length(const Pose& from, const Pose& to) {
 }  // namespace
 
 Pose Interpreter::Impl::target_from_words() const {
-  Pose end = pos_;
+  Pose end = Comp::comp_program_start(*this);
   const bool machine = block_.g_code(GGroup::non_modal) == 530;
   if (machine) {
     // G53: the named axes are machine coordinates. LinuxCNC works this out in the rotated
@@ -58,7 +59,7 @@ Pose Interpreter::Impl::target_from_words() const {
     const char letter = kAxisLetters[axis];
     if (!block_.has(letter)) continue;
     const auto a = static_cast<std::size_t>(axis);
-    end[a] = modal_.incremental ? pos_[a] + block_.get(letter) : block_.get(letter);
+    end[a] = modal_.incremental ? end[a] + block_.get(letter) : block_.get(letter);
   }
   if (block_.nx_polar) {
     // Numeryx g10: around the pole (I, J) at radius R and angle P (degrees).
@@ -70,8 +71,9 @@ Pose Interpreter::Impl::target_from_words() const {
     // Polar words give X and Y around the origin; incremental ones add to the current
     // distance and angle.
     const double degree = std::numbers::pi / 180.0;
-    double distance = std::hypot(pos_[kX], pos_[kY]);
-    double angle = std::atan2(pos_[kY], pos_[kX]) / degree;
+    const Pose start = Comp::comp_program_start(*this);
+    double distance = std::hypot(start[kX], start[kY]);
+    double angle = std::atan2(start[kY], start[kX]) / degree;
     if (block_.has_polar_distance) {
       distance = modal_.incremental ? distance + block_.polar_distance : block_.polar_distance;
     }
@@ -95,14 +97,20 @@ void Interpreter::Impl::emit_straight(StraightKind kind, const Pose& end) {
 
 // Inverse time: the move takes 1/F minutes, so its feed is length * F; LinuxCNC keeps that
 // rate as the current feed.
+// A move of no length gets LinuxCNC's rate of 0.1, not a rate of 0 the machine cannot run.
 void Interpreter::Impl::set_inverse_time_rate(double length) {
-  modal_.feed_rate = length * block_.get('f');
+  modal_.feed_rate = length == 0.0 ? 0.1 : length * block_.get('f');
   emit(SetFeedRate{modal_.feed_rate});
 }
 
 void Interpreter::Impl::straight(StraightKind kind, const Pose& end) {
+  comp_.arc_not_allowed = false;
   if (kind == StraightKind::feed && modal_.feed_mode == FeedMode::inverse_time) {
-    set_inverse_time_rate(straight_length(pos_, end));
+    set_inverse_time_rate(straight_length(Comp::comp_program_start(*this), end));
+  }
+  if (comp_.active()) {
+    Comp::comp_straight(*this, kind, end);
+    return;
   }
   emit_straight(kind, end);
 }
@@ -120,6 +128,7 @@ void Interpreter::Impl::do_motion() {
     axis_words |= block_.has(kAxisLetters[axis]);
   if (code == 530 || code < 0 || code == 800) return;
   if (is_canned_cycle(code)) {
+    if (axis_words && comp_.on()) fail("Cannot use canned cycles with cutter compensation on");
     if (axis_words) do_canned_cycle(code);
     return;
   }
@@ -129,12 +138,18 @@ void Interpreter::Impl::do_motion() {
   if (non_modal == 530 && modal_.incremental)
     fail("Cannot use g53 incremental", block_.g_column[0]);
   if (code >= 382 && code <= 385) {
+    if (axis_words && comp_.on()) fail("Cannot probe with cutter radius comp on");
     if (axis_words) do_probe(code);
     return;
   }
   if (code == 330 || code == 331) {
     if (axis_words) do_spindle_synced(code);
     return;
+  }
+  const bool arc_words = block_.has('i') || block_.has('j') || block_.has('k') || block_.has('r');
+  if ((code == 20 || code == 30) && comp_.arc_not_allowed &&
+      (axis_words || arc_words || explicit_code >= 0)) {
+    fail("The move just after exiting cutter compensation mode must be straight, not an arc");
   }
   if (code == 10 || code == 20 || code == 30) {
     if (modal_.feed_mode == FeedMode::inverse_time && !block_.has('f') && axis_words) {
@@ -149,7 +164,6 @@ void Interpreter::Impl::do_motion() {
     }
   }
   if (code == 20 || code == 30) {
-    const bool arc_words = block_.has('i') || block_.has('j') || block_.has('k') || block_.has('r');
     if (axis_words || arc_words || explicit_code >= 0) arc(code == 20, target_from_words());
     return;
   }

@@ -187,7 +187,7 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
     case Name::spindle_cw:
       return flag(modal_.spindle == SpindleDir::clockwise);
     case Name::ccomp:
-      return 400.0;
+      return comp_.side == CompSide::left ? 410.0 : comp_.side == CompSide::right ? 420.0 : 400.0;
     case Name::mist:
       return flag(modal_.mist);
     case Name::flood:

@@ -35,7 +35,7 @@ InterpState Interpreter::state() const {
   g[1] = s.nx_.cycle != 0 ? s.nx_.cycle : m.motion;
   g[2] = s.block_.g_code(GGroup::non_modal);
   g[3] = plane_code(m.plane);
-  g[4] = 400;  // cutter radius compensation is not supported: always off
+  g[4] = s.comp_.side == CompSide::left ? 410 : s.comp_.side == CompSide::right ? 420 : 400;
   g[5] = m.units == Units::inches ? 200 : 210;
   g[6] = m.incremental ? 910 : 900;
   g[7] = m.feed_mode == FeedMode::inverse_time       ? 930
