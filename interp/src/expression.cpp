@@ -43,7 +43,15 @@ int precedence(Op op) {
   return 0;
 }
 
-constexpr double kDegree = std::numbers::pi / 180.0;
+// Degrees to radians and back as LinuxCNC converts them, through a long double pi (its
+// sin, cos and tan then run in long double): the same last bits, so the same signs of zero.
+constexpr long double kPiLong = 3.141592653589793238462643383279502884L;
+long double to_radians(double degrees) {
+  return degrees * kPiLong / 180.0;
+}
+double to_degrees(double radians) {
+  return static_cast<double>(radians * 180.0 / kPiLong);
+}
 // LinuxCNC compares with this tolerance in EQ/NE/.. and when a real must be an integer.
 constexpr double kTolerance = 0.0001;
 
@@ -220,18 +228,18 @@ double BlockParser::read_unary(int col) {
     ++pos_;
     if (peek() != '[') error("Left bracket missing after slash with atan");
     const double x = read_expression();
-    return std::atan2(arg, x) / kDegree;
+    return to_degrees(std::atan2(arg, x));
   }
   if (name == "abs") return std::fabs(arg);
   if (name == "acos") {
     if (arg < -1.0 || arg > 1.0) fail("Argument to acos out of range", col);
-    return std::acos(arg) / kDegree;
+    return to_degrees(std::acos(arg));
   }
   if (name == "asin") {
     if (arg < -1.0 || arg > 1.0) fail("Argument to asin out of range", col);
-    return std::asin(arg) / kDegree;
+    return to_degrees(std::asin(arg));
   }
-  if (name == "cos") return std::cos(arg * kDegree);
+  if (name == "cos") return static_cast<double>(std::cos(to_radians(arg)));
   if (name == "exp") return std::exp(arg);
   if (name == "fix") return std::floor(arg);
   if (name == "fup") return std::ceil(arg);
@@ -240,12 +248,12 @@ double BlockParser::read_unary(int col) {
     return std::log(arg);
   }
   if (name == "round") return std::round(arg);
-  if (name == "sin") return std::sin(arg * kDegree);
+  if (name == "sin") return static_cast<double>(std::sin(to_radians(arg)));
   if (name == "sqrt") {
     if (arg < 0.0) fail("Negative argument to sqrt", col);
     return std::sqrt(arg);
   }
-  return std::tan(arg * kDegree);
+  return static_cast<double>(std::tan(to_radians(arg)));
 }
 
 // Numeryx: an expression written after '=' in an address or assignment ("x=gil(0,10)",
