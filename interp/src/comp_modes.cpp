@@ -8,6 +8,15 @@
 
 namespace cncd::interp {
 
+// A tool table length in program units. A table in inches is converted as LinuxCNC converts
+// it, through millimetres with its 0.03937007874016 inches per millimetre (so a 1 in tool is
+// a hair under 1 in in an inch program, which decides whether it fits an arc of its radius).
+static double table_length(double value, Units table, Units program) {
+  if (table != Units::inches) return value * unit_factor(table, program);
+  const double mm = value / 0.03937007874016;
+  return program == Units::inches ? mm / 25.4 : program == Units::cm ? mm / 10.0 : mm;
+}
+
 void Interpreter::Impl::Comp::comp_off(Impl& s) {
   CompState& c = s.comp_;
   s.emit_comment("interpreter: cutter radius compensation off");
@@ -63,7 +72,7 @@ void Interpreter::Impl::Comp::comp_on(Impl& s, int code) {
       }
     }
     if (entry != nullptr) {
-      radius = entry->diameter * unit_factor(s.tool_table_units(), s.modal_.units) / 2.0;
+      radius = table_length(entry->diameter, s.tool_table_units(), s.modal_.units) / 2.0;
       orientation = entry->orientation;
     }
     if (s.modal_.plane != Plane::xz && orientation != 0 && orientation != 9) {
