@@ -33,6 +33,7 @@ void Interpreter::Impl::Comp::comp_off(Impl& s) {
   }
   c.side = CompSide::off;
   c.first_move = true;
+  s.parameters_.hide_position(false);
 }
 
 void Interpreter::Impl::Comp::comp_on(Impl& s, int code) {
@@ -90,6 +91,7 @@ void Interpreter::Impl::Comp::comp_on(Impl& s, int code) {
   c.radius = radius;
   c.orientation = orientation;
   c.side = side;
+  s.parameters_.hide_position(true);
 }
 
 void Interpreter::Impl::Comp::comp_mode(Impl& s, int code) {

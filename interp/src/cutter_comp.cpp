@@ -218,6 +218,7 @@ void Interpreter::Impl::Comp::comp_flush(Impl& s) {
 
 void Interpreter::Impl::Comp::comp_scale(Impl& s, double factor) {
   CompState& c = s.comp_;
+  c.radius *= factor;
   for (int axis = 0; axis < kAxes; ++axis) {
     if (is_linear_axis(axis)) c.program[static_cast<std::size_t>(axis)] *= factor;
   }

@@ -350,6 +350,7 @@ bool Interpreter::Impl::do_stop() {
 void Interpreter::Impl::program_end_reset() {
   comp_.side = CompSide::off;
   comp_.first_move = true;
+  parameters_.hide_position(false);
   select_coord_system_quiet(1);
   emit_g5x();
   emit(SetXyRotation{rotation_deg_});

@@ -59,6 +59,7 @@ void Interpreter::Impl::reset_modal_state() {
   modal_.units = options_.machine_units;
   cycle_ = CycleState{};
   comp_ = CompState{};
+  parameters_.hide_position(false);
   nx_ = NumeryxState{};
   nx_loops_.clear();
   const int system = to_int(parameters_.get(5220));

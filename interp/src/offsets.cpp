@@ -7,6 +7,7 @@
 
 #include "cncd/interp/stored_values.hpp"
 #include "failure.hpp"
+#include "cutter_comp.hpp"
 #include "interp_state.hpp"
 
 namespace cncd::interp {
@@ -119,6 +120,7 @@ void Interpreter::Impl::change_units(Units units) {
       // LinuxCNC leaves the tool length offset's number as it is (it is in the units it was
       // set in); the canon layer converted it when it was set.
     }
+    Comp::comp_scale(*this, factor);
     modal_.units = units;
   }
   emit(UseLengthUnits{units});

@@ -33,6 +33,11 @@ class Parameters {
   }
   void check(int number, double value, int column = 0) const;
 
+  // Under cutter compensation the position parameters #5420-#5428 may not be read (the
+  // position is still to be decided by the next move), as in LinuxCNC.
+  void hide_position(bool hidden) { position_hidden_ = hidden; }
+  bool position_hidden() const { return position_hidden_; }
+
   // Named parameters. Read-only predefined names (_x, _metric ...) come from `predefined_`.
   std::optional<double> get_named(std::string_view name) const;
   bool exists_named(std::string_view name) const;
@@ -60,6 +65,7 @@ class Parameters {
   Scope globals_;
   std::vector<Scope> scopes_;  // back() = current subroutine's locals; front() = main program
   Predefined predefined_;
+  bool position_hidden_ = false;
 };
 
 }  // namespace cncd::interp

@@ -271,7 +271,12 @@ double BlockParser::read_parameter_value() {
     if (!value) fail("Named parameter #<" + name_ + "> not defined", col);
     return *value;
   }
-  return parameters_.get(read_parameter_index());
+  const int col = column();
+  const int number = read_parameter_index();
+  if (number >= 5420 && number <= 5428 && parameters_.position_hidden()) {
+    fail("Cannot read current position with cutter radius compensation on", col);
+  }
+  return parameters_.get(number);
 }
 
 int BlockParser::read_integer_value() {

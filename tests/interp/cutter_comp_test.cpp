@@ -16,6 +16,8 @@
 
 #include <unistd.h>
 
+#include "canon_recorder.hpp"
+#include "cncd/interp/interpreter.hpp"
 #include "rs274_session.hpp"
 
 namespace cncd::interp::testing {
@@ -100,6 +102,29 @@ TEST(CutterComp, WearInTheToolTableMovesThePathByHalfTheChange) {
     EXPECT_NEAR(from_square(a[i]), 0.25, 1e-4);
     EXPECT_NEAR(from_square(b[i]), 0.24, 1e-4);
   }
+}
+
+TEST(CutterComp, HeldBackCommandsKeepTheLinesTheyCameFrom) {
+  // Line 6's move waits for line 8 to fix the corner, and the coolant of line 7 waits behind
+  // it; each still carries its own line, which the machine shows as the line running.
+  Interpreter interp;
+  ASSERT_FALSE(
+      interp.open_string("G20\nG0 X0 Y-1\nF10\nG41.1 D0.2\nG1 X0 Y0\nG1 X2\nM8\nG1 Y2\nG40\nM2\n"));
+  test_support::CanonRecorder canon;
+  ASSERT_FALSE(run_program(interp, canon));
+  std::vector<std::pair<std::string, int>> seen;
+  for (const CanonCommand& command : canon.commands) {
+    if (std::holds_alternative<StraightFeed>(command.op)) seen.emplace_back("feed", command.line);
+    if (std::holds_alternative<FloodOn>(command.op)) seen.emplace_back("flood", command.line);
+  }
+  const std::vector<std::pair<std::string, int>> expected = {
+      {"feed", 5}, {"feed", 6}, {"flood", 7}, {"feed", 8}};
+  EXPECT_EQ(seen, expected);
+  // The inside corner trims line 6's move to where the offset paths meet.
+  const auto feeds = canon.all<StraightFeed>();
+  ASSERT_EQ(feeds.size(), 3U);
+  EXPECT_NEAR(feeds[1].end[0], 1.9, 1e-9);
+  EXPECT_NEAR(feeds[1].end[1], 0.1, 1e-9);
 }
 
 // A random closed profile: corners around a center at random radii, joined by lines or arcs
