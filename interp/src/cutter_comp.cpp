@@ -182,13 +182,36 @@ Pose Interpreter::Impl::Comp::comp_program_start(const Impl& s) {
   return start;
 }
 
+// A lathe tool's origin is not the center of its nose radius, which compensation steers: in
+// G18, by orientation (LinuxCNC's 1-8), X and Z move from the center to the tool's origin.
+static void to_lathe_origin(CanonOp& op, int orientation, double r) {
+  const int o = orientation;
+  const double dx = (o == 2 || o == 6 || o == 1) ? -r : (o == 3 || o == 8 || o == 4) ? r : 0.0;
+  const double dz = (o == 2 || o == 7 || o == 3) ? -r : (o == 1 || o == 5 || o == 4) ? r : 0.0;
+  if (auto* arc = std::get_if<ArcFeed>(&op)) {
+    arc->first_end += dz;
+    arc->first_axis += dz;
+    arc->second_end += dx;
+    arc->second_axis += dx;
+  } else if (auto* feed = std::get_if<StraightFeed>(&op)) {
+    feed->end[kX] += dx;
+    feed->end[kZ] += dz;
+  } else if (auto* traverse = std::get_if<StraightTraverse>(&op)) {
+    traverse->end[kX] += dx;
+    traverse->end[kZ] += dz;
+  }
+}
+
 void Interpreter::Impl::Comp::comp_dequeue(Impl& s) {
   s.comp_.start_valid = false;
   // Moved out first: a command sent may not find itself queued again.
   std::vector<QueuedCanon> queue;
   queue.swap(s.comp_.queue);
-  for (const QueuedCanon& q : queue)
+  const bool lathe = s.modal_.plane == Plane::xz && s.comp_.orientation != 0;
+  for (QueuedCanon& q : queue) {
+    if (lathe) to_lathe_origin(q.command.op, s.comp_.orientation, s.comp_.radius);
     s.send_command(q.command);
+  }
 }
 
 bool Interpreter::Impl::Comp::comp_hold_back(Impl& s, const CanonCommand& command) {
