@@ -1,6 +1,7 @@
 // The '%' lines that may open and close a program, as rs274 reads them: the opening one after
 // nothing but blank lines, the closing one ending the program wherever it is read, even while
 // an if is skipped or a sub is sought; what follows it is no part of the program.
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -15,6 +16,9 @@ bool Interpreter::Impl::delimiter_line() {
       return true;
     }
     if (seen_percent_) {
+      // cncd's own: rs274 ends here with its last compensated move still held back, never
+      // sent; the move the program asked for is cut.
+      Comp::comp_flush(*this);
       emit(Finish{});
       close_probe_file();
       ended_ = true;

@@ -21,6 +21,9 @@ std::string number(double value) {
 
 void Interpreter::Impl::do_spindle_synced(int code) {
   const std::string name = code == 330 ? "G33" : "G33.1";
+  // cncd's own refusal: rs274 offsets the move and drops its spindle synchronisation (a thread
+  // cut at the feed rate), or fails with an internal error.
+  if (comp_.on()) fail("Cannot use " + name + " with cutter radius compensation on");
   if (modal_.spindle == SpindleDir::stopped) fail("Spindle not turning in " + name);
   // cncd's own checks: LinuxCNC would start the move and wait for a spindle that never turns,
   // or for a position that never comes.

@@ -127,6 +127,35 @@ TEST(CutterComp, HeldBackCommandsKeepTheLinesTheyCameFrom) {
   EXPECT_NEAR(feeds[1].end[1], 0.1, 1e-9);
 }
 
+TEST(CutterComp, AClosingPercentSendsTheLastHeldBackMove) {
+  // rs274 ends here with the move to X1 still held back and never cuts it.
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string("%\nG20\nG0 X-1 Y-1\nF10\nG41.1 D0.5\nG1 X0 Y0\nG1 X1\n%\n"));
+  test_support::CanonRecorder canon;
+  ASSERT_FALSE(run_program(interp, canon));
+  const auto feeds = canon.all<StraightFeed>();
+  ASSERT_EQ(feeds.size(), 2U);
+  EXPECT_NEAR(feeds[1].end[0], 1.0, 1e-9);
+  EXPECT_NEAR(feeds[1].end[1], 0.25, 1e-9);
+  EXPECT_EQ(canon.commands.back().line, 8);
+  EXPECT_TRUE(std::holds_alternative<Finish>(canon.commands.back().op));
+}
+
+TEST(CutterComp, ThreadingUnderCompensationIsRefused) {
+  // rs274 would cut the G33 offset at the feed rate, its spindle synchronisation dropped.
+  for (const char* code : {"G33 X2 K0.1", "G33.1 X2 K0.1"}) {
+    Interpreter interp;
+    ASSERT_FALSE(interp.open_string(std::string("G20\nG0 X-1 Y-1\nF10\nM3 S100\nG41.1 D0.5\n") +
+                                    "G1 X0 Y0\n" + code + "\nM2\n"));
+    test_support::CanonRecorder canon;
+    const auto error = run_program(interp, canon);
+    ASSERT_TRUE(error) << code;
+    EXPECT_EQ(error->line, 7);
+    EXPECT_NE(error->message.find("with cutter radius compensation on"), std::string::npos)
+        << error->message;
+  }
+}
+
 // A random closed profile: corners around a center at random radii, joined by lines or arcs
 // (either way round, minor or major), cut with a random tool on a random side after a lead-in
 // (straight or an arc), in XY or XZ, inches or millimetres, with now and then a move along the
