@@ -135,6 +135,7 @@ struct SavedModalState {
   ModalState modal;
   Pose tool_offset{};        // G43.1's offsets
   bool g92_applied = false;  // #5210
+  CompSide comp_side = CompSide::off;
 };
 
 struct CallFrame {

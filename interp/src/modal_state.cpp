@@ -3,6 +3,7 @@
 // A restore changes only what differs from the saved state, in rs274's order and with the
 // canon each change's G or M code prints; where rs274 restores something other than what was
 // saved, cncd restores what was saved (docs/interpreter.md lists the cases).
+#include "cutter_comp.hpp"
 #include "failure.hpp"
 #include "interp_state.hpp"
 
@@ -45,6 +46,7 @@ void Interpreter::Impl::do_modal_state(int code) {
       saved.modal = modal_;
       saved.tool_offset = tool_offset_;
       saved.g92_applied = parameters_.get(5210) != 0.0;
+      saved.comp_side = comp_.side;
       return;
     case 71:
       saved = SavedModalState{};
@@ -141,6 +143,12 @@ void Interpreter::Impl::restore_modes(const SavedModalState& saved) {
   if (m.plane != modal_.plane) {
     modal_.plane = m.plane;
     emit(SelectPlane{m.plane});
+  }
+  if (saved.comp_side != comp_.side) {
+    // As rs274 does it: G40, or G41/G42 with the tool in the spindle's radius.
+    Comp::comp_mode(*this, saved.comp_side == CompSide::off    ? 400
+                           : saved.comp_side == CompSide::left ? 410
+                                                               : 420);
   }
   if (modal_.tool_length_code != m.tool_length_code) {
     if (m.tool_length_code != 431) {
