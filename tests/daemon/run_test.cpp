@@ -29,6 +29,31 @@ TEST_F(MachineTest, RunFromLineKeepsModalStateOffsetsAndSkipsMotion) {
   EXPECT_EQ(s["offsets"]["g5x"]["x"], 10.0);
 }
 
+TEST_F(MachineTest, ACompensatedProgramRunsToItsEndOnTheOffsetPath) {
+  ready_machine();
+  // A 4 mm tool on the left of a three-sided pocket wall: each move waits for the next one to
+  // fix the inside corner, and G40 sends the last.
+  const auto program = dir_.write("comp.ngc",
+                                  "G21 G90\n"
+                                  "G0 X10 Y10\n"
+                                  "F1200\n"
+                                  "G41.1 D4\n"
+                                  "G1 X20 Y10\n"
+                                  "G1 X20 Y20\n"
+                                  "G1 X10 Y20\n"
+                                  "G40\n"
+                                  "G0 X5 Y5\n"
+                                  "M2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run", json::object()));
+  const json s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+  EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+  // The rapid in, the three compensated feeds (to X18 Y12, X18 Y18, X10 Y18), the rapid out.
+  EXPECT_EQ(s["program"]["moves"], 5);
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), 5.0, 1e-9);
+}
+
 TEST_F(MachineTest, RunFromLineOutsideTheProgramIsRefused) {
   ready_machine();
   const auto program = dir_.write("short.ngc", "G21 G90\nG0 X1\nM2\n");
