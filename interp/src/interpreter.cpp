@@ -130,6 +130,8 @@ void Interpreter::Impl::emit_command(const CanonCommand& command) {
 }
 
 void Interpreter::Impl::send_command(const CanonCommand& command) {
+  // Held-back moves are checked here, as they leave (an offset can overflow too).
+  if (!finite(command.op)) fail("Result is not a finite number (overflow)");
   const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
                      std::holds_alternative<StraightFeed>(command.op) ||
                      std::holds_alternative<ArcFeed>(command.op) ||
