@@ -56,6 +56,28 @@ TEST_F(CncdCheckTest, GoodProgramPrintsASummaryAndExitsZero) {
   EXPECT_NE(r.out.find("soft limits: every move within them"), std::string::npos) << r.out;
 }
 
+TEST_F(CncdCheckTest, ACompensatedProgramIsCheckedAndPlannedOnItsOffsetPath) {
+  // A 4 mm tool left of three sides of a pocket: the corners trimmed 2 mm inside; the feeds
+  // are sqrt(8^2 + 2^2) (the entry), 6 and 8 mm long.
+  const std::string program =
+      "G21 G90\nG0 X10 Y10 Z5\nF600\nG41.1 D4\nG1 X20 Y10\nG1 X20 Y20\nG1 X10 Y20\nG40\n"
+      "G0 X5 Y5\nM2\n";
+  const auto summary = check_ini(program);
+  EXPECT_EQ(summary.exit_status, 0) << summary.err;
+  EXPECT_NE(summary.out.find("  X 5.0000 .. 18.0000\n"), std::string::npos) << summary.out;
+  EXPECT_NE(summary.out.find("  Y 5.0000 .. 18.0000\n"), std::string::npos) << summary.out;
+  EXPECT_NE(summary.out.find("feed path: 22.2462 mm\n"), std::string::npos) << summary.out;
+  const auto plan = check(program, {"--plan", "--ini", ini_.string()});
+  EXPECT_EQ(plan.exit_status, 0) << plan.err;
+  EXPECT_NE(plan.out.find("cycle time: "), std::string::npos) << plan.out;
+  const auto canon = check(program, {"--canon"});
+  EXPECT_EQ(canon.exit_status, 0) << canon.err;
+  EXPECT_NE(canon.out.find("STRAIGHT_FEED(18.0000, 12.0000, 5.0000"), std::string::npos)
+      << canon.out;
+  EXPECT_NE(canon.out.find("STRAIGHT_FEED(10.0000, 18.0000, 5.0000"), std::string::npos)
+      << canon.out;
+}
+
 TEST_F(CncdCheckTest, WithoutAnIniTheLimitsAreNotCheckedAndTheSummarySaysSo) {
   const auto r = check("G0 X5000\nM2\n");
   EXPECT_EQ(r.exit_status, 0) << r.err;
