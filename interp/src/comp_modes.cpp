@@ -66,7 +66,8 @@ void Interpreter::Impl::Comp::comp_on(Impl& s, int code) {
         fail(name + " requires D word to be a whole number", block.col('d'));
       }
       const int tool = to_int(whole);
-      entry = s.tools_.find(tool);
+      // D0 is the tool in the spindle, as no D is (LinuxCNC's table slot 0).
+      if (tool != 0) entry = s.tools_.find(tool);
       if (entry == nullptr && tool != 0 && !s.options_.tool_table.empty()) {
         fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
              block.col('d'));
