@@ -42,6 +42,19 @@ bool ProgramFeeder::drop_pending(motion::AxisPose& end) {
   return moved;
 }
 
+bool ProgramFeeder::drop_pending_before(int line, motion::AxisPose& end) {
+  bool moved = false;
+  while (!pending_.empty() && pending_.front().line < line) {
+    const motion::Move& move = pending_.front();
+    if (move.kind != motion::Move::Kind::dwell && move.kind != motion::Move::Kind::action) {
+      end = move.end;
+      moved = true;
+    }
+    pending_.pop_front();
+  }
+  return moved;
+}
+
 void ProgramFeeder::queue_tool_change(int number, int line, int before) {
   tool_ = number;
   const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;

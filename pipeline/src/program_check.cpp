@@ -354,6 +354,14 @@ CheckReport check_program(const std::filesystem::path& program, const CheckOptio
     sink.record = skipping ? &reaching : nullptr;
     const auto outcome = runner.advance(sink, one_block);
     sink.record = nullptr;
+    // Refused at the line itself (cutter compensation, a line not run there): the line is
+    // reached, the error says why it is not run from.
+    if (skipping && outcome == ProgramRunner::Outcome::error &&
+        runner.error().kind != ProgramRunner::Error::Kind::interpreter &&
+        runner.error().kind != ProgramRunner::Error::Kind::ends_before_line) {
+      report.from_line->state = interp.state();
+      report.from_line->reached = true;
+    }
     if (skipping && outcome != ProgramRunner::Outcome::error) {
       if (runner.skipping()) {
         report.from_line->state = interp.state();

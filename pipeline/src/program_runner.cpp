@@ -131,6 +131,17 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_end
                      "line that calls it or from one the program runs",
                  {}});
   }
+  // Under G41/G42 the interpreter holds the last move back until it knows the next one: the
+  // compensated point the run would start from is not there to approach.
+  if (const int comp = interp_.state().gcodes[4]; comp > 400) {
+    return fail({Error::Kind::approach,
+                 skip_to_,
+                 "line " + std::to_string(skip_to_) + " runs under cutter compensation (G" +
+                     std::to_string(comp / 10) + (comp % 10 != 0 ? ".1" : "") +
+                     "): run from a line before its G41/G42 or after its G40",
+                 {}});
+  }
+  if (feeder_.drop_pending_before(skip_to_, skip_end_)) skip_moved_ = true;
   const std::size_t own = feeder_.pending_count();
   if (skip_moved_) {
     if (auto why = feeder_.approach_first(skip_from_, skip_end_, safe_z_, line))

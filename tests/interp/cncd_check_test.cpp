@@ -303,6 +303,28 @@ TEST_F(CncdCheckTest, FromLinePrintsTheRebuiltStateAndTheWayToTheLine) {
   EXPECT_EQ(check(program, {"--canon", "--from-line", "3"}).exit_status, 2);
 }
 
+// Under G41/G42 the move the line starts from is held back until the next block: a run from
+// such a line is refused; from the G40 line it starts where the compensated path left off and
+// cuts no line before it again.
+TEST_F(CncdCheckTest, FromLineUnderCutterCompensationIsRefusedAndFromItsG40StartsRight) {
+  const std::string program =
+      "G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\nG1 X10 Y10\nG1 X0 Y10\n"
+      "G1 X0 Y0\nG40 G1 X-5 Y-5\nG0 Z5\nM2\n";
+  const auto inside = check(program, {"--ini", ini_.string(), "--from-line", "6"});
+  EXPECT_EQ(inside.exit_status, 1);
+  EXPECT_NE(inside.err.find("prog.ngc:6: line 6 runs under cutter compensation (G41): run from "
+                            "a line before its G41/G42 or after its G40"),
+            std::string::npos)
+      << inside.err;
+  const auto exit_line = check(program, {"--ini", ini_.string(), "--from-line", "8"});
+  EXPECT_EQ(exit_line.exit_status, 0) << exit_line.err;
+  // Line 7's compensated move ends at X1 Y0 (the tool's radius inside the corner): over there,
+  // then down; only line 8's exit move is checked (line 7, up from Y9, is not cut again).
+  EXPECT_NE(exit_line.out.find("    rapid to X1.0000 Y0.0000 Z50.0000\n"), std::string::npos)
+      << exit_line.out;
+  EXPECT_NE(exit_line.out.find("  Y -5.0000 .. -5.0000\n"), std::string::npos) << exit_line.out;
+}
+
 // A line inside a subroutine's definition is passed without being run where the program first
 // reaches it: refused. A call's line and a loop's first pass start where asked.
 TEST_F(CncdCheckTest, FromALineInsideASubroutineDefinitionIsRefusedAndACallLineWorks) {

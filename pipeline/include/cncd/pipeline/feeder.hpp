@@ -103,6 +103,9 @@ class ProgramFeeder final : public interp::CanonSink {
   // Drops the pending moves (run from line: the lines before it); true with `end` set where
   // the last of them that moves ends.
   bool drop_pending(motion::AxisPose& end);
+  // The same for the pending moves at the front that come from lines before `line` (moves
+  // cutter compensation held back until the line's block was read).
+  bool drop_pending_before(int line, motion::AxisPose& end);
 
   // What the stream has reached since the flag was last taken: M0/M1/M60 (a stop), M66 (the
   // interpreter must not read on until the machine has waited and its result is in #5399) and
