@@ -53,6 +53,10 @@ std::string format(const char* pattern, double a, double b) {
 }  // namespace
 
 void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
+  // LinuxCNC's arcs run in the XYZ planes only.
+  if (modal_.plane == Plane::uv || modal_.plane == Plane::vw || modal_.plane == Plane::uw) {
+    fail("Cannot do an arc in planes G17.1, G18.1, or G19.1");
+  }
   const PlaneAxes axes = plane_axes(modal_.plane);
   const bool radius_format = block_.has('r');
   const bool has_offsets = block_.has(axes.first_offset) || block_.has(axes.second_offset);

@@ -15,6 +15,12 @@ ArcAxes arc_axes(Plane plane) {
       return {2, 0, 1};
     case Plane::yz:
       return {1, 2, 0};
+    case Plane::uv:
+      return {6, 7, 8};
+    case Plane::vw:
+      return {7, 8, 6};
+    case Plane::uw:
+      return {8, 6, 7};
     case Plane::xy:
     default:
       return {0, 1, 2};

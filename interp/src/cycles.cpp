@@ -1,4 +1,4 @@
-// Canned cycles G73, G74, G81-G89 in the three planes, with L repeats, G98/G99 and absolute
+// Canned cycles G73, G74, G81-G89 in the six planes, with L repeats, G98/G99 and absolute
 // or incremental distances, expanded into straight moves, dwells and spindle commands in the
 // order LinuxCNC emits them (including where its errors interrupt a cycle).
 #include <algorithm>
@@ -13,8 +13,28 @@
 namespace cncd::interp {
 namespace {
 
+// As LinuxCNC's messages name the planes: the XYZ ones in lower case in most of them, the UVW
+// ones always in upper case.
 const char* plane_name(Plane plane) {
-  return plane == Plane::xz ? "xz" : plane == Plane::yz ? "yz" : "xy";
+  switch (plane) {
+    case Plane::xz:
+      return "xz";
+    case Plane::yz:
+      return "yz";
+    case Plane::uv:
+      return "UV";
+    case Plane::vw:
+      return "VW";
+    case Plane::uw:
+      return "UW";
+    case Plane::xy:
+      break;
+  }
+  return "xy";
+}
+
+bool is_uvw_plane(Plane plane) {
+  return plane == Plane::uv || plane == Plane::vw || plane == Plane::uw;
 }
 
 bool is_canned_cycle(int code) {
@@ -38,6 +58,22 @@ double peck_clearance(Units units) {
 
 }  // namespace
 
+// A cycle in an XYZ plane moves no U, V or W, and one in a UVW plane no X, Y or Z.
+void Interpreter::Impl::check_cycle_plane_words() const {
+  const bool uvw = is_uvw_plane(modal_.plane);
+  const char* plane = modal_.plane == Plane::xz   ? "XZ"
+                      : modal_.plane == Plane::yz ? "YZ"
+                      : uvw                       ? plane_name(modal_.plane)
+                                                  : "XY";
+  for (const char letter : uvw ? "xyz" : "uvw") {
+    if (letter == '\0' || !block_.has(letter)) continue;
+    const char upper = static_cast<char>(std::toupper(letter));
+    fail(std::string("Cannot put ") + (upper == 'X' ? "an " : "a ") + upper +
+             " in a canned cycle in the " + plane + " plane",
+         block_.col(letter));
+  }
+}
+
 void Interpreter::Impl::do_canned_cycle(int code) {
   CycleGeometry g;
   switch (modal_.plane) {
@@ -47,12 +83,30 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     case Plane::yz:
       g.a = kY, g.b = kZ, g.c = kX;
       break;
+    case Plane::uv:
+      g.a = kU, g.b = kV, g.c = kW;
+      break;
+    case Plane::uw:
+      g.a = kW, g.b = kU, g.c = kV;
+      break;
+    case Plane::vw:
+      g.a = kV, g.b = kW, g.c = kU;
+      break;
     case Plane::xy:
       break;
   }
   const char c_letter = kAxisLetters[g.c];
   const bool same_cycle = previous_motion_ == code;
 
+  if (modal_.feed_rate == 0.0) fail("Cannot feed with zero feed rate");
+  if (modal_.feed_mode == FeedMode::inverse_time) {
+    fail("Cannot use inverse time feed with canned cycles");
+  }
+  if (block_.has('r')) {
+    cycle_.r = block_.get('r');
+  } else if (!same_cycle) {
+    fail("R clearance plane unspecified in cycle");
+  }
   int repeats = 1;
   if (block_.has('l')) {
     repeats = to_int(block_.get('l'));
@@ -62,21 +116,14 @@ void Interpreter::Impl::do_canned_cycle(int code) {
            block_.col('l'));
     }
   }
-  if (block_.has('r')) {
-    cycle_.r = block_.get('r');
-  } else if (!same_cycle) {
-    fail("R clearance plane unspecified in cycle");
-  }
+  check_cycle_plane_words();
+
   if (block_.has(c_letter)) {
     cycle_.z = block_.get(c_letter);
   } else if (!same_cycle) {
     fail(std::string(1, static_cast<char>(std::toupper(c_letter))) + " value unspecified in " +
          plane_name(modal_.plane) + " plane canned cycle");
   }
-  if (modal_.feed_mode == FeedMode::inverse_time) {
-    fail("Cannot use inverse time feed with canned cycles");
-  }
-  if (modal_.feed_rate == 0.0) fail("Cannot feed with zero feed rate");
 
   if (!is_canned_cycle(previous_motion_)) cycle_.initial_level = pos_[g.c];
   double old_c = cycle_.initial_level;
@@ -87,7 +134,9 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     g.bottom += g.r;
   }
   if (g.r < g.bottom) {
-    fail(std::string("R less than ") + c_letter + " in cycle in " + plane_name(modal_.plane) +
+    const char letter =
+        is_uvw_plane(modal_.plane) ? static_cast<char>(std::toupper(c_letter)) : c_letter;
+    fail(std::string("R less than ") + letter + " in cycle in " + plane_name(modal_.plane) +
          " plane");
   }
   if (old_c < g.r) {
@@ -118,6 +167,7 @@ void Interpreter::Impl::do_canned_cycle(int code) {
   if (code == 870) {
     // I, J and K belong to X, Y and Z: the plane axes' letters give the entry offset, the
     // drilling axis' letter the height the back bore cuts up to.
+    // (U, V and W take I, J and K as X, Y and Z do.)
     static constexpr char kOffsetLetters[] = "ijk";
     for (const char letter : {'i', 'j', 'k'}) {
       if (block_.has(letter)) {
@@ -129,9 +179,9 @@ void Interpreter::Impl::do_canned_cycle(int code) {
     auto value_of = [this](char letter) {
       return letter == 'i' ? cycle_.i : letter == 'j' ? cycle_.j : cycle_.k;
     };
-    g.i = value_of(kOffsetLetters[g.a]);
-    g.j = value_of(kOffsetLetters[g.b]);
-    const double height = value_of(kOffsetLetters[g.c]);
+    g.i = value_of(kOffsetLetters[g.a % 3]);
+    g.j = value_of(kOffsetLetters[g.b % 3]);
+    const double height = value_of(kOffsetLetters[g.c % 3]);
     g.k = modal_.incremental ? g.bottom + height : height;
   }
 

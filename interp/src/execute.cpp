@@ -204,12 +204,15 @@ void Interpreter::Impl::do_dwell() {
 void Interpreter::Impl::do_modes() {
   const int plane = block_.g_code(GGroup::plane);
   if (plane >= 0) {
-    const Plane next = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
+    Plane next = plane == 170 ? Plane::xy : plane == 180 ? Plane::xz : Plane::yz;
+    if (plane == 171) next = Plane::uv;
+    if (plane == 181) next = Plane::uw;
+    if (plane == 191) next = Plane::vw;
     const int column = block_.g_column[static_cast<std::size_t>(GGroup::plane)];
     if (comp_.on() && next != modal_.plane) {
       fail("Cannot change planes with cutter radius compensation on", column);
     }
-    if (comp_.on() && next == Plane::yz) {
+    if (comp_.on() && next != Plane::xy && next != Plane::xz) {
       fail("Cutter radius compensation allowed only in XY, XZ planes", column);
     }
     modal_.plane = next;

@@ -298,6 +298,7 @@ struct Interpreter::Impl {
 
   // cycles.cpp
   void do_canned_cycle(int code);
+  void check_cycle_plane_words() const;
   void cycle_body(int code, const CycleGeometry& g, double a, double b, double& current_c);
 
   // control.cpp: O-words.

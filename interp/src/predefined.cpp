@@ -223,7 +223,21 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
     case Name::motion_mode:
       return modal_.motion < 0 ? 800 : modal_.motion;
     case Name::plane:
-      return modal_.plane == Plane::xy ? 170 : modal_.plane == Plane::xz ? 180 : 190;
+      switch (modal_.plane) {
+        case Plane::xz:
+          return 180;
+        case Plane::yz:
+          return 190;
+        case Plane::uv:
+          return 171;
+        case Plane::uw:
+          return 181;
+        case Plane::vw:
+          return 191;
+        case Plane::xy:
+          break;
+      }
+      return 170;
     case Name::vmajor:
       return 2.9;
     default:

@@ -27,6 +27,11 @@ const char* plane_name(Plane plane) {
       return "CANON_PLANE_YZ";
     case Plane::xz:
       return "CANON_PLANE_XZ";
+    // rs274's printer has no names for the UVW planes.
+    case Plane::uv:
+    case Plane::vw:
+    case Plane::uw:
+      return "CANON_PLANE_UNKNOWN";
     case Plane::xy:
     default:
       return "CANON_PLANE_XY";

@@ -111,6 +111,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
       add_action(a, m.line);
       need_at_speed_ = false;
     }
+    if (!unsupported_ && machine_ != nullptr) {
+      if (auto why = axis_missing(*machine_, end_, next.end))
+        unsupported_ = Unsupported{m.line, *why};
+    }
     next.sync = sync_;
     sync_ = {};
     end_ = next.end;

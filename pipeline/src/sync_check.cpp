@@ -1,6 +1,6 @@
-// What a machine needs to move in step with its spindle as a program asks: the spindle's
-// position to follow, a spindle that reverses for a rigid tap, and axes fast enough for a
-// thread's pitch at the spindle's speed.
+// What a machine needs to move as a program asks: the axes the moves use; to move in step with
+// its spindle, the spindle's position to follow, a spindle that reverses for a rigid tap, and
+// axes fast enough for a thread's pitch at the spindle's speed.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -19,6 +19,18 @@ std::string number(double value) {
 }
 
 }  // namespace
+
+std::optional<std::string> axis_missing(const config::MachineConfig& machine,
+                                        const motion::AxisPose& start,
+                                        const motion::AxisPose& end) {
+  static constexpr char kLetters[] = "XYZABCUVW";
+  for (std::size_t axis = 0; axis < machine.axes.size(); ++axis) {
+    if (machine.axes[axis].present || start[axis] == end[axis]) continue;
+    return std::string("the move commands ") + kLetters[axis] + ", an axis this machine does " +
+           "not have ([TRAJ] COORDINATES = " + machine.coordinates + ")";
+  }
+  return std::nullopt;
+}
 
 std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine) {
   const config::SpindleConfig& sp = machine.spindle;

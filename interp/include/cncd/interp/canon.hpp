@@ -14,7 +14,8 @@ namespace cncd::interp {
 inline constexpr int kAxes = 9;  // X Y Z A B C U V W
 using Pose = std::array<double, kAxes>;
 
-enum class Plane : std::uint8_t { xy = 1, yz = 2, xz = 3 };  // CANON_PLANE_XY/YZ/XZ
+// CANON_PLANE_XY/YZ/XZ, and G17.1/G19.1/G18.1's CANON_PLANE_UV/VW/UW.
+enum class Plane : std::uint8_t { xy = 1, yz = 2, xz = 3, uv = 4, vw = 5, uw = 6 };
 enum class Units : std::uint8_t { inches = 1, mm = 2, cm = 3 };
 enum class MotionMode : std::uint8_t { exact_stop = 1, exact_path = 2, continuous = 3 };
 // SET_FEED_MODE's mode: inverse time (G93) is per minute here, its rate set move by move.
@@ -27,7 +28,8 @@ struct StraightFeed {
   Pose end{};
 };
 // ARC_FEED(first_end, second_end, first_axis, second_axis, rotation, axis_end_point,
-// a, b, c, u, v, w): "first" and "second" are the plane's axes (XY: X Y, YZ: Y Z, XZ: Z X),
+// a, b, c, u, v, w): "first" and "second" are the plane's axes (XY: X Y, YZ: Y Z, XZ: Z X;
+// UV: U V, VW: V W, UW: W U),
 // the axis point is on its normal; rotation > 0 counterclockwise, |rotation| turns.
 struct ArcFeed {
   double first_end = 0;

@@ -34,6 +34,10 @@ struct HoldInfo {
   interp::UserMCode user;  // user_m: what to run
 };
 
+// Why `machine` cannot make the move from `start` to `end` (machine coordinates): it moves an
+// axis that [TRAJ] COORDINATES does not give the machine; or nothing.
+std::optional<std::string> axis_missing(const config::MachineConfig& machine,
+                                        const motion::AxisPose& start, const motion::AxisPose& end);
 // Why `machine` cannot move in step with its spindle (no position to follow), or nothing.
 std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine);
 // Why `machine` cannot tap rigidly (its spindle cannot reverse), or nothing.
