@@ -69,6 +69,8 @@ json spindle_object(const SpindleReport& sp) {
            {"at_speed", sp.at_speed}};
   if (sp.position) out["position"] = *sp.position;
   out["css"] = sp.css_max_rpm ? json{{"max_rpm", *sp.css_max_rpm}} : json(nullptr);
+  out["orient"] =
+      sp.orient.empty() ? json(nullptr) : json{{"state", sp.orient}, {"angle", sp.orient_angle}};
   return out;
 }
 

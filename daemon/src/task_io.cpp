@@ -22,6 +22,8 @@ const char* wait_kind_name(motion::WaitStatus::Kind kind) {
       return "tool_change";
     case motion::WaitStatus::Kind::user_m:
       return "user_m";
+    case motion::WaitStatus::Kind::spindle_orient:
+      return "spindle_orient";
   }
   return "";
 }
@@ -41,6 +43,10 @@ WaitReport Task::wait_report(const motion::Status& s) const {
     case motion::WaitStatus::Kind::input:
       out.message = fmt::format("waiting for {} input {}", s.wait.digital ? "digital" : "analog",
                                 s.wait.index);
+      break;
+    case motion::WaitStatus::Kind::spindle_orient:
+      out.message = fmt::format("waiting for the spindle to orient to {:g} degrees (M19)",
+                                s.spindle.orient_deg);
       break;
     case motion::WaitStatus::Kind::tool_change: {
       const auto* hold = runner_->feeder().hold(s.wait.hold_id);

@@ -74,6 +74,9 @@ struct SpindleReport {
   // G96: the spindle's speed follows X; programmed_speed is then the surface speed (m/min in
   // G21, ft/min in G20) and css_max_rpm its D. Unset in G97.
   std::optional<double> css_max_rpm;
+  // M19: "orienting" to orient_angle (degrees), or "oriented" and held there; "" otherwise.
+  std::string orient;
+  double orient_angle = 0;
 };
 
 // The machine's outputs and inputs.

@@ -244,6 +244,8 @@ TaskStatus Task::status() const {
   out.spindle.at_speed = sp.at_speed;
   if (sp.has_position) out.spindle.position = sp.revolutions;
   if (sp.css_numerator > 0) out.spindle.css_max_rpm = sp.css_max_rpm;
+  out.spindle.orient = sp.orient == 1 ? "orienting" : sp.orient == 2 ? "oriented" : "";
+  out.spindle.orient_angle = sp.orient_deg;
   out.sync = sync_report(s.sync);
   if (s.motion == motion::MotionState::pausing) out.pause_wait = pause_wait_report(s.sync, s.line);
   out.mist = s.io.mist;

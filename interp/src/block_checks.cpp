@@ -1,5 +1,6 @@
 // Checks of a whole block before anything runs: unsupported codes, axis words without a user,
 // words no code uses, negative words. LinuxCNC's wording throughout.
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -113,6 +114,7 @@ void Interpreter::Impl::check_word_users(int motion) const {
     if (b.has(letter) && !used) fail(message, b.col(letter));
   };
   const bool css = b.g_code(GGroup::spindle_mode) == 960;
+  const bool orient = b.m_code(MGroup::spindle) == 19;
   const bool synced = motion == 330 || motion == 331;
   require('d', css || b.g_code(GGroup::cutter_comp) > 400,
           "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
@@ -130,16 +132,26 @@ void Interpreter::Impl::check_word_users(int motion) const {
   const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
                       motion == 820 || motion == 860 || motion == 880 || motion == 890 ||
                       motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53) ||
-                      (io >= 62 && io <= 66) || user_m;
+                      (io >= 62 && io <= 66) || orient || user_m;
   require('p', p_user,
           "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
           "M63 M64 M65 M66 M98 or user M code to use it");
+  if (orient && b.has('p')) {
+    const double p = b.get('p');
+    const double whole = std::round(p);
+    if (std::fabs(whole - p) > 0.001) fail("P value not an integer with M19 G2 or G3", b.col('p'));
+    if (whole < 0 || whole > 2) fail("P value must be 0,1,or 2 with M19", b.col('p'));
+  }
   const bool q_user = g10 || b.g_code(GGroup::path_control) == 640 || motion == 730 ||
-                      motion == 830 || b.m_code(MGroup::tool_change) == 61 || io >= 66 || user_m;
+                      motion == 830 || b.m_code(MGroup::tool_change) == 61 || io >= 66 || orient ||
+                      user_m;
   require('q', q_user,
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
-  require('r', arc || cycle || g10, "R word with no g code that uses it");
+  require('r', arc || cycle || g10 || orient, "R word with no g code that uses it");
+  if (orient && b.has('r') && (b.get('r') > 360.0 || b.get('r') < 0.0)) {
+    fail("R value must be within 0..360 with M19", b.col('r'));
+  }
   check_spindle_words(motion);
 }
 

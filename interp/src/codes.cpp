@@ -90,7 +90,7 @@ CodeInfo m_code_info(int code) {
   static constexpr Codes kCodes[] = {
       {0, 2, MGroup::stopping, true},      {30, 30, MGroup::stopping, true},
       {60, 60, MGroup::stopping, true},    {3, 5, MGroup::spindle, true},
-      {19, 19, MGroup::spindle, false},    {6, 6, MGroup::tool_change, true},
+      {19, 19, MGroup::spindle, true},     {6, 6, MGroup::tool_change, true},
       {61, 61, MGroup::tool_change, true}, {7, 9, MGroup::coolant, true},
       {48, 53, MGroup::overrides, true},   {62, 68, MGroup::io, true},
       {70, 73, MGroup::spindle, true},     {98, 99, MGroup::stopping, true},

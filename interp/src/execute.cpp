@@ -73,6 +73,22 @@ void Interpreter::Impl::set_feed_mode(FeedMode mode) {
   emit(SetFeedRate{0.0});
 }
 
+// M19: with R or P the spindle orients (R degrees from its index, 0 without R; P the way it
+// turns there, its whole part as rs274 takes it, though the check lets 1.9996 pass as 2); with
+// Q the program waits for it at most Q seconds. A bare M19 emits nothing, as in rs274; the
+// spindle counts as stopped either way.
+void Interpreter::Impl::orient_spindle() {
+  modal_.spindle = SpindleDir::stopped;
+  if (block_.has('r') || block_.has('p')) {
+    emit(OrientSpindle{block_.has('r') ? block_.get('r') : 0.0,
+                       block_.has('p') ? to_int(block_.get('p')) : 0});
+  }
+  if (block_.has('q')) {
+    if (block_.get('q') <= 0.0) fail("Q word with M19 requires a value > 0", block_.col('q'));
+    emit(WaitOrientSpindle{block_.get('q')});
+  }
+}
+
 void Interpreter::Impl::do_tool_and_spindle() {
   if (block_.has('s')) {
     modal_.speed = block_.get('s');
@@ -129,6 +145,9 @@ void Interpreter::Impl::do_tool_and_spindle() {
     case 5:
       modal_.spindle = SpindleDir::stopped;
       emit(StopSpindleTurning{});
+      break;
+    case 19:
+      orient_spindle();
       break;
     default:  // M70-M73 share the group
       if (block_.m_code(MGroup::spindle) >= 70) do_modal_state(block_.m_code(MGroup::spindle));

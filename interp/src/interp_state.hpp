@@ -234,6 +234,7 @@ struct Interpreter::Impl {
   void do_feed_mode();
   void set_feed_mode(FeedMode mode);
   void do_tool_and_spindle();
+  void orient_spindle();
   void do_coolant_and_overrides();
   // io.cpp
   void do_io();

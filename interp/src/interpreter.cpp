@@ -106,6 +106,7 @@ bool finite(const CanonOp& op) {
                         [](const SetSpindleSpeed& c) { return std::isfinite(c.rpm); },
                         [](const SetSpindleMode& c) { return std::isfinite(c.css_max_rpm); },
                         [](const OrientSpindle& c) { return std::isfinite(c.angle_deg); },
+                        [](const WaitOrientSpindle& c) { return std::isfinite(c.timeout_s); },
                         [](const SetOutputValue& c) { return std::isfinite(c.value); },
                         [](const WaitInput& c) { return std::isfinite(c.timeout_s); },
                         [](const UserMCode& c) { return std::isfinite(c.p) && std::isfinite(c.q); },

@@ -215,6 +215,11 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
             append_args(out, c.angle_deg, c.mode);
             out += ')';
           },
+          [&](const WaitOrientSpindle& c) {
+            out += "SPINDLE.0.WAIT_ORIENT_COMPLETE(";
+            append_fixed4(out, c.timeout_s);
+            out += ')';
+          },
           [&](const SetToolTableEntry& c) { append_tool_table_entry(out, c); },
           [&](const SetOutputBit& c) {
             out += c.on ? "SET_" : "CLEAR_";

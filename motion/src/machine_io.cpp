@@ -17,6 +17,7 @@ bool MachineIo::run(const IoAction& action, bool first) noexcept {
     case Kind::none:
       return true;
     case Kind::spindle:
+      end_orient();
       if (action.direction != 0 && !spindle_.present) {
         RtEvent e;
         e.code = RtEvent::Code::no_spindle;
@@ -61,6 +62,10 @@ bool MachineIo::run(const IoAction& action, bool first) noexcept {
       return wait_at_speed(first);
     case Kind::wait_input:
       return wait_input(action, first);
+    case Kind::orient_spindle:
+      return orient(action, first);
+    case Kind::wait_orient:
+      return wait_orient(action, first);
     case Kind::hold:
       if (first) {
         released_ = false;
@@ -179,6 +184,7 @@ void MachineIo::started(const SyncOutputs& sync) noexcept {
 }
 
 void MachineIo::stop_all() noexcept {
+  end_orient();
   spindle_.direction = 0;
   spindle_.paused_off = false;
   resuming_ = false;

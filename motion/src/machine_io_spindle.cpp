@@ -44,15 +44,21 @@ void MachineIo::update_command() noexcept {
     spindle_.at_speed = true;
   }
   if (tapping_) apply_tap();
+  if (spindle_.orient != 0) apply_orient();
   // The new command against this period's speed: a spindle just started is not at speed yet.
   spindle_.at_speed = at_speed();
 }
 
 void MachineIo::apply_tap() noexcept {
-  const double rpm = std::abs(tap_rps_) * 60.0;
+  drive_at(tap_rps_);
+}
+
+void MachineIo::drive_at(double rps) noexcept {
+  // Enabled even at speed 0: the spindle is held, not let go.
+  const double rpm = std::abs(rps) * 60.0;
   spindle_.enabled = spindle_.present;
   spindle_.commanded_rpm = rpm;
-  command_spindle(spindle_.present, tap_rps_ < 0, rpm);
+  command_spindle(spindle_.present, rps < 0, rpm);
   if (ideal_) spindle_.actual_rpm = rpm;
 }
 
@@ -124,6 +130,7 @@ void MachineIo::feedback(const drivers::IoFeedback& in) noexcept {
     spindle_.has_position = spindle_.present;
     spindle_.revolutions += spindle_rps_ * period_s_;
   }
+  if (spindle_.orient != 0) step_orient();
   spindle_.at_speed = at_speed();
 }
 

@@ -99,6 +99,12 @@ int format(const RtEvent& e, char* out, std::size_t size) {
     case Code::spindle_stale:
       return std::snprintf(out, size, "spindle 0: no answer from the drive%s%s",
                            e.text[0] ? ": " : "", e.text);
+    case Code::spindle_not_oriented:
+      return std::snprintf(out, size,
+                           "spindle 0 did not orient to %.4g degrees within %.3g s (M19 Q): it "
+                           "stands %.4g degrees off",
+                           clamped(e.limit), static_cast<double>(e.oldest_ago) / 1000.0,
+                           clamped(e.error));
     case Code::no_spindle:
       return std::snprintf(out, size, "the machine has no spindle ([SPINDLE_0] DRIVER = none)");
     case Code::probe_tripped_at_start:

@@ -230,6 +230,36 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             }
             return false;
           },
+          [&](const in::OrientSpindle& c) {
+            if (!unsupported_ && machine_ != nullptr) {
+              if (auto why = spindle_cannot_orient(*machine_))
+                unsupported_ = Unsupported{m.line, *why};
+            }
+            // The spindle stops for it, and the program goes on once it is oriented.
+            spindle_direction_ = 0;
+            need_at_speed_ = false;
+            Action a;
+            a.kind = Action::Kind::orient_spindle;
+            a.value = c.angle_deg;
+            a.mode = static_cast<std::int8_t>(c.mode);
+            a.timeout_s = kOrientTimeoutS;
+            add_action(a, m.line);
+            return false;
+          },
+          [&](const in::WaitOrientSpindle& c) {
+            // M19 R.. Q..: the orientation just queued waits at most Q seconds.
+            if (!pending_.empty() && pending_.back().line == m.line &&
+                pending_.back().kind == motion::Move::Kind::action &&
+                pending_.back().action.kind == Action::Kind::orient_spindle) {
+              pending_.back().action.timeout_s = c.timeout_s;
+              return false;
+            }
+            Action a;
+            a.kind = Action::Kind::wait_orient;
+            a.timeout_s = c.timeout_s;
+            add_action(a, m.line);
+            return false;
+          },
           [&](const in::StopSpeedFeedSynch&) {
             per_rev_ = 0;
             return false;

@@ -32,7 +32,11 @@ std::optional<std::string> axis_missing(const config::MachineConfig& machine,
   return std::nullopt;
 }
 
-std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine) {
+namespace {
+
+// What `machine` lacks to know its spindle's position, after "needs the spindle's position: ";
+// or nothing.
+std::optional<std::string> position_source_missing(const config::MachineConfig& machine) {
   const config::SpindleConfig& sp = machine.spindle;
   // Without [SPINDLE_0] the spindle is ideal: its position is where its command took it.
   if (!sp.present) return std::nullopt;
@@ -41,18 +45,34 @@ std::optional<std::string> spindle_position_missing(const config::MachineConfig&
       return std::nullopt;
     case config::SpindleDriver::gpio:
       if (sp.encoder_ppr > 0) return std::nullopt;
-      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
-             "position: [SPINDLE_0] has no encoder (ENCODER_A, ENCODER_B, ENCODER_PPR)";
+      return "[SPINDLE_0] has no encoder (ENCODER_A, ENCODER_B, ENCODER_PPR)";
     case config::SpindleDriver::modbus:
       if (sp.position_register >= 0) return std::nullopt;
-      return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs the spindle's "
-             "position: the Modbus spindle ([SPINDLE_0] DRIVER = modbus) has no "
-             "POSITION_REGISTER";
+      return "the Modbus spindle ([SPINDLE_0] DRIVER = modbus) has no POSITION_REGISTER";
     case config::SpindleDriver::none:
       break;
   }
-  return "spindle-synchronized motion (G33, G33.1, rigid tapping) needs a spindle: [SPINDLE_0] "
-         "DRIVER = none";
+  return std::string("[SPINDLE_0] DRIVER = none");
+}
+
+}  // namespace
+
+// Why `machine` cannot do `what`, which needs the spindle's position; or nothing.
+static std::optional<std::string> needs_position(const config::MachineConfig& machine,
+                                                 const char* what) {
+  const auto missing = position_source_missing(machine);
+  if (!missing) return std::nullopt;
+  const bool no_spindle = machine.spindle.driver == config::SpindleDriver::none;
+  return std::string(what) +
+         (no_spindle ? " needs a spindle: " : " needs the spindle's position: ") + *missing;
+}
+
+std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine) {
+  return needs_position(machine, "spindle-synchronized motion (G33, G33.1, rigid tapping)");
+}
+
+std::optional<std::string> spindle_cannot_orient(const config::MachineConfig& machine) {
+  return needs_position(machine, "spindle orientation (M19, G87)");
 }
 
 std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine) {

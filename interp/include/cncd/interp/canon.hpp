@@ -133,9 +133,16 @@ struct PalletShuttle {};        // M60 (then a stop), M30
 struct OnReset {};
 struct Finish {};       // the program ended with a closing '%'
 struct StartChange {};  // M6: the tool change begins (before ChangeTool)
+// M19 R P (and G86/G87): the spindle stops and turns to `angle_deg` from its index, `mode` 0
+// clockwise, 1 counterclockwise, 2 the shorter way (LinuxCNC's M19 P).
 struct OrientSpindle {
   double angle_deg = 0;
-  int mode = 0;  // LinuxCNC's orientation mode
+  int mode = 0;
+};
+// M19 Q: the program waits at most `timeout_s` for the spindle to be oriented
+// (SPINDLE.0.WAIT_ORIENT_COMPLETE).
+struct WaitOrientSpindle {
+  double timeout_s = 0;
 };
 // The program I/O indexes cncd has (config::kMaxDigitalIo, config::kMaxAnalogIo): M62-M66 P
 // 0..31, M66-M68 E 0..15. Another index is an error at its line.
@@ -221,8 +228,8 @@ using CanonOp = std::variant<
     SelectTool, ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
     SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage, ProgramStop,
     OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish, StartChange, OrientSpindle,
-    SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode, TurnProbeOn,
-    TurnProbeOff, StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
+    WaitOrientSpindle, SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode,
+    TurnProbeOn, TurnProbeOff, StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
 
 struct CanonCommand {
   std::int32_t line = 0;  // 1-based source line number in its file

@@ -110,10 +110,21 @@ class MachineIo final : public ActionGate {
   // The spindle has not reached its speed within AT_SPEED_TIMEOUT: the error take_error() gives.
   CNCD_RT void not_at_speed() noexcept;
   CNCD_RT bool wait_input(const IoAction& action, bool first) noexcept;
+  // machine_io_orient.cpp: M19. orient() starts (first) and waits for an orientation,
+  // wait_orient() waits for one under way; step_orient() drives the spindle toward it each
+  // period, from its position, and apply_orient() tells the drive.
+  CNCD_RT bool orient(const IoAction& action, bool first) noexcept;
+  CNCD_RT bool wait_orient(const IoAction& action, bool first) noexcept;
+  CNCD_RT bool orient_waited(double timeout_s) noexcept;
+  CNCD_RT void step_orient() noexcept;
+  CNCD_RT void apply_orient() noexcept;
+  CNCD_RT void end_orient() noexcept;
   // The spindle as the synchronized-motion follower sees it this period.
   CNCD_RT SyncFollower::Spindle sync_spindle() const noexcept;
   // A tap drives the spindle: its command replaces the program's.
   CNCD_RT void apply_tap() noexcept;
+  // The drive told to turn at `rps` (signed), enabled whatever the speed.
+  CNCD_RT void drive_at(double rps) noexcept;
   CNCD_RT double input_value(const IoAction& action) const noexcept;
 
   const config::SpindleConfig& config_;
@@ -159,6 +170,12 @@ class MachineIo final : public ActionGate {
   // under way: told the other way, and not yet seen at rest or turning the new way.
   int turning_ = 0;
   bool reversing_ = false;
+  // M19: orienting (spindle_.orient != 0); the spindle first comes to rest, then its target (in
+  // revolutions, where it stood plus the turn to the angle) is fixed.
+  bool orient_placed_ = false;
+  int orient_mode_ = 0;
+  double orient_target_ = 0;
+  double orient_rps_ = 0;  // what the orientation drives the spindle at, signed
 };
 
 }  // namespace cncd::motion

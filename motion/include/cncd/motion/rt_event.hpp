@@ -41,6 +41,7 @@ struct RtEvent {
     spindle_fault,             // `text`: the driver's words, if any
     spindle_stale,             // `text`: the driver's words, if any
     no_spindle,                // the program starts a spindle the machine does not have
+    spindle_not_oriented,      // M19: `error` degrees off `limit` after `oldest_ago` ms
     probe_tripped_at_start,    // G38.2/G38.3 with the probe already in contact
     probe_untripped_at_start,  // G38.4/G38.5 with the probe out of contact
     probe_no_contact,          // G38.2 ended without contact

@@ -53,6 +53,9 @@ struct SpindleStatus {
   bool has_position = false;     // revolutions comes from an encoder (or the sim spindle)
   double revolutions = 0;
   bool paused_off = false;  // stopped by a pause (STOP_ON_PAUSE) or the door; resume restarts it
+  // M19: turning to orient_deg (1), or holding there (2); 0: not oriented.
+  std::int8_t orient = 0;
+  double orient_deg = 0;
   // G96 (IoAction::css_*): programmed_rpm is then the surface speed; 0 = G97.
   double css_numerator = 0;
   double css_max_rpm = 0;
@@ -71,7 +74,14 @@ struct IoStatus {
 
 // What the path waits for at an action (IoAction): none while it moves.
 struct WaitStatus {
-  enum class Kind : std::uint8_t { none, spindle_at_speed, input, tool_change, user_m };
+  enum class Kind : std::uint8_t {
+    none,
+    spindle_at_speed,
+    input,
+    tool_change,
+    user_m,
+    spindle_orient
+  };
   Kind kind = Kind::none;
   std::uint32_t hold_id = 0;  // tool_change and user_m: what IoAction::hold_id the task answers
   std::int16_t index = 0;     // input: its index

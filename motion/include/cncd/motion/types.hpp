@@ -32,6 +32,11 @@ struct IoAction {
     wait_at_speed,            // the spindle at the commanded speed (before a feed move)
     wait_input,               // index, digital, mode, timeout_s (M66)
     hold,                     // until the task releases hold_id (M6, user M codes)
+    // M19: the spindle stops and turns to `value` degrees from its zero, `mode` 0 forward (M3's
+    // way), 1 in reverse, 2 the shorter way; done once it stands there, an error after
+    // timeout_s. It holds there until the next spindle action.
+    orient_spindle,
+    wait_orient,  // M19 Q alone: until an orientation under way is done, at most timeout_s
   };
   enum class Hold : std::uint8_t { none, tool_change, user_m };
   Kind kind = Kind::none;

@@ -40,6 +40,8 @@ std::optional<std::string> axis_missing(const config::MachineConfig& machine,
                                         const motion::AxisPose& start, const motion::AxisPose& end);
 // Why `machine` cannot move in step with its spindle (no position to follow), or nothing.
 std::optional<std::string> spindle_position_missing(const config::MachineConfig& machine);
+// Why `machine` cannot orient its spindle (M19): no position to steer it by; or nothing.
+std::optional<std::string> spindle_cannot_orient(const config::MachineConfig& machine);
 // Why `machine` cannot tap rigidly (its spindle cannot reverse), or nothing.
 std::optional<std::string> spindle_cannot_reverse(const config::MachineConfig& machine);
 // Why `machine`'s axes cannot follow a thread (G33) from `start` to `end` (machine
@@ -53,6 +55,8 @@ std::optional<std::string> thread_too_fast(const config::MachineConfig& machine,
 
 class ProgramFeeder final : public interp::CanonSink {
  public:
+  // How long an orientation (M19 without Q, G87) may take before the program stops.
+  static constexpr double kOrientTimeoutS = 30.0;
   // Operator messages (MSG) in the program, with their line; none = dropped.
   using MessageHandler = std::function<void(int line, const std::string& text)>;
 
