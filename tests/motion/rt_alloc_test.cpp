@@ -130,8 +130,8 @@ void program(Rig& rig) {
   using test::arc_to;
   using test::line_to;
   rig.queue(line_to(Move::Kind::traverse, 10, 0, 5));
-  // The spindle, coolant, outputs and waits done where the path rests, and outputs set with
-  // the start of a move.
+  // The spindle, coolant, outputs and waits done where the path rests (an orientation to 2.5
+  // degrees among them), and outputs set with the start of a move.
   const auto action = [&rig](motion::IoAction::Kind kind) {
     Move m;
     m.kind = Move::Kind::action;
@@ -141,11 +141,13 @@ void program(Rig& rig) {
     m.action.flood = true;
     m.action.on = true;
     m.action.value = 2.5;
+    m.action.timeout_s = 5;
     rig.queue(m);
   };
   using Io = motion::IoAction::Kind;
   for (const Io kind : {Io::spindle, Io::coolant, Io::digital_output, Io::analog_output,
-                        Io::spindle_override_enable, Io::wait_input, Io::wait_at_speed})
+                        Io::spindle_override_enable, Io::wait_input, Io::wait_at_speed,
+                        Io::orient_spindle, Io::wait_orient, Io::spindle})
     action(kind);
   Move synced = blended(line_to(Move::Kind::feed, 10, 0, 0, 20));
   synced.sync.set = 1u << 3;
