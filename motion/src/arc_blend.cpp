@@ -320,16 +320,7 @@ bool Planner::fillet(Held& held, Segment& next) {
     next.length -= f.trim_out;
   }
   prev.continuous = true;
-  // The fillet starts the next move: its outputs go with it.
-  blend.sync = next.sync;
-  next.sync = {};
-  if (prev.length > 1e-12) {
-    output_.push_back(prev);
-  } else {
-    blend.moves += prev.moves;  // the fillet took all that was left of it
-    add_sync(blend.sync, prev.sync);
-  }
-  output_.push_back(blend);
+  emit_corner(prev, blend, next);
   return true;
 }
 

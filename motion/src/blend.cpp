@@ -257,9 +257,6 @@ void Planner::join(Segment& next, const Move& move) {
   blend.line = next.line;
   blend.moves = 0;
   blend.continuous = true;
-  // The blend starts the next move: its outputs go with it.
-  blend.sync = next.sync;
-  next.sync = {};
   if (prev.feed > 0 && next.feed > 0) {
     blend.feed = std::min(prev.feed, next.feed);
   } else {
@@ -272,6 +269,12 @@ void Planner::join(Segment& next, const Move& move) {
   prev.continuous = true;
   next.start = blend.end;
   next.length -= reach;
+  emit_corner(prev, blend, next);
+}
+
+void Planner::emit_corner(Segment& prev, Segment& blend, Segment& next) {
+  blend.sync = next.sync;
+  next.sync = {};
   if (prev.length > 1e-12) {
     output_.push_back(prev);
   } else {

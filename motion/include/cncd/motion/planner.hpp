@@ -130,6 +130,10 @@ class Planner {
   SyncOutputs pending_sync_{};
   // Adds the `earlier` settings of outputs to `into`, whose own settings win.
   static void add_sync(SyncOutputs& into, const SyncOutputs& earlier);
+  // Emits `prev` and the blend arc or fillet that rounds its corner into `next`. The blend
+  // starts the next move, so next's outputs go with it; a prev the blend used up entirely is
+  // dropped, its move count and outputs passing to the blend.
+  void emit_corner(Segment& prev, Segment& blend, Segment& next);
   std::deque<Segment> output_;
 };
 
