@@ -164,6 +164,14 @@ void ServoLoop::stop_now(MachineState next) noexcept {
   status_.axes_to_go = {};
 }
 
+bool ServoLoop::clear_into(MachineState from, MachineState to) noexcept {
+  if (status_.machine != from) return false;
+  status_.machine = to;
+  status_.fault = {};
+  status_.joint_fault = {};
+  return true;
+}
+
 void ServoLoop::apply(const Command& command) noexcept {
   switch (command.kind) {
     case Command::Kind::estop:
@@ -173,19 +181,10 @@ void ServoLoop::apply(const Command& command) noexcept {
       }
       break;
     case Command::Kind::reset_estop:
-      if (status_.machine == MachineState::estop) {
-        status_.machine = MachineState::off;
-        status_.fault = {};
-        status_.joint_fault = {};
-      }
+      clear_into(MachineState::estop, MachineState::off);
       break;
     case Command::Kind::on:
-      if (status_.machine == MachineState::off) {
-        status_.machine = MachineState::on;
-        status_.fault = {};
-        status_.joint_fault = {};
-        sync_axes_from_joints();
-      }
+      if (clear_into(MachineState::off, MachineState::on)) sync_axes_from_joints();
       break;
     case Command::Kind::off:
       if (status_.machine == MachineState::on) stop_now(MachineState::off);

@@ -120,6 +120,9 @@ class ServoLoop {
   CNCD_RT void apply(const Command& command) noexcept;
   CNCD_RT void start_homing(std::uint32_t mask) noexcept;
   CNCD_RT void stop_now(MachineState next) noexcept;
+  // Reset and machine on: from `from` to `to` with the faults forgotten; false (nothing
+  // changes) when the machine is not in `from`.
+  CNCD_RT bool clear_into(MachineState from, MachineState to) noexcept;
   // One period of path motion: the executor's progress into the status, its fault latched,
   // the joints moved with their axes.
   CNCD_RT void advance_path() noexcept;
