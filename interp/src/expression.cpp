@@ -147,36 +147,59 @@ double apply(Op op, double left, double right, int column) {
   }
   return 0.0;
 }
+
+// Operator-precedence evaluation with explicit stacks, for the bracketed expressions and the
+// Numeryx dialect's; expressions nest through the operand readers, not through this.
+class OperatorStack {
+ public:
+  explicit OperatorStack(double first) { values_[0] = first; }
+
+  // Applies the stacked operators that bind at least as tightly as `op`; false when there is
+  // no room left to stack `op`.
+  bool make_room_for(Op op) {
+    while (top_ > 0 && precedence(ops_[top_ - 1]) >= precedence(op))
+      apply_top();
+    return top_ + 1 < kMaxDepth;
+  }
+  // `op` (read at `column`) and the operand after it.
+  void push(Op op, int column, double operand) {
+    ops_[top_] = op;
+    op_columns_[top_] = column;
+    values_[++top_] = operand;
+  }
+  double result() {
+    while (top_ > 0)
+      apply_top();
+    return values_[0];
+  }
+
+ private:
+  static constexpr int kMaxDepth = 16;
+  void apply_top() {
+    values_[top_ - 1] =
+        apply(ops_[top_ - 1], values_[top_ - 1], values_[top_], op_columns_[top_ - 1]);
+    --top_;
+  }
+  double values_[kMaxDepth];
+  Op ops_[kMaxDepth];
+  int op_columns_[kMaxDepth];
+  int top_ = 0;
+};
+
 }  // namespace
 
 double BlockParser::read_expression() {
   ++pos_;  // '['
-  // Operator-precedence evaluation with explicit stacks (expressions nest via read_real_value).
-  constexpr int kMaxDepth = 16;
-  double values[kMaxDepth];
-  Op ops[kMaxDepth];
-  int op_columns[kMaxDepth];
-  int top = 0;
-  values[0] = read_real_value();
+  OperatorStack stack(read_real_value());
   for (;;) {
     if (peek() == ']') {
       ++pos_;
-      while (top > 0) {
-        values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
-        --top;
-      }
-      return values[0];
+      return stack.result();
     }
     const int col = column();
     const Op op = static_cast<Op>(read_binary_operator());
-    while (top > 0 && precedence(ops[top - 1]) >= precedence(op)) {
-      values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
-      --top;
-    }
-    if (top + 1 >= kMaxDepth) error("Expression too complex");
-    ops[top] = op;
-    op_columns[top] = col;
-    values[++top] = read_real_value();
+    if (!stack.make_room_for(op)) error("Expression too complex");
+    stack.push(op, col, read_real_value());
   }
 }
 
@@ -261,12 +284,7 @@ double BlockParser::read_unary(int col) {
 // (the next address letter, a comma, the end of the line). Symbolic operators only, with
 // LinuxCNC's precedence; words such as MOD would be read as addresses.
 double BlockParser::read_nx_expression() {
-  constexpr int kMaxDepth = 16;
-  double values[kMaxDepth];
-  Op ops[kMaxDepth];
-  int op_columns[kMaxDepth];
-  int top = 0;
-  values[0] = read_nx_operand();
+  OperatorStack stack(read_nx_operand());
   for (;;) {
     const char c = peek();
     Op op = Op::none;
@@ -280,21 +298,12 @@ double BlockParser::read_nx_expression() {
     } else {
       break;
     }
-    while (top > 0 && precedence(ops[top - 1]) >= precedence(op)) {
-      values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
-      --top;
-    }
-    if (top + 1 >= kMaxDepth) error("Expression too complex");
-    ops[top] = op;
-    op_columns[top] = col;
-    values[++top] = read_nx_operand();
+    if (!stack.make_room_for(op)) error("Expression too complex");
+    stack.push(op, col, read_nx_operand());
   }
-  while (top > 0) {
-    values[top - 1] = apply(ops[top - 1], values[top - 1], values[top], op_columns[top - 1]);
-    --top;
-  }
-  if (!std::isfinite(values[0])) error("Result is not a finite number (overflow)");
-  return values[0];
+  const double result = stack.result();
+  if (!std::isfinite(result)) error("Result is not a finite number (overflow)");
+  return result;
 }
 
 }  // namespace cncd::interp
