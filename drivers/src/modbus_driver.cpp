@@ -19,6 +19,17 @@
 #include "monotonic_clock.hpp"
 
 namespace cncd::drivers {
+
+struct ModbusDriver::Slot {
+  ModbusBus* bus = nullptr;
+  std::size_t drive = 0;
+  double scale = 1;
+  std::int64_t stale_ns = 0;
+  bool enabled = false;  // servo thread: enable of the last write
+  std::uint32_t reset_request = 0;
+  Readback last{};  // kept when the mailbox is busy
+};
+
 struct ModbusDriver::IoSlot {
   ModbusBus* bus = nullptr;
   std::uint32_t digital_mask = 0;  // the digital inputs it reads
@@ -176,22 +187,16 @@ void ModbusDriver::read(JointFeedback* feedback, int count) noexcept {
   for (int i = 0; i < n; ++i) {
     Slot& slot = slots_[static_cast<std::size_t>(i)];
     Readback rb;
-    if (slot.bus->get_readback(slot.drive, rb)) {
-      slot.counts = rb.counts;
-      slot.time_ns = rb.time_ns;
-      slot.reset_ack = rb.reset_ack;
-      slot.fault = rb.fault;
-      slot.command_cycle = rb.command_cycle;
-      slot.previous_cycle = rb.previous_cycle;
-    }
+    if (slot.bus->get_readback(slot.drive, rb)) slot.last = rb;
+    const Readback& last = slot.last;
     JointFeedback& fb = feedback[i];
     fb = JointFeedback{};
-    fb.position = static_cast<double>(slot.counts) / slot.scale;
-    fb.command_cycle = slot.command_cycle;
-    fb.previous_cycle = slot.previous_cycle;
+    fb.position = static_cast<double>(last.counts) / slot.scale;
+    fb.command_cycle = last.command_cycle;
+    fb.previous_cycle = last.previous_cycle;
     // A fault from before the latest reset request is history until the bus has seen it.
-    fb.fault = slot.fault && slot.reset_ack == slot.reset_request;
-    fb.stale = slot.time_ns == 0 || now - slot.time_ns > slot.stale_ns;
+    fb.fault = last.fault && last.reset_ack == slot.reset_request;
+    fb.stale = last.time_ns == 0 || now - last.time_ns > slot.stale_ns;
   }
 }
 

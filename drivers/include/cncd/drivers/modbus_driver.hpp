@@ -55,20 +55,7 @@ class ModbusDriver final : public Driver {
   std::uint64_t bus_cycles(int index) const noexcept;
 
  private:
-  struct Slot {
-    ModbusBus* bus = nullptr;
-    std::size_t drive = 0;
-    double scale = 1;
-    std::int64_t stale_ns = 0;
-    bool enabled = false;  // servo thread: enable of the last write
-    std::uint32_t reset_request = 0;
-    std::int64_t counts = 0;  // last readback, kept when the mailbox is busy
-    std::int64_t time_ns = 0;
-    std::uint32_t reset_ack = 0;
-    bool fault = false;
-    std::uint64_t command_cycle = 0;  // of the last readback
-    std::uint64_t previous_cycle = 0;
-  };
+  struct Slot;    // a joint's drive (modbus_driver.cpp)
   struct IoSlot;  // a bus that serves signals or the spindle (modbus_driver.cpp)
   std::vector<std::unique_ptr<ModbusBus>> buses_;
   std::vector<Slot> slots_;
