@@ -12,6 +12,7 @@
 
 #include "cncd/config/config_keys.hpp"
 #include "cncd/config/ini_file.hpp"
+#include "cncd/config/number_text.hpp"
 
 namespace cncd::config {
 
@@ -76,8 +77,5 @@ class TypedReader {
   std::vector<Problem>& problems_;
   std::vector<Problem>& warnings_;
 };
-
-// "%g"-style text for a number in messages.
-std::string format_number(double value);
 
 }  // namespace cncd::config

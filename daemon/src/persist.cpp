@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "cncd/config/number_text.hpp"
+
 namespace cncd::daemon {
 namespace {
 
@@ -63,21 +65,14 @@ std::string atomic_write_file(const std::filesystem::path& path, const std::stri
   return "";
 }
 
-namespace {
-std::string show_number(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.10g", value);
-  return text;
-}
-}  // namespace
-
 std::string position_problem(int joint, double value, const JointRange& range) {
-  const std::string where = "joint " + std::to_string(joint) + " position " + show_number(value);
+  const std::string where =
+      "joint " + std::to_string(joint) + " position " + config::format_number(value);
   if (!std::isfinite(value)) return where + " is not a finite number";
   const double margin = kPositionMarginShare * (range.max - range.min);
   if (value >= range.min - margin && value <= range.max + margin) return "";
-  return where + " is outside its limits [" + show_number(range.min) + ", " +
-         show_number(range.max) + "] by more than 10 % of its travel";
+  return where + " is outside its limits [" + config::format_number(range.min) + ", " +
+         config::format_number(range.max) + "] by more than 10 % of its travel";
 }
 
 std::string position_file_problem(const std::filesystem::path& path,

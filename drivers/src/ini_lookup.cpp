@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "cncd/config/number_text.hpp"
+
 namespace cncd::drivers {
 
 std::string upper(std::string text) {
@@ -56,14 +58,8 @@ double default_number(const config::KeySpec& spec) {
   return parse_real(std::string(spec.default_value)).value_or(0.0);
 }
 
-std::string number_text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.10g", value);
-  return text;
-}
-
 std::string range_text(const config::KeySpec& spec) {
-  return "outside " + number_text(spec.min) + " .. " + number_text(spec.max);
+  return "outside " + config::format_number(spec.min) + " .. " + config::format_number(spec.max);
 }
 
 bool in_range(const config::KeySpec& spec, double value) {
