@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cncd/config/enum_name.hpp"
 #include "cncd/config/machine_config.hpp"
 
 namespace cncd::config {
@@ -36,17 +37,8 @@ void line(std::string& out, const std::string& text) {
 }
 
 const char* driver_name(SpindleDriver driver) {
-  switch (driver) {
-    case SpindleDriver::none:
-      return "none";
-    case SpindleDriver::gpio:
-      return "gpio";
-    case SpindleDriver::modbus:
-      return "modbus";
-    case SpindleDriver::sim:
-      break;
-  }
-  return "sim";
+  static constexpr const char* kNames[] = {"none", "sim", "gpio", "modbus"};
+  return enum_name(driver, kNames);
 }
 
 // "  NAME = address as written" for a signal that is given.

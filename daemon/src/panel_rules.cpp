@@ -58,27 +58,11 @@ PanelVerdict press_verdict(PanelInput input, const PanelSituation& now) {
 }
 
 const char* panel_act_method(PanelAct act) {
-  switch (act) {
-    case PanelAct::run:
-      return "program.run";
-    case PanelAct::step:
-      return "program.step";
-    case PanelAct::resume:
-      return "program.resume";
-    case PanelAct::pause:
-      return "program.pause";
-    case PanelAct::abort:
-      return "program.abort";
-    case PanelAct::machine_on:
-      return "machine.on";
-    case PanelAct::reset:
-      return "machine.reset";
-    case PanelAct::none:
-    case PanelAct::ignored:
-    case PanelAct::refused:
-      break;
-  }
-  return "";
+  static constexpr const char* kMethods[] = {"program.run",   "program.step",  "program.resume",
+                                             "program.pause", "program.abort", "machine.on",
+                                             "machine.reset"};
+  if (act < PanelAct::run) return "";  // none, ignored, refused: nothing to call
+  return kMethods[static_cast<std::size_t>(act) - static_cast<std::size_t>(PanelAct::run)];
 }
 
 std::uint32_t panel_light_bits(motion::MachineState machine, bool fault, ExecState exec,

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "cncd/config/enum_name.hpp"
 #include "cncd/interp/canon.hpp"
 #include "cncd/interp/tool_entry.hpp"
 #include "cncd/motion/status.hpp"
@@ -24,13 +25,7 @@ enum class Mode { manual, automatic, mdi };
 // "G54" .. "G59.3" for coordinate system 1..9.
 std::string coord_system_name(int system);
 // "estop", "off" or "on", as status and errors name the machine's state.
-// The name of an enum value from a table in its declaration order; the first name for a value
-// past the table's end.
-template <typename Enum, std::size_t N>
-const char* enum_name(Enum value, const char* const (&names)[N]) {
-  const auto index = static_cast<std::size_t>(value);
-  return index < N ? names[index] : names[0];
-}
+using config::enum_name;
 
 const char* machine_state_name(motion::MachineState state);
 const char* exec_state_name(ExecState state);

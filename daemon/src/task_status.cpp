@@ -14,32 +14,12 @@ namespace cncd::daemon {
 namespace {
 
 SyncReport sync_report(const motion::SyncStatus& sync) {
-  using Phase = motion::SyncStatus::Phase;
   SyncReport out;
   if (sync.mode == motion::SpindleSync::none) return out;
   out.mode = sync.mode == motion::SpindleSync::tap ? "tap" : "thread";
-  switch (sync.phase) {
-    case Phase::spindle_stopping:
-      out.phase = "spindle_stopping";
-      break;
-    case Phase::tapping_in:
-      out.phase = "tapping_in";
-      break;
-    case Phase::tapping_out:
-      out.phase = "tapping_out";
-      break;
-    case Phase::index:
-      out.phase = "index";
-      break;
-    case Phase::following:
-      out.phase = "following";
-      break;
-    case Phase::stopping:
-      out.phase = "stopping";
-      break;
-    case Phase::none:
-      break;
-  }
+  static constexpr const char* kPhases[] = {
+      "", "spindle_stopping", "tapping_in", "tapping_out", "index", "following", "stopping"};
+  out.phase = enum_name(sync.phase, kPhases);
   out.per_rev = sync.per_rev;
   out.progress = sync.progress;
   return out;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "cncd/config/enum_name.hpp"
+
 namespace cncd::pipeline {
 namespace {
 
@@ -57,19 +59,8 @@ std::vector<bool> keep_points(std::size_t n, double tolerance, const At& at) {
 }  // namespace
 
 const char* piece_kind_name(PieceKind kind) {
-  switch (kind) {
-    case PieceKind::rapid:
-      return "rapid";
-    case PieceKind::feed:
-      return "feed";
-    case PieceKind::arc:
-      return "arc";
-    case PieceKind::cycle:
-      return "cycle";
-    case PieceKind::probe:
-      return "probe";
-  }
-  return "feed";
+  static constexpr const char* kNames[] = {"rapid", "feed", "arc", "cycle", "probe"};
+  return config::enum_name(kind, kNames);
 }
 
 std::vector<Xyz> thin_polyline(const std::vector<Xyz>& points, double tolerance) {
