@@ -268,22 +268,16 @@ bool ModbusBus::exchange_points(const IoCommand& command) {
     } else {
       std::uint8_t bit = 0;
       std::uint16_t reg = 0;
-      switch (p.table) {
-        case IoTable::coil:
-          result = modbus_read_bits(ctx, p.address, 1, &bit);
-          break;
-        case IoTable::discrete:
-          result = modbus_read_input_bits(ctx, p.address, 1, &bit);
-          break;
-        case IoTable::holding:
-          result = modbus_read_registers(ctx, p.address, 1, &reg);
-          break;
-        case IoTable::input:
-          result = modbus_read_input_registers(ctx, p.address, 1, &reg);
-          break;
+      const bool bits = p.table == IoTable::coil || p.table == IoTable::discrete;
+      if (bits) {
+        const auto read = p.table == IoTable::coil ? modbus_read_bits : modbus_read_input_bits;
+        result = read(ctx, p.address, 1, &bit);
+      } else {
+        const auto read =
+            p.table == IoTable::holding ? modbus_read_registers : modbus_read_input_registers;
+        result = read(ctx, p.address, 1, &reg);
       }
       if (result != -1) {
-        const bool bits = p.table == IoTable::coil || p.table == IoTable::discrete;
         const double value = bits ? bit : reg;
         const auto n = static_cast<std::size_t>(p.index);
         switch (p.signal) {
