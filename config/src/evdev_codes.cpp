@@ -2,6 +2,8 @@
 
 #include <linux/input-event-codes.h>
 
+#include <cstddef>
+#include <iterator>
 #include <string_view>
 
 namespace cncd::config {
@@ -27,15 +29,9 @@ constexpr bool starts_with(std::string_view text, std::string_view prefix) {
 }  // namespace
 
 std::uint16_t EvdevCode::event_type() const {
-  switch (type) {
-    case Type::key:
-      return EV_KEY;
-    case Type::rel:
-      return EV_REL;
-    case Type::abs:
-      return EV_ABS;
-  }
-  return EV_KEY;
+  static constexpr std::uint16_t kTypes[] = {EV_KEY, EV_REL, EV_ABS};  // in Type's order
+  const auto index = static_cast<std::size_t>(type);
+  return index < std::size(kTypes) ? kTypes[index] : EV_KEY;
 }
 
 std::optional<EvdevCode> evdev_code(std::string_view name) {

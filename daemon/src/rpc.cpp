@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <exception>
+#include <iterator>
 #include <set>
 #include <string>
 
@@ -369,27 +370,13 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& text, S
 }
 
 int rpc_code(TaskErrorKind kind) {
-  switch (kind) {
-    case TaskErrorKind::wrong_state:
-      return kWrongState;
-    case TaskErrorKind::not_homed:
-      return kNotHomed;
-    case TaskErrorKind::program:
-      return kProgramError;
-    case TaskErrorKind::busy:
-      return kBusy;
-    case TaskErrorKind::bad_value:
-      return kInvalidParams;
-    case TaskErrorKind::save_failed:
-      return kFileError;
-    case TaskErrorKind::fault:
-      return kFault;
-    case TaskErrorKind::cancelled:
-      return kCancelled;
-    case TaskErrorKind::unavailable:
-      return kUnavailable;
-  }
-  return kInternalError;
+  // In TaskErrorKind's order.
+  static constexpr int kCodes[] = {kWrongState,    kNotHomed,  kProgramError, kBusy,
+                                   kInvalidParams, kFileError, kFault,        kCancelled,
+                                   kUnavailable};
+  static_assert(std::size(kCodes) == static_cast<std::size_t>(TaskErrorKind::unavailable) + 1);
+  const auto index = static_cast<std::size_t>(kind);
+  return index < std::size(kCodes) ? kCodes[index] : kInternalError;
 }
 
 void Completions::post(std::uint64_t token, TaskOutcome outcome) {

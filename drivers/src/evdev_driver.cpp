@@ -51,15 +51,8 @@ const char* kind_of(EvdevCode::Type type) {
 }
 
 EvdevCode::Type type_for(Target target) {
-  switch (target) {
-    case Target::input:
-      return EvdevCode::Type::key;
-    case Target::counter:
-      return EvdevCode::Type::rel;
-    case Target::analog:
-      return EvdevCode::Type::abs;
-  }
-  return EvdevCode::Type::key;
+  if (target == Target::counter) return EvdevCode::Type::rel;
+  return target == Target::analog ? EvdevCode::Type::abs : EvdevCode::Type::key;
 }
 
 // What is wrong with DEVICE as a source of events, or "". A missing device is fine here: the
