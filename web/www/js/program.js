@@ -5,7 +5,7 @@
 // The text is drawn as a window of lines over a spacer as tall as the whole program, so a
 // program of a million lines scrolls as easily as one of ten.
 
-import {$, el, fmtDuration, setText} from './ui.js';
+import {$, el, fmtDuration, onNextFrame, setText} from './ui.js';
 
 const kLineHeight = 22;  // px, as .prog-line in style.css
 const kOverscan = 200;   // lines drawn above and below the visible ones
@@ -137,7 +137,7 @@ class ProgramText {
     box.replaceChildren(this.note, this.spacer);
     this.spacer.append(this.window);
     this.drawn = [0, 0];
-    this.pending = false;
+    this.schedule = onNextFrame(() => this.draw());
     box.addEventListener('scroll', () => this.schedule());
     box.addEventListener('click', (event) => {
       const line = event.target.closest('[data-line]');
@@ -155,15 +155,6 @@ class ProgramText {
     this.window.replaceChildren();
     this.box.scrollTop = 0;
     this.draw();
-  }
-
-  schedule() {
-    if (this.pending) return;
-    this.pending = true;
-    requestAnimationFrame(() => {
-      this.pending = false;
-      this.draw();
-    });
   }
 
   draw() {

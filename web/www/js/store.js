@@ -2,13 +2,23 @@
 // ones are JSON merge patches (RFC 7386) of it. Views subscribe and are redrawn at most once an
 // animation frame, however many updates came in meanwhile.
 
+import {onNextFrame} from './ui.js';
+
 export class StatusStore {
   constructor() {
     this.status = {};
     this.info = null;  // system.info's answer
     this.views = [];
-    this.scheduled = false;
     this.connected = false;
+    this.schedule = onNextFrame(() => {
+      for (const fn of this.views) {
+        try {
+          fn(this.status, this);
+        } catch (e) {
+          console.error('status view failed:', e);
+        }
+      }
+    });
   }
 
   // fn(status, store) runs after each batch of updates.
@@ -23,21 +33,6 @@ export class StatusStore {
   replace(status) {
     this.status = status ?? {};
     this.schedule();
-  }
-
-  schedule() {
-    if (this.scheduled) return;
-    this.scheduled = true;
-    requestAnimationFrame(() => {
-      this.scheduled = false;
-      for (const fn of this.views) {
-        try {
-          fn(this.status, this);
-        } catch (e) {
-          console.error('status view failed:', e);
-        }
-      }
-    });
   }
 }
 

@@ -33,6 +33,20 @@ export function setText(node, text) {
   if (node && node.textContent !== text) node.textContent = text;
 }
 
+// A function that runs fn at the next animation frame, once however often it is called
+// before then: views redraw at most once a frame.
+export function onNextFrame(fn) {
+  let pending = false;
+  return () => {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => {
+      pending = false;
+      fn();
+    });
+  };
+}
+
 export function fmt(value, digits = 3) {
   return typeof value === 'number' && Number.isFinite(value) ? value.toFixed(digits) : '—';
 }
