@@ -40,10 +40,18 @@ function numberInput(name, value, digits = 4) {
   });
 }
 
-async function loadTools(ctx) {
+// Asks `method` for a table and fills the page's with fill(result, axes); what fails is said
+// in `note`.
+async function loadTable(ctx, method, note, fill) {
   try {
-    const result = await ctx.call('tool.list', undefined, {quiet: true});
-    const axes = axesOf(ctx);
+    fill(await ctx.call(method, undefined, {quiet: true}), axesOf(ctx));
+  } catch (e) {
+    $(note).textContent = `${method}: ${e.message}`;
+  }
+}
+
+function loadTools(ctx) {
+  return loadTable(ctx, 'tool.list', '#tool-path', (result, axes) => {
     $('#tool-head')
         .replaceChildren(
             el('tr', {}, el('th', {}, 'T'), el('th', {}, 'pocket'),
@@ -53,9 +61,7 @@ async function loadTools(ctx) {
         .replaceChildren(...(result.tools ?? []).map((tool) => toolRow(ctx, tool, false)));
     $('#tool-path').textContent = `${result.path ?? ''} (${result.units ?? ''})`;
     gateTable($('#tool-table'), 'tool.set');
-  } catch (e) {
-    $('#tool-path').textContent = `tool.list: ${e.message}`;
-  }
+  });
 }
 
 function toolRow(ctx, tool, isNew) {
@@ -104,10 +110,8 @@ function toolRow(ctx, tool, isNew) {
   return row;
 }
 
-async function loadOffsets(ctx) {
-  try {
-    const result = await ctx.call('offsets.get', undefined, {quiet: true});
-    const axes = axesOf(ctx);
+function loadOffsets(ctx) {
+  return loadTable(ctx, 'offsets.get', '#offsets-g92', (result, axes) => {
     $('#offsets-head')
         .replaceChildren(
             el('tr', {}, el('th', {}, 'system'), ...axes.map((a) => el('th', {}, a.toUpperCase())),
@@ -145,9 +149,7 @@ async function loadOffsets(ctx) {
         `G92: ${axes.map((a) => `${a.toUpperCase()} ${fmt(g92[a], 4)}`).join('  ')}` +
         ` · active ${result.active ?? ''} (${result.units ?? ''})`;
     gateTable($('#offsets-table'), 'offsets.set');
-  } catch (e) {
-    $('#offsets-g92').textContent = `offsets.get: ${e.message}`;
-  }
+  });
 }
 
 function gateTable(table, method) {
