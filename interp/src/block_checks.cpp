@@ -73,8 +73,9 @@ void Interpreter::Impl::check_block() const {
   if (motion == 800 && axis_words && !axes_belong_elsewhere()) {
     fail("Cannot use axis values with g80", motion_column);
   }
-  // Only G0-G3 may stand without an axis word (a move to where the tool is).
-  if (motion >= 0 && motion != 800 && motion > 30 && !axis_words) {
+  // Only G0-G3 may stand without an axis word (a move to where the tool is), and G5.2, whose
+  // first line may give only the weight of the start point or the order.
+  if (motion >= 0 && motion != 800 && motion > 30 && motion != 52 && !axis_words) {
     fail("All axes missing with motion code", motion_column);
   }
   if (axis_words && motion < 0 && !axes_belong_elsewhere() &&
@@ -115,24 +116,26 @@ void Interpreter::Impl::check_word_users(int motion) const {
   };
   const bool css = b.g_code(GGroup::spindle_mode) == 960;
   const bool orient = b.m_code(MGroup::spindle) == 19;
+  const bool bezier = motion == 50 || motion == 51;  // G5, G5.1
   const bool synced = motion == 330 || motion == 331;
   require('d', css || b.g_code(GGroup::cutter_comp) > 400,
           "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
   require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
   require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
-  require('i', arc || g10 || motion == 870 || motion == 331,
+  require('i', arc || bezier || g10 || motion == 870 || motion == 331,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
-  require('j', arc || g10 || motion == 870,
+  require('j', arc || bezier || g10 || motion == 870,
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
   require('k', arc || motion == 870 || synced,
           "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
-  require('l', g10 || cycle || io == 66 || b.g_code(GGroup::cutter_comp) > 400,
+  require('l', g10 || cycle || io == 66 || b.g_code(GGroup::cutter_comp) > 400 || motion == 52,
           "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
           "NURBS code");
-  const bool p_user = arc || g10 || non_modal == 40 || b.g_code(GGroup::path_control) == 640 ||
-                      motion == 820 || motion == 860 || motion == 880 || motion == 890 ||
-                      motion == 840 || motion == 740 || (overrides >= 50 && overrides <= 53) ||
-                      (io >= 62 && io <= 66) || orient || user_m;
+  const bool p_user = arc || motion == 50 || motion == 52 || g10 || non_modal == 40 ||
+                      b.g_code(GGroup::path_control) == 640 || motion == 820 || motion == 860 ||
+                      motion == 880 || motion == 890 || motion == 840 || motion == 740 ||
+                      (overrides >= 50 && overrides <= 53) || (io >= 62 && io <= 66) || orient ||
+                      user_m;
   require('p', p_user,
           "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
           "M63 M64 M65 M66 M98 or user M code to use it");
@@ -142,9 +145,9 @@ void Interpreter::Impl::check_word_users(int motion) const {
     if (std::fabs(whole - p) > 0.001) fail("P value not an integer with M19 G2 or G3", b.col('p'));
     if (whole < 0 || whole > 2) fail("P value must be 0,1,or 2 with M19", b.col('p'));
   }
-  const bool q_user = g10 || b.g_code(GGroup::path_control) == 640 || motion == 730 ||
-                      motion == 830 || b.m_code(MGroup::tool_change) == 61 || io >= 66 || orient ||
-                      user_m;
+  const bool q_user = motion == 50 || g10 || b.g_code(GGroup::path_control) == 640 ||
+                      motion == 730 || motion == 830 || b.m_code(MGroup::tool_change) == 61 ||
+                      io >= 66 || orient || user_m;
   require('q', q_user,
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");

@@ -16,9 +16,9 @@ struct GEntry {
 constexpr std::array kGCodes{
     GEntry{0, GGroup::motion, true},           GEntry{10, GGroup::motion, true},
     GEntry{20, GGroup::motion, true},          GEntry{30, GGroup::motion, true},
-    GEntry{40, GGroup::non_modal, true},       GEntry{50, GGroup::motion, false},
-    GEntry{51, GGroup::motion, false},         GEntry{52, GGroup::motion, false},
-    GEntry{53, GGroup::motion, false},         GEntry{70, GGroup::lathe_diameter, false},
+    GEntry{40, GGroup::non_modal, true},       GEntry{50, GGroup::motion, true},
+    GEntry{51, GGroup::motion, true},          GEntry{52, GGroup::motion, true},
+    GEntry{53, GGroup::non_modal, true},       GEntry{70, GGroup::lathe_diameter, false},
     GEntry{80, GGroup::lathe_diameter, false}, GEntry{100, GGroup::non_modal, true},
     GEntry{170, GGroup::plane, true},          GEntry{171, GGroup::plane, true},
     GEntry{180, GGroup::plane, true},          GEntry{181, GGroup::plane, true},

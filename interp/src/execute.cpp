@@ -26,6 +26,10 @@ void Interpreter::Impl::execute_block() {
   do_modes();
   do_non_modal();
   do_motion();
+  // G5.3 ends the G5.2 motion mode unless its line starts another curve.
+  if (block_.g_code(GGroup::non_modal) == 53 && block_.g_code(GGroup::motion) < 0) {
+    modal_.motion = 800;
+  }
   do_stop();
 }
 
@@ -322,6 +326,9 @@ void Interpreter::Impl::do_non_modal() {
   switch (code) {
     case 100:
       do_g10();
+      break;
+    case 53:
+      close_nurbs();
       break;
     case 280:
     case 281:

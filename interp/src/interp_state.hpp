@@ -20,6 +20,7 @@
 #include "parameters.hpp"
 #include "parser.hpp"
 #include "source.hpp"
+#include "splines.hpp"
 #include "tool_table.hpp"
 
 namespace cncd::interp {
@@ -297,6 +298,11 @@ struct Interpreter::Impl {
   Pose machine_to_program(const Pose& machine) const;
   Pose program_to_machine(const Pose& program) const;
 
+  // splines.cpp: G5, G5.1, and G5.2 .. G5.3.
+  void do_spline(int code);
+  void do_nurbs_point();
+  void close_nurbs();
+
   // cycles.cpp
   void do_canned_cycle(int code);
   void check_cycle_plane_words() const;
@@ -399,6 +405,7 @@ struct Interpreter::Impl {
   CycleState cycle_;
   CompState comp_;
   struct Comp;  // cutter_comp.hpp
+  SplineState spline_;
   NumeryxState nx_;
   std::vector<ForFrame> nx_loops_;
   int nx_cycle_distance_ = -1;  // this block's g90/g91 that belongs to the drilling cycle

@@ -60,6 +60,7 @@ void Interpreter::Impl::reset_modal_state() {
   cycle_ = CycleState{};
   comp_ = CompState{};
   parameters_.hide_position(false);
+  spline_ = SplineState{};
   nx_ = NumeryxState{};
   nx_loops_.clear();
   const int system = to_int(parameters_.get(5220));
@@ -95,6 +96,14 @@ bool finite(const CanonOp& op) {
                         [](const StraightTraverse& c) { return finite(c.end); },
                         [](const StraightFeed& c) { return finite(c.end); },
                         [](const ArcFeed& c) { return finite(c.end()) && finite(c.center()); },
+                        [](const NurbsFeed& c) {
+                          bool all = std::isfinite(c.inverse_time_feed);
+                          for (const Pose& point : c.points)
+                            all = all && finite(point);
+                          for (const double w : c.weights)
+                            all = all && std::isfinite(w);
+                          return all;
+                        },
                         [](const Dwell& c) { return std::isfinite(c.seconds); },
                         [](const SetFeedRate& c) { return std::isfinite(c.rate); },
                         [](const SetG5xOffset& c) { return finite(c.offset); },
@@ -136,6 +145,7 @@ void Interpreter::Impl::send_command(const CanonCommand& command) {
   const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
                      std::holds_alternative<StraightFeed>(command.op) ||
                      std::holds_alternative<ArcFeed>(command.op) ||
+                     std::holds_alternative<NurbsFeed>(command.op) ||
                      std::holds_alternative<Dwell>(command.op) ||
                      std::holds_alternative<StraightProbe>(command.op) ||
                      std::holds_alternative<RigidTap>(command.op);

@@ -118,6 +118,11 @@ void Interpreter::Impl::straight(StraightKind kind, const Pose& end) {
 void Interpreter::Impl::do_motion() {
   const int explicit_code = block_.g_code(GGroup::motion);
   previous_motion_ = modal_.motion;
+  if (explicit_code == 50 || explicit_code == 51) {
+    // G5 and G5.1 move once and leave the motion mode as it was, as rs274 does.
+    do_spline(explicit_code);
+    return;
+  }
   if (explicit_code >= 0) modal_.motion = explicit_code;
   if (explicit_code == 800) emit_comment("interpreter: motion mode set to none");
   const int non_modal = block_.g_code(GGroup::non_modal);
@@ -127,6 +132,10 @@ void Interpreter::Impl::do_motion() {
   for (int axis = 0; axis < kAxes; ++axis)
     axis_words |= block_.has(kAxisLetters[axis]);
   if (code == 530 || code < 0 || code == 800) return;
+  if (code == 52) {
+    if (axis_words || explicit_code == 52) do_nurbs_point();
+    return;
+  }
   if (is_canned_cycle(code)) {
     if (axis_words && comp_.on()) fail("Cannot use canned cycles with cutter compensation on");
     if (axis_words) do_canned_cycle(code);

@@ -65,6 +65,8 @@ void Interpreter::Impl::track_standalone(const CanonOp& op) {
     s.pos = traverse->end;
   } else if (const auto* arc = std::get_if<ArcFeed>(&op)) {
     s.pos = arc->end();
+  } else if (const auto* nurbs = std::get_if<NurbsFeed>(&op)) {
+    if (!nurbs->points.empty()) s.pos = nurbs->points.back();
   } else if (const auto* probe = std::get_if<StraightProbe>(&op)) {
     double d[3];
     double distance = 0;

@@ -142,6 +142,11 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
           },
           [&](const StraightFeed& c) { append_pose_call(out, "STRAIGHT_FEED(", c.end, axes); },
           [&](const ArcFeed& c) { append_arc(out, c, axes); },
+          [&](const NurbsFeed& c) {
+            out += "NURBS_FEED(";
+            append_int(out, static_cast<int>(c.points.size()));
+            out += ", ...)";
+          },
           [&](const Dwell& c) { append_call(out, "DWELL(", c.seconds); },
           [&](const SetFeedRate& c) { append_call(out, "SET_FEED_RATE(", c.rate); },
           [&](const SetFeedMode& c) {

@@ -68,6 +68,13 @@ CanonCommand MachineTracker::to_machine(const CanonCommand& command) {
                  [&](StraightProbe& c) { c.end = machine_pose(c.end); },
                  [&](RigidTap& c) { c.end = machine_pose(c.end); },
                  [&](StartSpeedFeedSynch& c) { c.feed_per_rev *= length_factor(); },
+                 [&](NurbsFeed& c) {
+                   // An affine map of the control points maps the curve: offsets, rotation
+                   // and units apply point by point.
+                   for (Pose& point : c.points)
+                     point = machine_pose(point);
+                   c.inverse_time_feed *= length_factor();
+                 },
                  [&](ArcFeed& c) {
                    const Pose machine_center = machine_pose(c.center());
                    c.set_end(machine_pose(c.end()));

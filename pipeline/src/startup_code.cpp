@@ -21,6 +21,7 @@ class MoveSink final : public interp::CanonSink {
                             [](const interp::StraightTraverse&) { return "a rapid move"; },
                             [](const interp::StraightFeed&) { return "a feed move"; },
                             [](const interp::ArcFeed&) { return "an arc"; },
+                            [](const interp::NurbsFeed&) { return "a spline"; },
                             [](const auto&) { return static_cast<const char*>(nullptr); },
                         },
                         command.op);

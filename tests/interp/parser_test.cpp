@@ -103,7 +103,6 @@ TEST(Errors, UnsupportedFeaturesAreRejected) {
   expect_errors({
       {"G76 P1 Z-1\nM2\n",
        "G76 is not supported: threading cycles are for lathe mode, which cncd does not have"},
-      {"G5.1 X1 I1\nM2\n", "G5.1 is not supported"},
   });
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 #include <variant>
+#include <vector>
 
 namespace cncd::interp {
 
@@ -46,6 +47,17 @@ struct ArcFeed {
   Pose center() const;
   void set_end(const Pose& end);
   void set_center(const Pose& center);
+};
+// G5 (cubic), G5.1 (quadratic) and G5.2 .. G5.3: a rational B-spline in the XY plane on the
+// clamped uniform knot vector of its order (degree + 1); the first point is where the tool is,
+// the curve ends on the last. G5 and G5.1 are Bezier curves: as many points as the order, all
+// weights 1. Only X and Y of the points differ. rs274 prints NURBS_FEED(points, ...).
+struct NurbsFeed {
+  std::vector<Pose> points;
+  std::vector<double> weights;
+  int order = 4;
+  // G93: the feed (length units per minute) that takes the curve in 1/F minutes; else 0.
+  double inverse_time_feed = 0;
 };
 struct Dwell {
   double seconds = 0;
@@ -220,16 +232,18 @@ struct SetToolTableEntry {
 };
 
 // The moves and the dwell come first.
-using CanonOp = std::variant<
-    StraightTraverse, StraightFeed, ArcFeed, Dwell, SetFeedRate, SetFeedMode, SetFeedReference,
-    SelectPlane, UseLengthUnits, SetG5xOffset, SetG92Offset, SetXyRotation, UseToolLengthOffset,
-    SetMotionControlMode, SetNaivecamTolerance, StartSpindleClockwise, StartSpindleCounterclockwise,
-    StopSpindleTurning, SetSpindleSpeed, SetSpindleMode, MistOn, MistOff, FloodOn, FloodOff,
-    SelectTool, ChangeTool, ChangeToolNumber, SetFeedOverrideEnable, SetSpindleOverrideEnable,
-    SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment, Message, DebugMessage, ProgramStop,
-    OptionalProgramStop, ProgramEnd, PalletShuttle, OnReset, Finish, StartChange, OrientSpindle,
-    WaitOrientSpindle, SetToolTableEntry, SetOutputBit, SetOutputValue, WaitInput, UserMCode,
-    TurnProbeOn, TurnProbeOff, StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
+using CanonOp =
+    std::variant<StraightTraverse, StraightFeed, ArcFeed, NurbsFeed, Dwell, SetFeedRate,
+                 SetFeedMode, SetFeedReference, SelectPlane, UseLengthUnits, SetG5xOffset,
+                 SetG92Offset, SetXyRotation, UseToolLengthOffset, SetMotionControlMode,
+                 SetNaivecamTolerance, StartSpindleClockwise, StartSpindleCounterclockwise,
+                 StopSpindleTurning, SetSpindleSpeed, SetSpindleMode, MistOn, MistOff, FloodOn,
+                 FloodOff, SelectTool, ChangeTool, ChangeToolNumber, SetFeedOverrideEnable,
+                 SetSpindleOverrideEnable, SetAdaptiveFeedEnable, SetFeedHoldEnable, Comment,
+                 Message, DebugMessage, ProgramStop, OptionalProgramStop, ProgramEnd, PalletShuttle,
+                 OnReset, Finish, StartChange, OrientSpindle, WaitOrientSpindle, SetToolTableEntry,
+                 SetOutputBit, SetOutputValue, WaitInput, UserMCode, TurnProbeOn, TurnProbeOff,
+                 StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
 
 struct CanonCommand {
   std::int32_t line = 0;  // 1-based source line number in its file
