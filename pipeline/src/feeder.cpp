@@ -73,9 +73,30 @@ void ProgramFeeder::add_action(const motion::IoAction& action, int line) {
   pending_.push_back(move);
 }
 
+void ProgramFeeder::begin_move(motion::Move& next, int line) {
+  // A tap brings the spindle to rest before it starts: no need to wait for its speed.
+  if (next.kind != motion::Move::Kind::traverse && next.spindle_sync != motion::SpindleSync::tap &&
+      need_at_speed_) {
+    motion::IoAction a;
+    a.kind = motion::IoAction::Kind::wait_at_speed;
+    add_action(a, line);
+    need_at_speed_ = false;
+  }
+  if (!unsupported_ && machine_ != nullptr) {
+    if (auto why = axis_missing(*machine_, end_, next.end)) unsupported_ = Unsupported{line, *why};
+  }
+  next.sync = sync_;
+  sync_ = {};
+  end_ = next.end;
+}
+
 void ProgramFeeder::emit(const interp::CanonCommand& command) {
   namespace in = interp;
   const in::CanonCommand m = tracker_.to_machine(command);
+  if (const auto* spline = std::get_if<in::NurbsFeed>(&m.op)) {
+    queue_spline(*spline, m.line);
+    return;
+  }
   motion::Move move;
   move.line = m.line;
   using Action = motion::IoAction;
@@ -102,23 +123,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
     queue_tool_change(number, m.line, tool_);
     return false;
   };
-  auto moving = [&](motion::Move& next) {
-    // A tap brings the spindle to rest before it starts: no need to wait for its speed.
-    if (next.kind != motion::Move::Kind::traverse &&
-        next.spindle_sync != motion::SpindleSync::tap && need_at_speed_) {
-      Action a;
-      a.kind = Action::Kind::wait_at_speed;
-      add_action(a, m.line);
-      need_at_speed_ = false;
-    }
-    if (!unsupported_ && machine_ != nullptr) {
-      if (auto why = axis_missing(*machine_, end_, next.end))
-        unsupported_ = Unsupported{m.line, *why};
-    }
-    next.sync = sync_;
-    sync_ = {};
-    end_ = next.end;
-  };
+  auto moving = [&](motion::Move& next) { begin_move(next, m.line); };
   auto stop = [&] {
     stop_seen_ = true;
     return false;

@@ -160,6 +160,11 @@ class ProgramFeeder final : public interp::CanonSink {
   int tool_ = 0;
   interp::MachineTracker tracker_;
   MessageHandler on_message_;
+  // Where a move that goes into the queue starts: the wait for the spindle's speed before a
+  // feed move, the outputs that go with it; `end_` moves to its end.
+  void begin_move(motion::Move& next, int line);
+  // G5, G5.1, G5.2: straight pieces within kSplineTolerance of the curve (feeder_spline.cpp).
+  void queue_spline(const interp::NurbsFeed& spline, int line);
   // Queues a stop point (a zero dwell) where a spindle, coolant or tool event comes in the
   // program, for the task to flush the planner there: the path comes to rest at that point
   // instead of blending through it.
