@@ -1,5 +1,7 @@
 #include "cncd/interp/canon.hpp"
 
+#include <cmath>
+
 namespace cncd::interp {
 namespace {
 
@@ -61,6 +63,57 @@ void ArcFeed::set_center(const Pose& center) {
   const ArcAxes axes = arc_axes(plane);
   first_axis = center[axes.first];
   second_axis = center[axes.second];
+}
+
+namespace {
+
+bool finite(const Pose& pose) {
+  bool all = true;
+  for (const double v : pose)
+    all = all && std::isfinite(v);
+  return all;
+}
+
+}  // namespace
+
+bool all_finite(const CanonOp& op) {
+  return std::visit(Overloaded{
+                        [](const StraightTraverse& c) { return finite(c.end); },
+                        [](const StraightFeed& c) { return finite(c.end); },
+                        [](const ArcFeed& c) { return finite(c.end()) && finite(c.center()); },
+                        [](const NurbsFeed& c) {
+                          bool all = std::isfinite(c.inverse_time_feed);
+                          for (const Pose& point : c.points)
+                            all = all && finite(point);
+                          for (const double w : c.weights)
+                            all = all && std::isfinite(w);
+                          return all;
+                        },
+                        [](const Dwell& c) { return std::isfinite(c.seconds); },
+                        [](const SetFeedRate& c) { return std::isfinite(c.rate); },
+                        [](const SetG5xOffset& c) { return finite(c.offset); },
+                        [](const SetG92Offset& c) { return finite(c.offset); },
+                        [](const SetXyRotation& c) { return std::isfinite(c.degrees); },
+                        [](const UseToolLengthOffset& c) { return finite(c.offset); },
+                        [](const SetMotionControlMode& c) { return std::isfinite(c.tolerance); },
+                        [](const SetNaivecamTolerance& c) { return std::isfinite(c.tolerance); },
+                        [](const SetSpindleSpeed& c) { return std::isfinite(c.rpm); },
+                        [](const SetSpindleMode& c) { return std::isfinite(c.css_max_rpm); },
+                        [](const OrientSpindle& c) { return std::isfinite(c.angle_deg); },
+                        [](const WaitOrientSpindle& c) { return std::isfinite(c.timeout_s); },
+                        [](const SetOutputValue& c) { return std::isfinite(c.value); },
+                        [](const WaitInput& c) { return std::isfinite(c.timeout_s); },
+                        [](const UserMCode& c) { return std::isfinite(c.p) && std::isfinite(c.q); },
+                        [](const StraightProbe& c) { return finite(c.end); },
+                        [](const RigidTap& c) { return finite(c.end) && std::isfinite(c.scale); },
+                        [](const StartSpeedFeedSynch& c) { return std::isfinite(c.feed_per_rev); },
+                        [](const SetToolTableEntry& c) {
+                          return finite(c.offset) && std::isfinite(c.front_angle) &&
+                                 std::isfinite(c.back_angle);
+                        },
+                        [](const auto&) { return true; },  // no number in it
+                    },
+                    op);
 }
 
 }  // namespace cncd::interp

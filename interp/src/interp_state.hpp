@@ -297,17 +297,14 @@ struct Interpreter::Impl {
   Pose table_offset(const ToolEntry& entry) const;
   Pose machine_to_program(const Pose& machine) const;
   Pose program_to_machine(const Pose& program) const;
-
   // splines.cpp: G5, G5.1, and G5.2 .. G5.3.
   void do_spline(int code);
   void do_nurbs_point();
   void close_nurbs();
-
   // cycles.cpp
   void do_canned_cycle(int code);
   void check_cycle_plane_words() const;
   void cycle_body(int code, const CycleGeometry& g, double a, double b, double& current_c);
-
   // control.cpp: O-words.
   void handle_o_word();
   void do_call();

@@ -82,66 +82,15 @@ void Interpreter::Impl::reset_modal_state() {
   probe_pending_ = false;
 }
 
-namespace {
-
-bool finite(const Pose& pose) {
-  bool all = true;
-  for (const double v : pose)
-    all = all && std::isfinite(v);
-  return all;
-}
-
-bool finite(const CanonOp& op) {
-  return std::visit(Overloaded{
-                        [](const StraightTraverse& c) { return finite(c.end); },
-                        [](const StraightFeed& c) { return finite(c.end); },
-                        [](const ArcFeed& c) { return finite(c.end()) && finite(c.center()); },
-                        [](const NurbsFeed& c) {
-                          bool all = std::isfinite(c.inverse_time_feed);
-                          for (const Pose& point : c.points)
-                            all = all && finite(point);
-                          for (const double w : c.weights)
-                            all = all && std::isfinite(w);
-                          return all;
-                        },
-                        [](const Dwell& c) { return std::isfinite(c.seconds); },
-                        [](const SetFeedRate& c) { return std::isfinite(c.rate); },
-                        [](const SetG5xOffset& c) { return finite(c.offset); },
-                        [](const SetG92Offset& c) { return finite(c.offset); },
-                        [](const SetXyRotation& c) { return std::isfinite(c.degrees); },
-                        [](const UseToolLengthOffset& c) { return finite(c.offset); },
-                        [](const SetMotionControlMode& c) { return std::isfinite(c.tolerance); },
-                        [](const SetNaivecamTolerance& c) { return std::isfinite(c.tolerance); },
-                        [](const SetSpindleSpeed& c) { return std::isfinite(c.rpm); },
-                        [](const SetSpindleMode& c) { return std::isfinite(c.css_max_rpm); },
-                        [](const OrientSpindle& c) { return std::isfinite(c.angle_deg); },
-                        [](const WaitOrientSpindle& c) { return std::isfinite(c.timeout_s); },
-                        [](const SetOutputValue& c) { return std::isfinite(c.value); },
-                        [](const WaitInput& c) { return std::isfinite(c.timeout_s); },
-                        [](const UserMCode& c) { return std::isfinite(c.p) && std::isfinite(c.q); },
-                        [](const StraightProbe& c) { return finite(c.end); },
-                        [](const RigidTap& c) { return finite(c.end) && std::isfinite(c.scale); },
-                        [](const StartSpeedFeedSynch& c) { return std::isfinite(c.feed_per_rev); },
-                        [](const SetToolTableEntry& c) {
-                          return finite(c.offset) && std::isfinite(c.front_angle) &&
-                                 std::isfinite(c.back_angle);
-                        },
-                        [](const auto&) { return true; },  // no number in it
-                    },
-                    op);
-}
-
-}  // namespace
-
 void Interpreter::Impl::emit_command(const CanonCommand& command) {
-  if (!finite(command.op)) fail("Result is not a finite number (overflow)");
+  if (!all_finite(command.op)) fail("Result is not a finite number (overflow)");
   if (Comp::comp_hold_back(*this, command)) return;
   send_command(command);
 }
 
 void Interpreter::Impl::send_command(const CanonCommand& command) {
   // Held-back moves are checked here, as they leave (an offset can overflow too).
-  if (!finite(command.op)) fail("Result is not a finite number (overflow)");
+  if (!all_finite(command.op)) fail("Result is not a finite number (overflow)");
   const bool moves = std::holds_alternative<StraightTraverse>(command.op) ||
                      std::holds_alternative<StraightFeed>(command.op) ||
                      std::holds_alternative<ArcFeed>(command.op) ||

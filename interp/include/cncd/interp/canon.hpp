@@ -245,6 +245,9 @@ using CanonOp =
                  SetOutputBit, SetOutputValue, WaitInput, UserMCode, TurnProbeOn, TurnProbeOff,
                  StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
 
+// Whether every number in `op` is finite (an overflow shows as inf or NaN).
+bool all_finite(const CanonOp& op);
+
 struct CanonCommand {
   std::int32_t line = 0;  // 1-based source line number in its file
   CanonOp op;
