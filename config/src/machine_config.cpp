@@ -5,6 +5,7 @@
 #include <exception>
 #include <map>
 #include <new>
+#include <ostream>
 
 #include "cncd/config/ini_file.hpp"
 #include "loader.hpp"
@@ -77,6 +78,17 @@ LoadResult load(const std::filesystem::path& ini_path, const LoadOptions& option
 }
 
 }  // namespace
+
+std::optional<MachineConfig> load_or_report(const std::filesystem::path& ini_path,
+                                            std::string_view program, std::ostream& err) {
+  auto loaded = load_machine_config(ini_path);
+  if (loaded.ok()) return std::move(loaded.config);
+  for (const auto& problem : loaded.problems)
+    err << problem.to_string() << '\n';
+  err << program << ": " << loaded.problems.size() << " problem"
+      << (loaded.problems.size() == 1 ? "" : "s") << " in " << ini_path.string() << '\n';
+  return std::nullopt;
+}
 
 LoadResult load_machine_config(const std::filesystem::path& ini_path, const LoadOptions& options) {
   // Bad input never throws here; what remains is running out of memory or a filesystem

@@ -90,15 +90,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cncd-telemetry: unknown log level '%s'\n", log_level.c_str());
     return 2;
   }
-  auto loaded = cncd::config::load_machine_config(ini);
-  if (!loaded.ok()) {
-    for (const auto& problem : loaded.problems)
-      std::cerr << problem.to_string() << '\n';
-    std::cerr << "cncd-telemetry: " << loaded.problems.size() << " problem"
-              << (loaded.problems.size() == 1 ? "" : "s") << " in " << ini << '\n';
-    return cncd::config::kExitConfig;
-  }
-  const cncd::config::MachineConfig& machine = *loaded.config;
+  auto loaded = cncd::config::load_or_report(ini, "cncd-telemetry", std::cerr);
+  if (!loaded) return cncd::config::kExitConfig;
+  const cncd::config::MachineConfig& machine = *loaded;
   const cncd::config::TelemetryConfig& t = machine.telemetry;
   std::string metrics_address = t.metrics_address;
   int metrics_port = t.metrics_port;

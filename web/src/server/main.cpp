@@ -83,15 +83,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cncd-web: unknown log level '%s'\n", log_level.c_str());
     return 2;
   }
-  auto loaded = cncd::config::load_machine_config(ini);
-  if (!loaded.ok()) {
-    for (const auto& problem : loaded.problems)
-      std::cerr << problem.to_string() << '\n';
-    std::cerr << "cncd-web: " << loaded.problems.size() << " problem"
-              << (loaded.problems.size() == 1 ? "" : "s") << " in " << ini << '\n';
-    return cncd::config::kExitConfig;
-  }
-  auto machine = cncd::web::with_web_defaults(std::move(*loaded.config));
+  auto loaded = cncd::config::load_or_report(ini, "cncd-web", std::cerr);
+  if (!loaded) return cncd::config::kExitConfig;
+  auto machine = cncd::web::with_web_defaults(std::move(*loaded));
   if (!rest.empty()) return cncd::web::run_admin(rest, machine.web);
 
   cncd::daemon::init_logging(*level);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -357,6 +358,12 @@ struct LoadOptions {
 // Reads, validates and types an INI file. Never throws on bad input; collects all problems.
 LoadResult load_machine_config(const std::filesystem::path& ini_path,
                                const LoadOptions& options = {});
+
+// For the programs that only read a machine's INI (cncd-web, cncd-telemetry): its
+// configuration, or nullopt after writing each problem on a line of `err` and then
+// "PROGRAM: N problems in INI".
+std::optional<MachineConfig> load_or_report(const std::filesystem::path& ini_path,
+                                            std::string_view program, std::ostream& err);
 
 // The copy of a state file to read: `file` when it exists, else `seed` when that exists,
 // else `file` (which then does not exist: the defaults apply). cncd-check reads this way
