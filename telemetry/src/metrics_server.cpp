@@ -7,6 +7,8 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 
+#include "tcp_listen.hpp"
+
 namespace cncd::telemetry {
 
 namespace beast = boost::beast;
@@ -76,15 +78,7 @@ MetricsServer::MetricsServer(boost::asio::io_context& io, std::function<std::str
     : io_(io), acceptor_(io), render_(std::move(render)) {}
 
 std::string MetricsServer::listen(const std::string& address, int port) {
-  beast::error_code ec;
-  const auto ip = boost::asio::ip::make_address(address, ec);
-  if (ec) return "'" + address + "' is not an IP address";
-  const tcp::endpoint endpoint(ip, static_cast<unsigned short>(port));
-  acceptor_.open(endpoint.protocol(), ec);
-  if (!ec) acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
-  if (!ec) acceptor_.bind(endpoint, ec);
-  if (!ec) acceptor_.listen(boost::asio::socket_base::max_listen_connections, ec);
-  if (ec) return "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message();
+  if (auto error = listen_on(acceptor_, address, port); !error.empty()) return error;
   accept();
   return "";
 }

@@ -11,6 +11,7 @@
 #include <boost/asio/write.hpp>
 
 #include "json_read.hpp"
+#include "tcp_listen.hpp"
 
 namespace cncd::telemetry {
 
@@ -258,15 +259,7 @@ ShdrServer::ShdrServer(boost::asio::io_context& io, const MachineFeed& feed, std
     : io_(io), feed_(feed), axes_(std::move(axes)), acceptor_(io), throttle_(io) {}
 
 std::string ShdrServer::listen(const std::string& address, int port) {
-  boost::system::error_code ec;
-  const auto ip = boost::asio::ip::make_address(address, ec);
-  if (ec) return "'" + address + "' is not an IP address";
-  const tcp::endpoint endpoint(ip, static_cast<unsigned short>(port));
-  acceptor_.open(endpoint.protocol(), ec);
-  if (!ec) acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
-  if (!ec) acceptor_.bind(endpoint, ec);
-  if (!ec) acceptor_.listen(boost::asio::socket_base::max_listen_connections, ec);
-  if (ec) return "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message();
+  if (auto error = listen_on(acceptor_, address, port); !error.empty()) return error;
   sent_ = shdr_items(feed_, axes_);
   accept();
   return "";
