@@ -139,18 +139,6 @@ std::vector<std::pair<std::string, std::string>> JobHistory::take_reports() {
   return std::exchange(reports_, {});
 }
 
-void JobHistory::flush() {
-  std::unique_lock lock(mutex_);
-  wake_.notify_all();
-  idle_.wait(lock, [this] {
-    if (busy_ || !asks_.empty()) return false;
-    for (const auto& [handle, row] : rows_) {
-      if (!row.written && store_problem_.empty()) return false;
-    }
-    return true;
-  });
-}
-
 void JobHistory::report(const std::string& level, std::string message) {
   reports_.emplace_back(level, std::move(message));
 }
@@ -172,7 +160,6 @@ void JobHistory::run() {
     wake_.wait_for(lock, wait, [&] {
       return stopping_ || !asks_.empty() || (pending() && store_problem_.empty());
     });
-    busy_ = true;
     write_rows(lock);
     while (!asks_.empty()) {
       const Ask ask = asks_.front();
@@ -185,8 +172,6 @@ void JobHistory::run() {
     lock.unlock();
     store_.reset();
     lock.lock();
-    busy_ = false;
-    idle_.notify_all();
     if (stopping_) return;
   }
 }

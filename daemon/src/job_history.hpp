@@ -45,9 +45,6 @@ class JobHistory {
   std::vector<std::pair<std::uint64_t, TaskOutcome>> take();
   std::vector<std::pair<std::string, std::string>> take_reports();
 
-  // For tests: waits until every row handed over has been written or given up on.
-  void flush();
-
  private:
   struct Ask {
     std::uint64_t token = 0;
@@ -77,9 +74,7 @@ class JobHistory {
   std::string store_problem_;  // why the database is not open or written, "" when fine
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::condition_variable idle_;
   bool stopping_ = false;
-  bool busy_ = false;
   std::uint64_t next_handle_ = 1;
   std::map<std::uint64_t, Row> rows_;  // not yet written for good
   std::deque<Ask> asks_;
