@@ -1,6 +1,7 @@
 // Prometheus' /metrics from the real cncd-telemetry: read by Prometheus' own text-format parser
 // (python3-prometheus-client), its counters against status.get and the job history.
 #include <fstream>
+#include <regex>
 
 #include "telemetry_fixture.hpp"
 
@@ -72,6 +73,18 @@ TEST_F(TelemetryTest, MetricsParseAndAgreeWithTheStatusAndTheJobHistory) {
   EXPECT_EQ(value_of(samples, "cncd_up"), 1);
   EXPECT_EQ(value_of(samples, "cncd_machine_state", {{"state", "on"}}), 1);
   EXPECT_EQ(value_of(samples, "cncd_joint_homed", {{"joint", "2"}}), 1);
+  // Every metric the Grafana dashboard in docs/ plots is served.
+  const std::string dashboard =
+      slurp(std::string(CNCD_SOURCE_DIR) + "/docs/grafana-dashboard.json");
+  ASSERT_FALSE(dashboard.empty());
+  const std::regex metric("cncd_[a-z_]+");
+  int plotted = 0;
+  for (auto it = std::sregex_iterator(dashboard.begin(), dashboard.end(), metric);
+       it != std::sregex_iterator(); ++it) {
+    ++plotted;
+    EXPECT_TRUE(samples.contains(it->str())) << it->str() << " is plotted but not served";
+  }
+  EXPECT_GE(plotted, 10);
   // The events it has seen: both programs started and finished.
   EXPECT_GE(value_of(samples, "cncd_events_total", {{"level", "info"}, {"kind", "program"}}), 4);
 }
