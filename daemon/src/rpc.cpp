@@ -371,9 +371,9 @@ std::optional<std::string> RpcDispatcher::handle_line(const std::string& text, S
 
 int rpc_code(TaskErrorKind kind) {
   // In TaskErrorKind's order.
-  static constexpr int kCodes[] = {kWrongState,    kNotHomed,  kProgramError, kBusy,
-                                   kInvalidParams, kFileError, kFault,        kCancelled,
-                                   kUnavailable};
+  static constexpr int kCodes[] = {kWrongState, kNotHomed,      kProgramError,
+                                   kBusy,       kInvalidParams, kFileError,
+                                   kFault,      kCancelled,     kUnavailable};
   static_assert(std::size(kCodes) == static_cast<std::size_t>(TaskErrorKind::unavailable) + 1);
   const auto index = static_cast<std::size_t>(kind);
   return index < std::size(kCodes) ? kCodes[index] : kInternalError;

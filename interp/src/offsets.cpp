@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "cncd/interp/stored_values.hpp"
-#include "failure.hpp"
 #include "cutter_comp.hpp"
+#include "failure.hpp"
 #include "interp_state.hpp"
 
 namespace cncd::interp {
