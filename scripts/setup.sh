@@ -6,13 +6,15 @@ set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libmodbus-dev libgpiod-dev libspdlog-dev
           nlohmann-json3-dev libssl-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache
           libboost1.81-dev libargon2-dev libsqlite3-dev libjs-three
-          libmosquitto-dev mosquitto python3-prometheus-client)
+          libmosquitto-dev python3-prometheus-client)
 for option in "$@"; do
   case "$option" in
     # LinuxCNC's standalone interpreter, used by the differential tests when present.
     --with-oracle) packages+=(linuxcnc-uspace) ;;
     # The browser the web page's tests drive.
     --with-browser) packages+=(chromium chromium-driver python3-selenium) ;;
+    # The MQTT broker cncd-telemetry's tests publish through (its own, on a port of its own).
+    --with-broker) packages+=(mosquitto) ;;
     *) echo "setup: unknown option '$option'" >&2; exit 2 ;;
   esac
 done

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-scripts/setup.sh --with-browser
+scripts/setup.sh --with-browser --with-broker
 # Rebuilds reuse compiled objects through ccache, also from another checkout of the same tree:
 # paths under the checkout are hashed relative to it.
 if command -v ccache >/dev/null && [[ -z "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ]]; then
