@@ -8,14 +8,18 @@
 namespace cncd::config {
 namespace {
 
+// A key's value without a trailing comment or blanks; "" when absent.
+std::string value(TypedReader& r, std::string_view key) {
+  return std::string(trim(strip_trailing_comment(r.text("TELEMETRY", key).value_or(""))));
+}
+
 bool id_character(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
          c == '_' || c == '.';
 }
 
 void load_machine_id(TypedReader& r, const MachineConfig& c, TelemetryConfig& t) {
-  const std::string given(
-      trim(strip_trailing_comment(r.text("TELEMETRY", "MACHINE_ID").value_or(""))));
+  const std::string given = value(r, "MACHINE_ID");
   if (!given.empty()) {
     for (const char ch : given) {
       if (!id_character(ch)) {
@@ -38,8 +42,7 @@ void load_machine_id(TypedReader& r, const MachineConfig& c, TelemetryConfig& t)
 
 // ADDRESS:PORT, or "off".
 void load_metrics_listen(TypedReader& r, TelemetryConfig& t) {
-  const std::string text(
-      trim(strip_trailing_comment(r.text("TELEMETRY", "METRICS_LISTEN").value_or(""))));
+  const std::string text = value(r, "METRICS_LISTEN");
   if (text == "off") {
     t.metrics_port = 0;
     return;
@@ -63,8 +66,7 @@ void load_metrics_listen(TypedReader& r, TelemetryConfig& t) {
 
 // A topic prefix names levels, never wildcards: '+' and '#' are for subscribers.
 void load_topic_prefix(TypedReader& r, TelemetryConfig& t) {
-  const std::string given(
-      trim(strip_trailing_comment(r.text("TELEMETRY", "TOPIC_PREFIX").value_or(""))));
+  const std::string given = value(r, "TOPIC_PREFIX");
   if (given.empty()) {
     t.topic_prefix = "cncd/" + t.machine_id;
     return;
@@ -90,8 +92,7 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
   }
   load_machine_id(r, c, t);
   load_metrics_listen(r, t);
-  const std::string shdr(
-      trim(strip_trailing_comment(r.text("TELEMETRY", "SHDR_LISTEN").value_or(""))));
+  const std::string shdr = value(r, "SHDR_LISTEN");
   if (const auto address = ip_address(shdr)) {
     t.shdr_address = *address;
   } else {
@@ -99,8 +100,7 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
               "'" + printable(shdr) + "' is not an IP address (e.g. 127.0.0.1, 0.0.0.0 or ::)");
   }
   if (const auto v = r.integer("TELEMETRY", "SHDR_PORT")) t.shdr_port = static_cast<int>(*v);
-  t.mqtt_host =
-      std::string(trim(strip_trailing_comment(r.text("TELEMETRY", "MQTT_HOST").value_or(""))));
+  t.mqtt_host = value(r, "MQTT_HOST");
   if (const auto v = r.integer("TELEMETRY", "MQTT_PORT")) t.mqtt_port = static_cast<int>(*v);
   t.mqtt_username = std::string(trim(r.text("TELEMETRY", "MQTT_USERNAME").value_or("")));
   t.mqtt_password = std::string(r.text("TELEMETRY", "MQTT_PASSWORD").value_or(""));
