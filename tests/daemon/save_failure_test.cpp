@@ -45,6 +45,18 @@ class SaveFailureTest : public ::testing::Test {
     return client_.call(method, params, 30000);
   }
 
+  // Runs the open program and returns the status once it has ended.
+  json run_to_idle() {
+    result_of(call("program.run"));
+    json s;
+    for (int i = 0; i < 3000; ++i) {
+      s = result_of(call("status.get"));
+      if (s["exec"] == "idle") break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return s;
+  }
+
   // Waits until the event log has an event of `kind` whose message holds `text`.
   bool wait_for_event(const std::string& kind, const std::string& text) {
     json events;
@@ -196,13 +208,7 @@ TEST_F(SaveFailureTest, ProgramThatSetsAnOffsetOnAFullDiskEndsInErrorAndIsUndone
   const fs::path program = dir_.write("g10.ngc", "G10 L2 P3 X11 Y12\nG0 X2\nM2\n");
   result_of(call("program.open", {{"path", program.string()}}));
   fill_disk();
-  result_of(call("program.run"));
-  json s;
-  for (int i = 0; i < 3000; ++i) {
-    s = result_of(call("status.get"));
-    if (s["exec"] == "idle") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const json s = run_to_idle();
   EXPECT_EQ(s["program"]["result"], "error") << s.dump();
   const std::string error = s["program"]["error"];
   EXPECT_NE(error.find("sim_mm.var"), std::string::npos) << error;
@@ -218,13 +224,7 @@ TEST_F(SaveFailureTest, AJobOnAFullDiskIsLoggedKeptAndWrittenWhenThereIsRoom) {
   const fs::path program = dir_.write("part.ngc", "G21 G90 F3000\nG1 X5\nM30\n");
   result_of(call("program.open", {{"path", program.string()}}));
   fill_disk();
-  result_of(call("program.run"));
-  json s;
-  for (int i = 0; i < 3000; ++i) {
-    s = result_of(call("status.get"));
-    if (s["exec"] == "idle") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const json s = run_to_idle();
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
   EXPECT_TRUE(wait_for_event("jobs", "No space left on device"));
   EXPECT_EQ(s["state"], "on");
