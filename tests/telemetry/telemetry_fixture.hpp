@@ -6,6 +6,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <memory>
 #include <regex>
@@ -37,6 +38,16 @@ inline int connect_loopback(int port, int timeout_s = 10) {
     return -1;
   }
   return fd;
+}
+
+// Whether the peer closes `fd` (a read returns end of file) before its read timeout.
+inline bool closed_by_peer(int fd) {
+  char byte;
+  for (;;) {
+    const ssize_t n = ::recv(fd, &byte, 1, 0);
+    if (n == 0) return true;
+    if (n < 0) return errno == ECONNRESET;  // else timed out: still open
+  }
 }
 
 inline HttpAnswer http_exchange(int port, const std::string& request) {
