@@ -83,7 +83,10 @@ void Interpreter::Impl::reset_modal_state() {
 }
 
 void Interpreter::Impl::emit_command(const CanonCommand& command) {
-  if (!all_finite(command.op)) fail("Result is not a finite number (overflow)");
+  // A command held back behind a compensated move is checked at its own line too;
+  // send_command() checks every other one as it goes out.
+  if (!comp_.queue.empty() && !all_finite(command.op))
+    fail("Result is not a finite number (overflow)");
   if (Comp::comp_hold_back(*this, command)) return;
   send_command(command);
 }
