@@ -10,14 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "status_json.hpp"
+
 namespace cncd::daemon {
 namespace {
 
 using nlohmann::json;
-
-json optional_number(const std::optional<double>& value) {
-  return value ? json(*value) : json(nullptr);
-}
 
 json job_json(const JobRecord& job) {
   return json{{"id", job.id},

@@ -53,10 +53,6 @@ json joints_array(const std::vector<JointReport>& joints) {
   return out;
 }
 
-json optional_number(const std::optional<double>& value) {
-  return value ? json(*value) : json(nullptr);
-}
-
 json spindle_object(const SpindleReport& sp) {
   json out{{"direction", sp.direction},
            {"speed", sp.speed},
@@ -160,6 +156,10 @@ json panel_object(const std::optional<PanelReport>& panel) {
 }
 
 }  // namespace
+
+json optional_number(const std::optional<double>& value) {
+  return value ? json(*value) : json(nullptr);
+}
 
 json status_json(const TaskStatus& s, const config::MachineConfig& config) {
   json homed = json::array();

@@ -3,6 +3,7 @@
 // lower case.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,6 +21,8 @@ nlohmann::json tool_list_json(const std::vector<interp::ToolEntry>& tools,
 nlohmann::json offsets_json(const OffsetsReport& offsets, const config::MachineConfig& config);
 // One entry of the event log, as errors.list lists it and the "event" notification carries it.
 nlohmann::json event_json(const Event& event);
+// The number, or null when there is none.
+nlohmann::json optional_number(const std::optional<double>& value);
 // Events as errors.list lists them, oldest first.
 nlohmann::json events_json(const std::vector<Event>& events);
 
