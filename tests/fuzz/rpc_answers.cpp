@@ -66,7 +66,9 @@ bool known_code(int code) {
                                       daemon::kRequestTooLarge,
                                       daemon::kFileError,
                                       daemon::kFault,
-                                      daemon::kCancelled};
+                                      daemon::kCancelled,
+                                      daemon::kAttributionRefused,
+                                      daemon::kUnavailable};
   return codes.contains(code);
 }
 
