@@ -183,7 +183,12 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
     spdlog::critical("cannot start motion: {}", error);
     return kExitUnavailable;
   }
-  StatusCache status([&task, &config] { return status_json(task.status(), config); });
+  // The status counts the server's connections: built on the server's thread, once it runs.
+  const Server* serving_clients = nullptr;
+  StatusCache status([&task, &config, &serving_clients] {
+    return status_json(task.status(), config,
+                       serving_clients != nullptr ? serving_clients->client_count() : 0);
+  });
   RpcDispatcher dispatcher;
   JogHeartbeats heartbeats(task, events);
   register_methods(dispatcher, task, config, events, completions, heartbeats, &status);
@@ -196,6 +201,7 @@ int serve(const cncd::config::MachineConfig& config, const std::string& socket_p
                                 static_cast<std::size_t>(config.cncd.max_connections_per_user),
                                 static_cast<std::size_t>(config.cncd.control_reserve)};
   Server server(dispatcher, policy, status, events, completions, limits);
+  serving_clients = &server;
   std::string serving = socket_path;
   // Socket activation: systemd hands over the listening socket of cncd.socket.
   if (sd_listen_fds(1) == 1 &&

@@ -110,12 +110,19 @@ json program_object(const ProgramReport& p) {
 }
 
 json rt_object(const motion::RtStats& rt) {
+  json below = json::array();
+  for (std::size_t i = 0; i < motion::kWakeEdgesUs.size(); ++i)
+    below.push_back({{"us", motion::kWakeEdgesUs[i]}, {"count", rt.wake_error_below[i]}});
   return {{"cycles", rt.cycles},
           {"overruns", rt.overruns},
           {"wake_error_p50_ns", rt.wake_error_p50_ns},
           {"wake_error_p99_ns", rt.wake_error_p99_ns},
           {"wake_error_p999_ns", rt.wake_error_p999_ns},
           {"wake_error_max_ns", rt.wake_error_max_ns},
+          {"wake_error_below", below},
+          {"wake_error_count", rt.wake_error_count},
+          {"wake_error_sum_ns", rt.wake_error_sum_ns},
+          {"modbus_errors", rt.modbus_errors},
           {"realtime", rt.realtime},
           {"memory_locked", rt.memory_locked}};
 }
@@ -161,7 +168,7 @@ json optional_number(const std::optional<double>& value) {
   return value ? json(*value) : json(nullptr);
 }
 
-json status_json(const TaskStatus& s, const config::MachineConfig& config) {
+json status_json(const TaskStatus& s, const config::MachineConfig& config, std::size_t clients) {
   json homed = json::array();
   json joint_fault = json::array();
   for (const JointReport& joint : s.joints) {
@@ -232,6 +239,7 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config) {
       {"rt", rt_object(s.rt)},
       {"panel", panel_object(s.panel)},
       {"manual_holder", manual_holder_object(s.manual_holder)},
+      {"clients", clients},
   };
 }
 

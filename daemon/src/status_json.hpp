@@ -3,6 +3,7 @@
 // lower case.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <vector>
 
@@ -15,7 +16,9 @@
 
 namespace cncd::daemon {
 
-nlohmann::json status_json(const TaskStatus& status, const config::MachineConfig& config);
+// `clients`: the connections to the control socket (the server's count).
+nlohmann::json status_json(const TaskStatus& status, const config::MachineConfig& config,
+                           std::size_t clients);
 nlohmann::json tool_list_json(const std::vector<interp::ToolEntry>& tools,
                               const config::MachineConfig& config);
 nlohmann::json offsets_json(const OffsetsReport& offsets, const config::MachineConfig& config);

@@ -101,12 +101,14 @@ bool ModbusBus::connect() {
   const auto timeout_us = static_cast<std::uint32_t>(bus_.timeout_ms) * 1000u;
   modbus_set_response_timeout(ctx, timeout_us / 1'000'000u, timeout_us % 1'000'000u);
   if (modbus_connect(ctx) != 0) {
+    count_error();
     modbus_free(ctx);
     return false;
   }
   if (!bus_.rtu && connected_to_itself(modbus_get_socket(ctx))) {
     // With nobody listening on a loopback port in the ephemeral range, the kernel may hand
     // the connection that very port as its source and connect it to itself. That is no drive.
+    count_error();
     modbus_close(ctx);
     modbus_free(ctx);
     errno = ECONNREFUSED;
@@ -169,6 +171,7 @@ bool ModbusBus::exchange(std::size_t index, const Setpoint& setpoint) {
   const auto attempt = [&](auto&& request) {
     for (int tries = 0; tries <= bus_.retries; ++tries) {
       if (request() != -1) return true;
+      count_error();
       if (is_exception(errno)) return false;
     }
     return false;
@@ -301,7 +304,10 @@ bool ModbusBus::exchange_points(const IoCommand& command) {
         }
       }
     }
-    if (result == -1 && !is_exception(errno)) return false;  // the link is gone: start over
+    if (result == -1) {
+      count_error();
+      if (!is_exception(errno)) return false;  // the link is gone: start over
+    }
   }
   return true;
 }

@@ -195,6 +195,8 @@ class ModbusBus {
   }
   // Any thread: completed update cycles and their start time span, for rate figures.
   std::uint64_t cycles() const noexcept { return cycles_.load(std::memory_order_relaxed); }
+  // Any thread: requests that failed (each try), and connects that failed.
+  std::uint64_t errors() const noexcept { return errors_.load(std::memory_order_relaxed); }
 
  private:
   struct DriveState {
@@ -250,6 +252,8 @@ class ModbusBus {
   void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
   bool link_failed_ = false;
   std::atomic<std::uint64_t> cycles_{0};
+  std::atomic<std::uint64_t> errors_{0};
+  void count_error() noexcept { errors_.fetch_add(1, std::memory_order_relaxed); }
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -261,6 +261,13 @@ bool ModbusDriver::fault_reason(char* out, std::size_t size) const noexcept {
   return false;
 }
 
+std::uint64_t ModbusDriver::exchange_errors() const noexcept {
+  std::uint64_t errors = 0;
+  for (const auto& bus : buses_)
+    errors += bus->errors();
+  return errors;
+}
+
 std::uint64_t ModbusDriver::bus_cycles(int index) const noexcept {
   if (index < 0 || static_cast<std::size_t>(index) >= slots_.size()) return 0;
   return slots_[static_cast<std::size_t>(index)].bus->cycles();

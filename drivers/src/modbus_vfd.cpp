@@ -54,6 +54,7 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
   const int speed = static_cast<int>(std::clamp(scaled, 0L, 65535L));
   const auto failed = [&](const char* what, int reg) {
     const int error = errno;
+    count_error();
     if (error == ETIMEDOUT) {
       vfd_problem("no answer (timeout)");
     } else {

@@ -1,5 +1,7 @@
 #include "cncd/motion/rt_stats.hpp"
 
+#include <algorithm>
+
 namespace cncd::motion {
 
 void RtHistogram::add(std::int64_t error_ns) noexcept {
@@ -16,6 +18,22 @@ void RtHistogram::add(std::int64_t error_ns) noexcept {
   }
   ++buckets_[static_cast<std::size_t>(bucket)];
   ++count_;
+  sum_ns_ += static_cast<std::uint64_t>(error_ns);
+}
+
+void RtHistogram::count_below(const std::int32_t* edges_us, std::uint64_t* below,
+                              std::size_t n) const noexcept {
+  std::uint64_t seen = 0;
+  int bucket = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    // The first bucket at or past the edge: fine buckets are 1 us wide from 0, coarse ones
+    // 100 us wide from 1000 us.
+    const std::int32_t edge = edges_us[i];
+    const int end = edge <= kFine ? edge : std::min(kFine + (edge - kFine) / 100, kBuckets - 1);
+    for (; bucket < end; ++bucket)
+      seen += buckets_[static_cast<std::size_t>(bucket)];
+    below[i] = seen;
+  }
 }
 
 std::int64_t RtHistogram::quantile_ns(double q) const noexcept {

@@ -368,7 +368,15 @@ void ServoLoop::update_stats(std::int64_t wake_error_ns) noexcept {
     status_.rt.wake_error_p50_ns = histogram_.quantile_ns(0.5);
     status_.rt.wake_error_p99_ns = histogram_.quantile_ns(0.99);
     status_.rt.wake_error_p999_ns = histogram_.quantile_ns(0.999);
+    histogram_.count_below(kWakeEdgesUs.data(), status_.rt.wake_error_below.data(),
+                           kWakeEdgesUs.size());
+    status_.rt.wake_error_count = histogram_.count();
+    status_.rt.wake_error_sum_ns = histogram_.sum_ns();
   }
+  std::uint64_t bus_errors = 0;
+  for (const auto& binding : drivers_)
+    bus_errors += binding.driver->exchange_errors();
+  status_.rt.modbus_errors = bus_errors;
   status_.rt.wake_error_max_ns = histogram_.max_ns();
 }
 

@@ -170,6 +170,7 @@ TEST_F(ModbusDriverTest, KilledDriveLatchesAFaultAndWorksAgainOnlyAfterReset) {
   start_driver();
   servo(40, 0.1, 0.2, true);
   ASSERT_FALSE(faulted(0)) << reason();
+  EXPECT_EQ(driver_.exchange_errors(), 0u) << "a healthy bus counts no error";
   sim_.reset();  // power cut
   int periods = 0;
   while (!faulted(0) && periods < 500) {
@@ -179,6 +180,11 @@ TEST_F(ModbusDriverTest, KilledDriveLatchesAFaultAndWorksAgainOnlyAfterReset) {
   EXPECT_TRUE(feedback_[0].fault);
   EXPECT_LT(periods, 100) << "a dead drive must fault within a few update periods";
   EXPECT_NE(reason().find("slave 1"), std::string::npos) << reason();
+  // The failed request, and each failed reconnect since.
+  const std::uint64_t dead = driver_.exchange_errors();
+  EXPECT_GT(dead, 0u);
+  servo(50, 0.1, 0.2, true);
+  EXPECT_GT(driver_.exchange_errors(), dead) << "reconnects to a dead drive count too";
 
   start_sim(port);  // the drive comes back; the bus reconnects by itself
   servo(100, 0.3, 0.4, true);
@@ -275,8 +281,11 @@ TEST_F(ModbusDriverTest, ExceptionRepliesAndSilenceFault) {
   start_sim();
   start_driver();
   servo(30, 0, 0, true);
+  EXPECT_EQ(driver_.exchange_errors(), 0u);
   sim_->set_exception(true);
   EXPECT_TRUE(servo_until([&] { return feedback_[0].fault; }, 2000, 0, 0, true));
+  const std::uint64_t exceptions = driver_.exchange_errors();
+  EXPECT_GT(exceptions, 0u) << "exception replies count";
   EXPECT_NE(reason().find("Illegal data address"), std::string::npos) << reason();
   sim_->set_exception(false);
   servo(20, 0, 0, false);
@@ -286,6 +295,7 @@ TEST_F(ModbusDriverTest, ExceptionRepliesAndSilenceFault) {
   sim_->set_silent(true);
   EXPECT_TRUE(servo_until([&] { return feedback_[0].fault; }, 3000, 0, 0, true));
   EXPECT_NE(reason().find("timeout"), std::string::npos) << reason();
+  EXPECT_GT(driver_.exchange_errors(), exceptions) << "timeouts count";
 }
 
 TEST_F(ModbusDriverTest, RtuOverAPseudoTerminalPair) {

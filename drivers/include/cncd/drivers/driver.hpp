@@ -170,6 +170,9 @@ class Driver {
     if (size > 0) out[0] = '\0';
     return false;
   }
+  // RT-safe, any thread: field-bus requests that failed since enable() (timeouts, exceptions,
+  // lost links, failed connects); 0 for a driver without a bus.
+  CNCD_RT virtual std::uint64_t exchange_errors() const noexcept { return 0; }
   // Non-RT, after configure(): how long ago (ns) the command that feedback not yet stale
   // answers may have been written; 0 when feedback always answers the latest command. The
   // servo loop keeps that many periods of commands to compare late feedback with.

@@ -46,6 +46,8 @@ class ModbusDriver final : public Driver {
   CNCD_RT void read_io(IoFeedback& feedback) noexcept override;
   // RT-safe, any thread: a joint drive's reason first, else the spindle VFD's.
   CNCD_RT bool fault_reason(char* out, std::size_t size) const noexcept override;
+  // RT-safe, any thread: the failed requests and connects of all its buses.
+  CNCD_RT std::uint64_t exchange_errors() const noexcept override;
   // The stale deadline of the slowest bus plus its update period.
   std::int64_t feedback_deadline_ns() const noexcept override { return deadline_ns_; }
   std::uint32_t capabilities() const noexcept override { return kCapPositionFeedback; }

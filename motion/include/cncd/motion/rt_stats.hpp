@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "cncd/drivers/rt.hpp"
@@ -21,10 +22,18 @@ class RtHistogram {
   CNCD_RT std::int64_t quantile_ns(double q) const noexcept;
   CNCD_RT std::int64_t max_ns() const noexcept { return max_ns_; }
   std::uint64_t count() const noexcept { return count_; }
+  // Sum of the errors counted (negative ones as 0), ns.
+  std::uint64_t sum_ns() const noexcept { return sum_ns_; }
+  // Fills below[i] with the number of errors under edges_us[i] microseconds (ascending edges,
+  // each 1 to 1000 or a multiple of 100 up to 100000: the buckets' own edges). One pass.
+  CNCD_RT void count_below(const std::int32_t* edges_us, std::uint64_t* below,
+                           std::size_t n) const noexcept;
 
  private:
-  std::array<std::uint32_t, kBuckets> buckets_{};
+  // 64 bits: at a 1 kHz servo period a 32-bit bucket would wrap after 49 days.
+  std::array<std::uint64_t, kBuckets> buckets_{};
   std::uint64_t count_ = 0;
+  std::uint64_t sum_ns_ = 0;
   std::int64_t max_ns_ = 0;
 };
 

@@ -13,6 +13,10 @@ namespace cncd::motion {
 enum class MachineState : std::uint8_t { estop, off, on };
 enum class MotionState : std::uint8_t { idle, moving, pausing, paused, stopping, homing, jogging };
 
+// The edges (us) of the wake-up error histogram the status carries, as Prometheus buckets.
+inline constexpr std::array<std::int32_t, 14> kWakeEdgesUs = {
+    5, 10, 25, 50, 100, 250, 500, 1000, 2500, 5000, 10000, 25000, 50000, 100000};
+
 struct RtStats {
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;  // periods whose wake-up came later than one period
@@ -20,6 +24,14 @@ struct RtStats {
   std::int64_t wake_error_p99_ns = 0;
   std::int64_t wake_error_p999_ns = 0;
   std::int64_t wake_error_max_ns = 0;
+  // Taken with the percentiles: wake-ups that came less than kWakeEdgesUs[i] late, and the
+  // count and sum (ns) of all wake-ups then.
+  std::array<std::uint64_t, kWakeEdgesUs.size()> wake_error_below{};
+  std::uint64_t wake_error_count = 0;
+  std::uint64_t wake_error_sum_ns = 0;
+  // Field-bus (Modbus) requests that failed since the drivers started: timeouts, exceptions,
+  // lost links and failed connects.
+  std::uint64_t modbus_errors = 0;
   bool realtime = false;       // SCHED_FIFO granted
   bool memory_locked = false;  // mlockall succeeded
 };
