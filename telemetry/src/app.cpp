@@ -18,7 +18,16 @@ App::App(boost::asio::io_context& io, const config::TelemetryConfig& config,
       feed_(io, std::move(socket_path),
             {[this] { on_status(); }, [this](const json& event) { on_event(event); },
              [this] { on_jobs(); }, [this](bool) { on_status(); }}),
-      metrics_(io, [this] { return prometheus_text(feed_, counters_, config_.machine_id); }),
+      metrics_(io,
+               [this] {
+                 if (mqtt_) {
+                   counters_.mqtt = true;
+                   counters_.mqtt_connected = mqtt_->connected();
+                   counters_.mqtt_queued = mqtt_->queued();
+                   counters_.mqtt_dropped = mqtt_->dropped();
+                 }
+                 return prometheus_text(feed_, counters_, config_.machine_id);
+               }),
       shdr_(io, feed_, std::move(axes)),
       position_timer_(io) {}
 

@@ -100,6 +100,19 @@ void servo_metrics(Writer& w, const json& s, double period_s) {
     w.sample("cncd_servo_wake_error_seconds", num(rt, key) * 1e-9,
              std::string("quantile=\"") + quantile + "\"");
   }
+  // The wake-up error as a histogram: cumulative buckets that aggregate across machines and
+  // over time, which quantiles do not.
+  w.family("cncd_servo_wake_latency_seconds", "histogram",
+           "How late the servo thread wakes, since cncd started");
+  for (const auto& bucket : array_at(rt, "wake_error_below")) {
+    w.sample("cncd_servo_wake_latency_seconds_bucket", num(bucket, "count"),
+             "le=\"" + number(num(bucket, "us") * 1e-6) + "\"");
+  }
+  w.sample("cncd_servo_wake_latency_seconds_bucket", num(rt, "wake_error_count"), "le=\"+Inf\"");
+  w.sample("cncd_servo_wake_latency_seconds_sum", num(rt, "wake_error_sum_ns") * 1e-9);
+  w.sample("cncd_servo_wake_latency_seconds_count", num(rt, "wake_error_count"));
+  w.single("cncd_modbus_exchange_errors_total", "counter",
+           "Modbus requests and connects that failed since cncd started", num(rt, "modbus_errors"));
 }
 
 void joint_metrics(Writer& w, const json& s) {
@@ -132,6 +145,8 @@ void motion_metrics(Writer& w, const json& s, const MachineFeed& feed) {
     w.sample("cncd_override_ratio", num(overrides, kind), std::string("kind=\"") + kind + "\"");
   w.single("cncd_tool_number", "gauge", "The tool in the spindle",
            num(object_at(s, "tool"), "number"));
+  w.single("cncd_clients", "gauge", "Connections to cncd's control socket, this one included",
+           num(s, "clients"));
 }
 
 void job_metrics(Writer& w, const MachineFeed& feed) {
@@ -174,6 +189,16 @@ std::string prometheus_text(const MachineFeed& feed, const Counters& counters,
   for (const auto& [key, count] : counters.events) {
     w.sample("cncd_events_total", static_cast<double>(count),
              "level=\"" + escaped(key.first) + "\",kind=\"" + escaped(key.second) + "\"");
+  }
+  if (counters.mqtt) {
+    w.single("cncd_telemetry_mqtt_connected", "gauge", "1 while the MQTT broker is connected",
+             counters.mqtt_connected ? 1 : 0);
+    w.single("cncd_telemetry_mqtt_queued_messages", "gauge",
+             "Events and jobs waiting for the broker's acknowledgement",
+             static_cast<double>(counters.mqtt_queued));
+    w.single("cncd_telemetry_mqtt_dropped_total", "counter",
+             "Events and jobs dropped unsent: the queue ([TELEMETRY] EVENT_QUEUE) was full",
+             static_cast<double>(counters.mqtt_dropped));
   }
   return w.take();
 }

@@ -3,6 +3,7 @@
 // the machine's id. docs/telemetry.md lists each metric.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -15,6 +16,11 @@ namespace cncd::telemetry {
 // What the telemetry process counts itself, beside the feed.
 struct Counters {
   std::map<std::pair<std::string, std::string>, std::uint64_t> events;  // (level, kind) -> n
+  // The MQTT publisher's own state, when there is one ([TELEMETRY] MQTT_HOST).
+  bool mqtt = false;
+  bool mqtt_connected = false;
+  std::size_t mqtt_queued = 0;
+  std::uint64_t mqtt_dropped = 0;
 };
 
 std::string prometheus_text(const MachineFeed& feed, const Counters& counters,

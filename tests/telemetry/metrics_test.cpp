@@ -1,5 +1,6 @@
 // Prometheus' /metrics from the real cncd-telemetry: read by Prometheus' own text-format parser
 // (python3-prometheus-client), its counters against status.get and the job history.
+#include <cmath>
 #include <fstream>
 #include <regex>
 
@@ -90,6 +91,50 @@ TEST_F(TelemetryTest, MetricsParseAndAgreeWithTheStatusAndTheJobHistory) {
   EXPECT_GE(plotted, 10);
   // The events it has seen: both programs started and finished.
   EXPECT_GE(value_of(samples, "cncd_events_total", {{"level", "info"}, {"kind", "program"}}), 4);
+}
+
+TEST_F(TelemetryTest, TheWakeUpHistogramBusErrorsAndClientsAgreeWithTheStatus) {
+  // Two more clients: the count is this test's, cncd-telemetry's and these.
+  daemon::Client second;
+  daemon::Client third;
+  ASSERT_EQ(second.connect(daemon_.socket()), "");
+  ASSERT_EQ(third.connect(daemon_.socket()), "");
+  // Counted once the daemon has taken them in.
+  json before = status();
+  for (int i = 0; i < 500 && before["clients"] != 4; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    before = status();
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const json samples = parse(dir_, metrics());
+  const json after = status();
+  ASSERT_TRUE(samples.is_object());
+  EXPECT_EQ(before["clients"], 4);
+  EXPECT_EQ(value_of(samples, "cncd_clients"), after["clients"].get<double>());
+  // A histogram as Prometheus reads it: cumulative buckets in rising order, the last (+Inf)
+  // the count, taken between the two reads of the status.
+  EXPECT_EQ(samples["#types"]["cncd_servo_wake_latency_seconds"], "histogram");
+  const json buckets = samples.value("cncd_servo_wake_latency_seconds_bucket", json::array());
+  ASSERT_EQ(buckets.size(), before["rt"]["wake_error_below"].size() + 1);
+  double edge = 0;
+  double below = 0;
+  for (const auto& bucket : buckets) {
+    const std::string le = bucket["labels"]["le"];
+    const double next = le == "+Inf" ? HUGE_VAL : std::stod(le);
+    EXPECT_GT(next, edge) << le;
+    EXPECT_GE(bucket["value"].get<double>(), below) << le;
+    edge = next;
+    below = bucket["value"].get<double>();
+  }
+  const double count = value_of(samples, "cncd_servo_wake_latency_seconds_count");
+  EXPECT_EQ(buckets.back()["value"].get<double>(), count);
+  EXPECT_GE(count, before["rt"]["wake_error_count"].get<double>());
+  EXPECT_LE(count, after["rt"]["wake_error_count"].get<double>());
+  EXPECT_GT(count, 0);
+  EXPECT_GE(value_of(samples, "cncd_servo_wake_latency_seconds_sum"), 0);
+  // The simulated machine has no field bus: none of its requests failed.
+  EXPECT_EQ(after["rt"]["modbus_errors"], 0);
+  EXPECT_EQ(value_of(samples, "cncd_modbus_exchange_errors_total"), 0);
 }
 
 TEST_F(TelemetryTest, CncdAwayIsUpZeroAndItsReturnIsSeen) {
