@@ -2,6 +2,8 @@
 
 #include <mosquitto.h>
 
+#include <cstring>
+
 #include <spdlog/spdlog.h>
 #include <boost/asio/post.hpp>
 
@@ -61,11 +63,22 @@ std::string MqttPublisher::start() {
       if (*alive) me->on_connect(rc);
     });
   });
-  mosquitto_disconnect_callback_set(mosq_, [](mosquitto*, void* self, int) {
+  mosquitto_disconnect_callback_set(mosq_, [](mosquitto*, void* self, int rc) {
     auto* me = static_cast<MqttPublisher*>(self);
-    boost::asio::post(me->io_, [me, alive = me->alive_] {
-      if (*alive) me->on_disconnect();
+    boost::asio::post(me->io_, [me, alive = me->alive_, rc] {
+      if (*alive) me->on_disconnect(rc);
     });
+  });
+  // libmosquitto's own words on a failure (a TLS certificate it does not trust: no
+  // disconnect is reported for a handshake that failed); they name neither the broker nor the
+  // credentials.
+  mosquitto_log_callback_set(mosq_, [](mosquitto*, void* self, int level, const char* text) {
+    if ((level & MOSQ_LOG_ERR) == 0 || text == nullptr) return;
+    auto* me = static_cast<MqttPublisher*>(self);
+    boost::asio::post(me->io_,
+                      [me, alive = me->alive_, words = std::string(text, strnlen(text, 300))] {
+                        if (*alive) me->on_error(words);
+                      });
   });
   mosquitto_publish_callback_set(mosq_, [](mosquitto*, void* self, int mid) {
     auto* me = static_cast<MqttPublisher*>(self);
@@ -139,6 +152,7 @@ void MqttPublisher::on_connect(int rc) {
   }
   spdlog::info("MQTT: connected to the broker");
   connected_ = true;
+  unreachable_said_ = false;
   publish(options_.prefix + "/availability", "online", 1, true);
   if (!state_.empty()) publish(options_.prefix + "/state", state_, 1, true);
   for (auto& pending : queue_)
@@ -146,9 +160,24 @@ void MqttPublisher::on_connect(int rc) {
   send_queue();
 }
 
-void MqttPublisher::on_disconnect() {
-  if (connected_) spdlog::warn("MQTT: the broker's connection is lost; trying again");
+void MqttPublisher::on_disconnect(int rc) {
+  if (connected_) {
+    spdlog::warn("MQTT: the broker's connection is lost; trying again");
+  } else {
+    unreachable(mosquitto_strerror(rc));
+  }
   connected_ = false;
+}
+
+void MqttPublisher::on_error(const std::string& words) {
+  if (!connected_) unreachable(words);
+}
+
+void MqttPublisher::unreachable(const std::string& why) {
+  // Once an outage, not at every try.
+  if (unreachable_said_) return;
+  unreachable_said_ = true;
+  spdlog::warn("MQTT: cannot reach the broker: {}; trying again", why);
 }
 
 void MqttPublisher::on_publish(int mid) {

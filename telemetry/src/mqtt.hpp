@@ -64,7 +64,9 @@ class MqttPublisher {
   void send_queue();
   int publish(const std::string& topic, const std::string& payload, int qos, bool retain);
   void on_connect(int rc);
-  void on_disconnect();
+  void on_disconnect(int rc);
+  void on_error(const std::string& words);  // libmosquitto logged an error
+  void unreachable(const std::string& why);
   void on_publish(int mid);
 
   boost::asio::io_context& io_;
@@ -75,6 +77,7 @@ class MqttPublisher {
   std::string state_;  // the last state payload, sent again at each connection
   std::deque<Pending> queue_;
   std::uint64_t dropped_ = 0;
+  bool unreachable_said_ = false;  // logged for this outage
   // Cleared when the publisher goes: callbacks already handed to the io_context do nothing.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -35,13 +35,16 @@ class Broker {
  public:
   explicit Broker(const std::filesystem::path& dir) : dir_(dir) {}
   ~Broker() { stop(); }
+  // mosquitto.conf lines for its listener, in place of "allow_anonymous true" (a password
+  // file, TLS certificates), before the next start().
+  void settings(std::string lines) { settings_ = std::move(lines); }
   // Starts mosquitto on `port` (a free one when 0); "" or why not.
   std::string start(int port = 0) {
     for (int attempt = 0; attempt < 5; ++attempt) {
       port_ = port != 0 ? port : free_port();
       const auto conf = dir_ / "mosquitto.conf";
-      std::ofstream(conf) << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\n"
-                          << "persistence false\n";
+      std::ofstream(conf) << "listener " << port_ << " 127.0.0.1\n"
+                          << settings_ << "persistence false\n";
       process_ = std::make_unique<BackgroundCommand>(
           std::vector<std::string>{"/usr/sbin/mosquitto", "-c", conf.string()});
       for (int i = 0; i < 500; ++i) {
@@ -69,6 +72,14 @@ class Broker {
   std::filesystem::path dir_;
   std::unique_ptr<BackgroundCommand> process_;
   int port_ = 0;
+  std::string settings_ = "allow_anonymous true\n";
+};
+
+// How a Subscriber logs in: a user name and password, and a CA file for TLS.
+struct SubscriberLogin {
+  std::string username;
+  std::string password;
+  std::string tls_ca;
 };
 
 struct Message {
@@ -79,9 +90,14 @@ struct Message {
 
 class Subscriber {
  public:
-  Subscriber(int port, std::string filter) : filter_(std::move(filter)) {
+  Subscriber(int port, std::string filter, const SubscriberLogin& login = {})
+      : filter_(std::move(filter)) {
     mosquitto_lib_init();
     mosq_ = mosquitto_new(nullptr, true, this);
+    if (!login.username.empty())
+      mosquitto_username_pw_set(mosq_, login.username.c_str(), login.password.c_str());
+    if (!login.tls_ca.empty())
+      mosquitto_tls_set(mosq_, login.tls_ca.c_str(), nullptr, nullptr, nullptr, nullptr);
     mosquitto_reconnect_delay_set(mosq_, 1, 1, false);
     mosquitto_connect_callback_set(mosq_, [](mosquitto* m, void* self, int rc) {
       if (rc == 0)

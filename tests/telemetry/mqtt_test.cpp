@@ -20,10 +20,52 @@ class MqttTest : public TelemetryTest {
     start_telemetry();
   }
   // The machine's INI with cncd-telemetry publishing to a broker on `port`.
-  void configure_mqtt(int port) {
+  void configure_mqtt(int port, const std::string& more = "") {
     std::ofstream(ini_, std::ios::trunc)
         << base_ini_ << "\n[TELEMETRY]\nMACHINE_ID = mill-1\nMQTT_HOST = 127.0.0.1\n"
-        << "MQTT_PORT = " << port << "\n";
+        << "MQTT_PORT = " << port << "\n"
+        << more;
+  }
+  // cncd-telemetry started again on the INI as it is now.
+  void restart_telemetry() {
+    telemetry_.reset();
+    port_ = shdr_port_ = 0;
+    start_telemetry();
+  }
+  // The broker started again with `settings` for its listener.
+  void restart_broker(const std::string& settings) {
+    broker_.stop();
+    // mosquitto started as root reads its files as the user mosquitto.
+    namespace fs = std::filesystem;
+    fs::permissions(broker_dir_.path(), fs::perms::owner_all | fs::perms::group_read |
+                                            fs::perms::group_exec | fs::perms::others_read |
+                                            fs::perms::others_exec);
+    for (const auto& entry : fs::directory_iterator(broker_dir_.path()))
+      fs::permissions(entry.path(), fs::perms::others_read, fs::perm_options::add);
+    broker_.settings(settings);
+    ASSERT_EQ(broker_.start(), "");
+  }
+  // A certificate authority and a certificate it signs for 127.0.0.1, in the broker's folder
+  // with `name` as their prefix; "" or why not.
+  std::string make_certificates(const std::string& name) {
+    const auto at = [&](const char* suffix) {
+      return (broker_dir_.path() / (name + suffix)).string();
+    };
+    std::ofstream(at("-ext.cnf")) << "subjectAltName = IP:127.0.0.1\n";
+    for (const auto& args : std::vector<std::vector<std::string>>{
+             {"req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "2", "-subj",
+              "/CN=" + name + " CA", "-keyout", at("-ca.key"), "-out", at("-ca.crt")},
+             {"req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=127.0.0.1", "-keyout",
+              at("-server.key"), "-out", at("-server.csr")},
+             {"x509", "-req", "-days", "2", "-in", at("-server.csr"), "-CA", at("-ca.crt"),
+              "-CAkey", at("-ca.key"), "-CAcreateserial", "-extfile", at("-ext.cnf"), "-out",
+              at("-server.crt")}}) {
+      std::vector<std::string> argv{"/usr/bin/openssl"};
+      argv.insert(argv.end(), args.begin(), args.end());
+      const auto r = run_command(argv);
+      if (r.exit_status != 0) return "openssl " + args[0] + ": " + r.err;
+    }
+    return "";
   }
   // The events' seq numbers as they came, each once.
   static std::vector<std::uint64_t> event_seqs(const std::vector<Message>& messages) {
@@ -135,6 +177,97 @@ TEST_F(MqttTest, TenSecondsWithoutTheBrokerLoseNoEvent) {
   ASSERT_FALSE(seqs.empty());
   EXPECT_LE(seqs.front(), first_run);
   EXPECT_EQ(seqs.back(), events.back()["seq"].get<std::uint64_t>());
+  expect_no_gap(seqs);
+}
+
+TEST_F(MqttTest, APasswordBrokerTakesTheRightLoginAndNoSecretIsLogged) {
+  const auto passwords = broker_dir_.path() / "passwords";
+  ASSERT_EQ(run_command({"/usr/bin/mosquitto_passwd", "-b", "-c", passwords.string(), "mill",
+                         "Open-sesame-42"})
+                .exit_status,
+            0);
+  restart_broker("allow_anonymous false\npassword_file " + passwords.string() + "\n");
+  const std::string port = std::to_string(broker_.port());
+  configure_mqtt(broker_.port(), "MQTT_USERNAME = mill\nMQTT_PASSWORD = Open-sesame-42\n");
+  restart_telemetry();
+  Subscriber sub(broker_.port(), "cncd/mill-1/#", {"mill", "Open-sesame-42", ""});
+  ASSERT_TRUE(sub.got("/availability", "online"));
+  ASSERT_TRUE(sub.got("/state", "\"machine\":\"mill-1\""));
+  metrics_with("cncd_telemetry_mqtt_connected{machine=\"mill-1\"} 1");
+  std::string log = telemetry_->err_so_far();
+  // A wrong password is refused, said so, and tried again later; nothing goes out.
+  configure_mqtt(broker_.port(), "MQTT_USERNAME = mill\nMQTT_PASSWORD = Wrong-guess-17\n");
+  restart_telemetry();
+  for (int i = 0; i < 3000 && telemetry_->err_so_far().find("refused") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  log += telemetry_->err_so_far();
+  EXPECT_NE(log.find("the broker refused the connection"), std::string::npos) << log;
+  metrics_with("cncd_telemetry_mqtt_connected{machine=\"mill-1\"} 0");
+  for (const std::string& secret : {std::string("Open-sesame"), std::string("Wrong-guess"), port})
+    EXPECT_EQ(log.find(secret), std::string::npos) << secret << " is in the log:\n" << log;
+}
+
+TEST_F(MqttTest, TlsToABrokerOfTheShopsCaAndNotToAnother) {
+  ASSERT_EQ(make_certificates("shop"), "");
+  ASSERT_EQ(make_certificates("other"), "");
+  const auto file = [&](const char* name) { return (broker_dir_.path() / name).string(); };
+  restart_broker("allow_anonymous true\ncafile " + file("shop-ca.crt") + "\ncertfile " +
+                 file("shop-server.crt") + "\nkeyfile " + file("shop-server.key") + "\n");
+  configure_mqtt(broker_.port(), "MQTT_TLS_CA = " + file("shop-ca.crt") + "\n");
+  restart_telemetry();
+  Subscriber sub(broker_.port(), "cncd/mill-1/#", {"", "", file("shop-ca.crt")});
+  ASSERT_TRUE(sub.got("/availability", "online"));
+  ASSERT_TRUE(sub.got("/state", "\"machine\":\"mill-1\""));
+  // A broker whose certificate the configured CA did not sign is not talked to.
+  configure_mqtt(broker_.port(), "MQTT_TLS_CA = " + file("other-ca.crt") + "\n");
+  restart_telemetry();
+  metrics_with("cncd_telemetry_mqtt_connected{machine=\"mill-1\"} 0");
+  for (int i = 0; i < 3000 && telemetry_->err_so_far().find("cannot reach") == std::string::npos;
+       ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const std::string log = telemetry_->err_so_far();
+  EXPECT_NE(log.find("MQTT: cannot reach the broker"), std::string::npos) << log;
+  EXPECT_EQ(log.find(std::to_string(broker_.port())), std::string::npos) << log;
+  // A CA file that is not there is a configuration error named at start.
+  configure_mqtt(broker_.port(), "MQTT_TLS_CA = " + file("missing-ca.crt") + "\n");
+  const auto r = run_command({CNCD_TELEMETRY_BINARY, "--ini", ini_.string(), "--socket",
+                              daemon_.socket(), "--metrics-listen", "127.0.0.1:0"});
+  EXPECT_NE(r.exit_status, 0);
+  EXPECT_NE(r.err.find("missing-ca.crt"), std::string::npos) << r.err;
+}
+
+TEST_F(MqttTest, AFullQueueDropsTheOldestCountsThemAndKeepsTheNewest) {
+  configure_mqtt(broker_.port(), "EVENT_QUEUE = 4\n");
+  restart_telemetry();
+  {
+    Subscriber sub(broker_.port(), "cncd/mill-1/#");
+    ASSERT_TRUE(sub.got("/availability", "online"));
+  }
+  ready_machine();
+  const int port = broker_.port();
+  broker_.stop();
+  metrics_with("cncd_telemetry_mqtt_connected{machine=\"mill-1\"} 0");
+  run_part();  // more events than the queue holds
+  run_part();
+  metrics_with("cncd_telemetry_mqtt_queued_messages{machine=\"mill-1\"} 4");
+  const std::string dropped = metrics();
+  EXPECT_EQ(dropped.find("cncd_telemetry_mqtt_dropped_total{machine=\"mill-1\"} 0\n"),
+            std::string::npos)
+      << dropped;
+  EXPECT_NE(telemetry_->err_so_far().find("messages dropped unsent, the queue holding 4"),
+            std::string::npos)
+      << telemetry_->err_so_far();
+  ASSERT_EQ(broker_.start(port), "");
+  Subscriber sub(port, "cncd/mill-1/#");
+  ASSERT_TRUE(sub.subscribed());
+  ASSERT_TRUE(sub.got("/job", "\"result\":\"done\"", 90));
+  metrics_with("cncd_telemetry_mqtt_queued_messages{machine=\"mill-1\"} 0");
+  // The newest came, in order; the oldest are gone.
+  const auto seqs = event_seqs(sub.messages());
+  const json events = result_of(call("errors.list"))["events"];
+  ASSERT_FALSE(seqs.empty());
+  EXPECT_EQ(seqs.back(), events.back()["seq"].get<std::uint64_t>());
+  EXPECT_LE(seqs.size(), 4u);
   expect_no_gap(seqs);
 }
 
