@@ -2,7 +2,8 @@
 """The page in a real headless Chromium, against the real cncd on the simulated mill and the
 real cncd-web: a setter (an operator who may also upload) logs in, resets, turns the machine
 on, homes, takes the lease, uploads and opens the G81 example, sees its preview drawn, runs it
-watching the DRO and progress move, ends at X4 Y5 Z3, pauses and resumes a second run, jogs X
+watching the DRO and progress move, ends at X4 Y5 Z3, pauses and resumes a second run, finds
+both runs on the Jobs tab, jogs X
 by press and hold, sees a bad MDI line's error in the log, and saves screenshots at 1024x600
 and 1920x1080 into the build tree.
 
@@ -165,6 +166,21 @@ def paused_run(m, browser):
     print(f"run 2: paused at Z {z:.4f}, resumed, ended at {work_xyz(done)}")
 
 
+def job_history(m, browser):
+    """The Jobs tab lists both runs, newest first, as the daemon's job history has them."""
+    history = m.rpc.call("jobs.history", {"limit": 10})["jobs"]
+    assert [j["result"] for j in history[:2]] == ["done", "done"], history
+    browser.tab("jobs")
+    browser.wait(lambda: len(browser.find_all("#job-rows tr.job-done")) >= 2,
+                 "both runs listed as done on the Jobs tab")
+    rows = browser.find_all("#job-rows tr")
+    assert rows[0].get_attribute("data-job") == str(history[0]["id"]), "the newest run first"
+    assert PROGRAM in rows[0].text and USER in rows[0].text, rows[0].text
+    browser.wait(lambda: re.search(r"\b2 done\b", browser.text("#jobs-stats")),
+                 "the sums say two runs done")
+    print(f"jobs tab: {len(rows)} runs listed, {browser.text('#jobs-stats')}")
+
+
 def jog_hold(m, browser):
     set_range(browser, "#override-feed", 1 / 1.5)
     set_range(browser, "#override-rapid", 1.0)
@@ -229,6 +245,17 @@ def screenshots(browser, out_dir):
             assert box[4] > 0 and box[0] >= 0 and box[1] >= 0 and box[2] <= width + 1 and \
                 box[3] <= height + 1, f"{css} not fully on screen at {width}x{height}: {box}"
         print(f"screenshot {path}: {colours}+ colours")
+    # The Jobs tab at the tablet's size: its table fits the width.
+    browser.set_viewport(1024, 600)
+    browser.tab("jobs")
+    path = os.path.join(out_dir, "web-jobs-1024x600.png")
+    browser.screenshot(path)
+    overflow = browser.driver.execute_script(
+        "const t = document.getElementById('job-table');"
+        "return t.getBoundingClientRect().right - window.innerWidth;")
+    assert overflow <= 1, f"the job table runs {overflow} px past the screen's right"
+    print(f"screenshot {path}")
+    browser.tab("preview")
 
 
 def docs_screenshot(browser, out_dir):
@@ -265,6 +292,7 @@ def main():
         docs_screenshot(browser, args.out_dir)
         first_run(m, browser)
         paused_run(m, browser)
+        job_history(m, browser)
         jog_hold(m, browser)
         bad_mdi(browser)
         screenshots(browser, args.out_dir)

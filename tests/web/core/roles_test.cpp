@@ -10,10 +10,10 @@
 namespace cncd::web {
 namespace {
 
-const std::vector<std::string> kObserver{"status.get",  "status.subscribe", "status.unsubscribe",
-                                         "errors.list", "system.info",      "tool.list",
-                                         "offsets.get", "program.preview",  "web.session",
-                                         "lease.get",   "files.list",       "machine.estop"};
+const std::vector<std::string> kObserver{
+    "status.get",  "status.subscribe", "status.unsubscribe", "errors.list",  "system.info",
+    "tool.list",   "offsets.get",      "jobs.history",       "jobs.stats",   "program.preview",
+    "web.session", "lease.get",        "files.list",         "machine.estop"};
 const std::vector<std::string> kOperator{
     "machine.reset", "machine.on",    "machine.off",    "machine.home",     "jog.start",
     "jog.stop",      "jog.increment", "jog.heartbeat",  "program.open",     "files.open",

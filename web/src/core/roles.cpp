@@ -21,6 +21,8 @@ constexpr std::array kRules{
     MethodRule{"system.info", Role::observer},
     MethodRule{"tool.list", Role::observer},
     MethodRule{"offsets.get", Role::observer},
+    MethodRule{"jobs.history", Role::observer},
+    MethodRule{"jobs.stats", Role::observer},
     MethodRule{"program.preview", Role::observer},
     MethodRule{"web.session", Role::observer},
     MethodRule{"lease.get", Role::observer},

@@ -7,6 +7,7 @@ import {setupDiag} from './diag.js';
 import {setupDro} from './dro.js';
 import {setupFiles} from './files.js';
 import {setupHeader} from './header.js';
+import {setupJobs} from './jobs.js';
 import {setupJog} from './jog.js';
 import {EventLog} from './log.js';
 import {setupMdi} from './mdi.js';
@@ -157,6 +158,7 @@ function main() {
   setupMdi(ctx);
   setupFiles(ctx);
   setupTables(ctx);
+  setupJobs(ctx);
   setupDiag(ctx);
   ctx.rpc.on('status.update', (update) => ctx.store.apply(update));
   ctx.rpc.on('lease.changed', (lease) => ctx.setLease(lease ?? null));

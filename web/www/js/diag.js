@@ -1,18 +1,19 @@
-// Diagnostics: servo-thread statistics (cycles, overruns, wake-up latency percentiles), each
-// joint's drive and switches, and homing one joint at a time.
+// Diagnostics: servo-thread statistics (cycles, overruns, wake-up latency percentiles), failed
+// Modbus requests, the daemon's client connections, each joint's drive and switches, and
+// homing one joint at a time.
 
 import {$, applyGate, el, setText} from './ui.js';
 
 export function setupDiag(ctx) {
   ctx.store.subscribe((status) => {
-    showServo(status.rt);
+    showServo(status.rt, status.clients);
     showDrives(ctx, status);
   });
 }
 
 const us = (ns) => (typeof ns === 'number' ? `${(ns / 1000).toFixed(1)} µs` : '—');
 
-function showServo(rt) {
+function showServo(rt, clients) {
   const box = $('#servo-stats');
   if (!rt) return;
   const rows = [
@@ -24,6 +25,8 @@ function showServo(rt) {
     ['wake-up max', us(rt.wake_error_max_ns)],
     ['real-time priority', rt.realtime ? 'yes' : 'no'],
     ['memory locked', rt.memory_locked ? 'yes' : 'no'],
+    ['Modbus errors', String(rt.modbus_errors ?? '—')],
+    ['clients of cncd', String(clients ?? '—')],
   ];
   if (box.children.length !== rows.length) {
     box.replaceChildren(...rows.map(
