@@ -4,12 +4,18 @@
 //   flood      64 read-only clients, each keeping two batches of 256 status.get in flight
 //   subscribe  300 read-only clients subscribed to the whole status every 10 ms
 //   open       a control client opening a program of LINES lines over and over
+//   stalled-broker  cncd-telemetry publishing to an MQTT "broker" that takes the connection
+//              and never answers
 // The read-only clients run in a child process as uid nobody in the group "users", made the
 // daemon's READ_GROUP; without root (or that group) they run as the bench's own user, which
-// has control access, and the table says so. Prints figures; never fails on timing.
+// has control access, and the table says so. Each row also counts the servo overruns during its
+// tries. Prints figures; never fails on timing.
 //
-//   cncd_stop_load_bench [TRIES=200] [LINES=10000000] [LOADS=flood,subscribe,open]
+//   cncd_stop_load_bench [TRIES=200] [LINES=10000000]
+//                        [LOADS=flood,subscribe,open,stalled-broker]
+#include <arpa/inet.h>
 #include <grp.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/wait.h>
 
@@ -124,18 +130,59 @@ void open_again(const std::string& sock, const std::string& program) {
   }
 }
 
+// A loopback port that takes connections and never answers: nobody accepts, the kernel
+// completes the TCP handshake. Its socket stays open (and is inherited) for the whole run.
+int silent_port() {
+  const int silent = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t size = sizeof addr;
+  if (bind(silent, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
+      listen(silent, 16) != 0 ||
+      getsockname(silent, reinterpret_cast<sockaddr*>(&addr), &size) != 0)
+    return -1;
+  return ntohs(addr.sin_port);
+}
+
+// cncd-telemetry, as this process, publishing to the broker `ini` names.
+void telemetry(const std::string& sock, const std::string& ini) {
+  std::vector<std::string> args{
+      CNCD_TELEMETRY_BINARY, "--ini",         ini,          "--socket", sock, "--metrics-listen",
+      "127.0.0.1:0",         "--shdr-listen", "127.0.0.1:0"};
+  std::vector<char*> argv;
+  for (auto& arg : args)
+    argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  execv(argv[0], argv.data());
+  _exit(127);
+}
+
 struct Row {
   std::string load;
   std::vector<double> jog_stop_ms;
   std::vector<double> estop_ms;
   int not_stopped = 0;
+  long overruns = 0;
+  long clients = 0;
 };
+
+// A number of status.get's answer: `key` is `"overruns":` (in rt) or `"clients":`.
+long status_number(Conn& c, const std::string& key) {
+  const std::string answer = answer_to(c, request("status.get", R"({"fields":["rt","clients"]})"));
+  const auto at = answer.find(key);
+  return at == std::string::npos ? -1 : std::atol(answer.c_str() + at + key.size());
+}
+long overruns(Conn& c) {
+  return status_number(c, "\"overruns\":");
+}
 
 // Each try: jog X, stop the jog and wait for rest; jog again, estop, check the machine is in
 // estop and at rest.
 Row run_tries(Conn& control, const std::string& load, int tries) {
-  Row row{load, {}, {}, 0};
+  Row row{load, {}, {}, 0, 0, status_number(control, "\"clients\":")};
   std::string answer;
+  const long overruns_before = overruns(control);
   for (int i = 0; i < tries; ++i) {
     const std::string velocity = i % 2 == 0 ? "20" : "-20";
     const std::string jog = request("jog.start", "{\"axis\":\"X\",\"velocity\":" + velocity + "}");
@@ -154,6 +201,7 @@ Row run_tries(Conn& control, const std::string& load, int tries) {
         !reaches(control, R"({"fields":["state","motion"]})", R"("motion":"idle","state":"estop")"))
       ++row.not_stopped;
   }
+  row.overruns = overruns(control) - overruns_before;
   return row;
 }
 
@@ -162,7 +210,7 @@ Row run_tries(Conn& control, const std::string& load, int tries) {
 int main(int argc, char** argv) {
   const int tries = argc > 1 ? std::atoi(argv[1]) : 200;
   const long lines = argc > 2 ? std::atol(argv[2]) : 10'000'000;
-  const std::string loads = argc > 3 ? argv[3] : "flood,subscribe,open";
+  const std::string loads = argc > 3 ? argv[3] : "flood,subscribe,open,stalled-broker";
   namespace fs = std::filesystem;
   const fs::path dir = bench_dir({".var", ".tbl"});
   fs::permissions(dir, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
@@ -177,6 +225,12 @@ int main(int argc, char** argv) {
   std::ofstream(dir / "sim_mm.ini") << ini;
   const fs::path program = dir / "big.ngc";
   if (loads.find("open") != std::string::npos) write_program(program, lines);
+  if (loads.find("stalled-broker") != std::string::npos) {
+    std::ofstream(dir / "telemetry.ini")
+        << ini
+        << "\n[TELEMETRY]\nMACHINE_ID = bench\nMQTT_HOST = 127.0.0.1\nMQTT_PORT = " << silent_port()
+        << "\n";
+  }
   const std::string sock = (dir / "cncd.sock").string();
   daemon_pid = start_cncd(dir, sock, {"--state-dir", dir.string(), "--log-level", "warn"});
   std::atexit(end_children);
@@ -196,6 +250,7 @@ int main(int argc, char** argv) {
       if (load == "flood") flood(sock);
       if (load == "subscribe") subscribe(sock);
       if (load == "open") open_again(sock, program.string());
+      if (load == "stalled-broker") telemetry(sock, (dir / "telemetry.ini").string());
       _exit(0);
     }
     close(ready[1]);
@@ -217,12 +272,15 @@ int main(int argc, char** argv) {
   std::printf("tries=%d per load; program %ld lines; readers %s\n", tries, lines,
               readers_read_only ? "read-only (uid nobody, group users)"
                                 : "run as this user (control access): not root or no group users");
-  std::printf("%-10s %12s %12s %12s %12s %12s\n", "load", "jog.stop p50", "jog.stop p99",
-              "estop p50", "estop p99", "not stopped");
+  std::printf("%-14s %12s %12s %12s %12s %12s %9s %14s\n", "load", "jog.stop p50", "jog.stop p99",
+              "estop p50", "estop p99", "not stopped", "overruns", "estop p99/none");
+  const double reference = percentile(rows.front().estop_ms, 0.99);
   for (const auto& row : rows) {
-    std::printf("%-10s %9.2f ms %9.2f ms %9.2f ms %9.2f ms %12d\n", row.load.c_str(),
-                percentile(row.jog_stop_ms, 0.5), percentile(row.jog_stop_ms, 0.99),
-                percentile(row.estop_ms, 0.5), percentile(row.estop_ms, 0.99), row.not_stopped);
+    std::printf("%-14s %9.2f ms %9.2f ms %9.2f ms %9.2f ms %12d %9ld %8ld %14.2f\n",
+                row.load.c_str(), percentile(row.jog_stop_ms, 0.5),
+                percentile(row.jog_stop_ms, 0.99), percentile(row.estop_ms, 0.5),
+                percentile(row.estop_ms, 0.99), row.not_stopped, row.overruns, row.clients,
+                percentile(row.estop_ms, 0.99) / reference);
   }
   return 0;
 }
