@@ -55,6 +55,13 @@ bool ProgramFeeder::drop_pending_before(int line, motion::AxisPose& end) {
   return moved;
 }
 
+bool ProgramFeeder::moves_from(int line) const {
+  return std::any_of(pending_.begin(), pending_.end(), [line](const motion::Move& move) {
+    return move.line >= line && move.kind != motion::Move::Kind::dwell &&
+           move.kind != motion::Move::Kind::action;
+  });
+}
+
 void ProgramFeeder::queue_tool_change(int number, int line, int before) {
   tool_ = number;
   const config::ToolChangeConfig* change = machine_ ? &machine_->tool_change : nullptr;
@@ -98,7 +105,7 @@ void ProgramFeeder::change_tool_first(int number, int line, const motion::AxisPo
 
 std::optional<std::string> ProgramFeeder::approach_first(const motion::AxisPose& from,
                                                          const motion::AxisPose& to, double safe_z,
-                                                         int line) {
+                                                         int line, std::optional<double> feed) {
   approach_moves_ = 0;
   if (from == to) return std::nullopt;  // already there
   constexpr std::size_t kZ = 2;
@@ -120,13 +127,13 @@ std::optional<std::string> ProgramFeeder::approach_first(const motion::AxisPose&
   over[kZ] = high;
   if (over != up) add(motion::Move::Kind::traverse, over);
   if (to != over) {
-    const double feed = feed_per_second();
-    if (!(feed > 0)) {
+    const double down = feed.value_or(feed_per_second());
+    if (!(down > 0)) {
       return "no feed is in force to move Z down to the line's start: set F on a line before "
              "it";
     }
     add(motion::Move::Kind::feed, to);
-    way.back().feed = feed;
+    way.back().feed = down;
   }
   pending_.insert(pending_.begin(), way.begin(), way.end());
   approach_moves_ = static_cast<int>(way.size());

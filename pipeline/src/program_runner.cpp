@@ -21,6 +21,7 @@ void ProgramRunner::start(const motion::AxisPose* at, bool mdi, int tool) {
   skip_to_ = 0;
   lead_in_ = 0;
   skip_moved_ = false;
+  skip_feed_.reset();
   sink_.shuttled = false;
   sink_.end_code = 0;
 }
@@ -31,6 +32,7 @@ void ProgramRunner::skip_to(int line, const motion::AxisPose& at, int tool_in_sp
   skip_to_ = line > 1 ? line : 0;
   lead_in_ = 0;
   skip_moved_ = false;
+  skip_feed_.reset();
   skip_from_ = at;
   skip_end_ = at;
   tool_at_start_ = tool_in_spindle;
@@ -131,20 +133,19 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_end
                      "line that calls it or from one the program runs",
                  {}});
   }
-  // Under G41/G42 the interpreter holds the last move back until it knows the next one: the
-  // compensated point the run would start from is not there to approach.
-  if (const int comp = interp_.state().gcodes[4]; comp > 400) {
-    return fail({Error::Kind::approach,
-                 skip_to_,
-                 "line " + std::to_string(skip_to_) + " runs under cutter compensation (G" +
-                     std::to_string(comp / 10) + (comp % 10 != 0 ? ".1" : "") +
-                     "): run from a line before its G41/G42 or after its G40",
-                 {}});
+  // Under G41/G42 the interpreter holds each move back until it has read the next: the move
+  // the line starts from (the one before it, ending at the compensated corner) comes out with
+  // a later block. The lines before keep being skipped until a move of the line or a later one
+  // is out; the way then leads to where the compensated path left off.
+  if (!skip_feed_) skip_feed_ = feeder_.feed_in_force();
+  if (interp_.state().gcodes[4] > 400 && !program_ended && !feeder_.moves_from(skip_to_)) {
+    if (feeder_.drop_pending_before(skip_to_, skip_end_)) skip_moved_ = true;
+    return std::nullopt;
   }
   if (feeder_.drop_pending_before(skip_to_, skip_end_)) skip_moved_ = true;
   const std::size_t own = feeder_.pending_count();
   if (skip_moved_) {
-    if (auto why = feeder_.approach_first(skip_from_, skip_end_, safe_z_, line))
+    if (auto why = feeder_.approach_first(skip_from_, skip_end_, safe_z_, line, skip_feed_))
       return fail({Error::Kind::approach, line, std::move(*why), {}});
   }
   // The spindle and coolant as the skipped lines left them, before the machine moves there.

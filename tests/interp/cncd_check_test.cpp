@@ -303,19 +303,48 @@ TEST_F(CncdCheckTest, FromLinePrintsTheRebuiltStateAndTheWayToTheLine) {
   EXPECT_EQ(check(program, {"--canon", "--from-line", "3"}).exit_status, 2);
 }
 
-// Under G41/G42 the move the line starts from is held back until the next block: a run from
-// such a line is refused; from the G40 line it starts where the compensated path left off and
-// cuts no line before it again.
-TEST_F(CncdCheckTest, FromLineUnderCutterCompensationIsRefusedAndFromItsG40StartsRight) {
+// Under G41/G42 the move a line starts from is held back until the next block: the run reads
+// on until the line's own move is out, and starts where the compensated path reaches the line,
+// also after an arc, from a line without motion, and from one the program ends after. From the
+// G40 line it starts where the compensated path left off and cuts no line before it again.
+TEST_F(CncdCheckTest, FromALineUnderCutterCompensationStartsAtTheCompensatedPoint) {
   const std::string program =
       "G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\nG1 X10 Y10\nG1 X0 Y10\n"
       "G1 X0 Y0\nG40 G1 X-5 Y-5\nG0 Z5\nM2\n";
   const auto inside = check(program, {"--ini", ini_.string(), "--from-line", "6"});
-  EXPECT_EQ(inside.exit_status, 1);
-  EXPECT_NE(inside.err.find("prog.ngc:6: line 6 runs under cutter compensation (G41): run from "
-                            "a line before its G41/G42 or after its G40"),
+  EXPECT_EQ(inside.exit_status, 0) << inside.err;
+  // Line 5 (on X9, the tool's radius inside) ends at the corner X9 Y9; line 5 is not cut
+  // again: the path checked stays at Y9 and below X9 from there.
+  EXPECT_NE(inside.out.find("    rapid to X9.0000 Y9.0000 Z50.0000\n"
+                            "    feed to X9.0000 Y9.0000 Z-1.0000 at 600.0000 mm/min\n"),
             std::string::npos)
-      << inside.err;
+      << inside.out;
+  EXPECT_NE(inside.out.find("  X -5.0000 .. 9.0000\n  Y -5.0000 .. 9.0000\n"), std::string::npos)
+      << inside.out;
+  EXPECT_NE(inside.out.find("  modal: G1 G17 G41"), std::string::npos) << inside.out;
+  // An arc before the line: its compensated end (radius 5 - 1 about X10 Y5) is the start.
+  const auto arc = check(
+      "G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\nG3 X10 Y10 R5\nG1 X0 Y10\n"
+      "G40 G1 X-5 Y-5\nM2\n",
+      {"--ini", ini_.string(), "--from-line", "6"});
+  EXPECT_EQ(arc.exit_status, 0) << arc.err;
+  EXPECT_NE(arc.out.find("    rapid to X10.0000 Y9.0000 Z50.0000\n"), std::string::npos) << arc.out;
+  // A line without motion: the next move starts where line 5 ended.
+  const auto message = check(
+      "G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\nG1 X10 Y10\n(MSG, here)\n"
+      "G1 X0 Y10\nG40 G1 X-5 Y-5\nM2\n",
+      {"--ini", ini_.string(), "--from-line", "6"});
+  EXPECT_EQ(message.exit_status, 0) << message.err;
+  EXPECT_NE(message.out.find("    rapid to X9.0000 Y9.0000 Z50.0000\n"), std::string::npos)
+      << message.out;
+  // The program ends (M2) right after the line, compensation still on: down at the F in force.
+  const auto ends =
+      check("G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\nG1 X10 Y10\nG1 X0 Y10\nM2\n",
+            {"--ini", ini_.string(), "--from-line", "6"});
+  EXPECT_EQ(ends.exit_status, 0) << ends.err;
+  EXPECT_NE(ends.out.find("    feed to X9.0000 Y9.0000 Z-1.0000 at 600.0000 mm/min\n"),
+            std::string::npos)
+      << ends.out;
   const auto exit_line = check(program, {"--ini", ini_.string(), "--from-line", "8"});
   EXPECT_EQ(exit_line.exit_status, 0) << exit_line.err;
   // Line 7's compensated move ends at X1 Y0 (the tool's radius inside the corner): over there,

@@ -84,9 +84,13 @@ class ProgramFeeder final : public interp::CanonSink {
   // Run from line: the way from `from`, where the machine stands, to `to`, where the lines
   // skipped leave the tool, in front of the pending moves: Z up to `safe_z` (it stays where it
   // is when higher), the other axes over `to` at rapid, then Z down to `to` at the feed in
-  // force. An error (nothing queued) when the way down has no feed in force.
+  // force (or `feed`, units per second, when given). An error (nothing queued) when the way
+  // down has no feed.
   std::optional<std::string> approach_first(const motion::AxisPose& from,
-                                            const motion::AxisPose& to, double safe_z, int line);
+                                            const motion::AxisPose& to, double safe_z, int line,
+                                            std::optional<double> feed = std::nullopt);
+  // The feed of the next feed move, machine units per second.
+  double feed_in_force() const { return feed_per_second(); }
   // The moves approach_first() queued (0 to 3).
   int approach_moves() const { return approach_moves_; }
   // Whether `move` is a stop point (a zero dwell, G4 P0 included): nothing to execute, the
@@ -114,6 +118,8 @@ class ProgramFeeder final : public interp::CanonSink {
   // The same for the pending moves at the front that come from lines before `line` (moves
   // cutter compensation held back until the line's block was read).
   bool drop_pending_before(int line, motion::AxisPose& end);
+  // Whether a pending move (not a dwell or an action) comes from `line` or a later one.
+  bool moves_from(int line) const;
 
   // What the stream has reached since the flag was last taken: M0/M1/M60 (a stop), M66 (the
   // interpreter must not read on until the machine has waited and its result is in #5399) and

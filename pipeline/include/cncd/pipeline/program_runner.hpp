@@ -154,6 +154,8 @@ class ProgramRunner {
   int skip_to_ = 0;
   bool skip_moved_ = false;
   motion::AxisPose skip_end_{};
+  // The feed in force when the line was read (cutter compensation reads on past it).
+  std::optional<double> skip_feed_;
   motion::AxisPose skip_from_{};
   int tool_at_start_ = 0;
   double safe_z_ = 0;
