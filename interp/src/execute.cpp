@@ -10,12 +10,15 @@
 
 namespace cncd::interp {
 
+// The Numeryx dialect checks its own codes and has its own modes and motion; the rest of the
+// order is LinuxCNC's.
 void Interpreter::Impl::execute_block() {
-  if (dialect_ == Dialect::numeryx) {
-    execute_numeryx_block();
-    return;
+  const bool numeryx = dialect_ == Dialect::numeryx;
+  if (numeryx) {
+    check_numeryx_block();
+  } else {
+    check_block();
   }
-  check_block();
   do_comment();
   do_spindle_mode();
   do_feed_mode();
@@ -23,12 +26,20 @@ void Interpreter::Impl::execute_block() {
   do_coolant_and_overrides();
   do_user_m_code();
   do_dwell();
-  do_modes();
+  if (numeryx) {
+    numeryx_modes();
+  } else {
+    do_modes();
+  }
   do_non_modal();
-  do_motion();
-  // G5.3 ends the G5.2 motion mode unless its line starts another curve.
-  if (block_.g_code(GGroup::non_modal) == 53 && block_.g_code(GGroup::motion) < 0) {
-    modal_.motion = 800;
+  if (numeryx) {
+    numeryx_motion();
+  } else {
+    do_motion();
+    // G5.3 ends the G5.2 motion mode unless its line starts another curve.
+    if (block_.g_code(GGroup::non_modal) == 53 && block_.g_code(GGroup::motion) < 0) {
+      modal_.motion = 800;
+    }
   }
   do_stop();
 }

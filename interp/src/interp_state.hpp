@@ -211,7 +211,6 @@ struct Interpreter::Impl {
   void check_supported_codes() const;
 
   // numeryx.cpp: the Numeryx dialect's blocks, cycles and loops.
-  void execute_numeryx_block();
   void check_numeryx_block() const;
   void numeryx_modes();
   void numeryx_motion();

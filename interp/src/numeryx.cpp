@@ -40,21 +40,6 @@ std::string no_progress(int var, double step, double value, double end) {
 
 }  // namespace
 
-void Interpreter::Impl::execute_numeryx_block() {
-  check_numeryx_block();
-  do_comment();
-  do_spindle_mode();
-  do_feed_mode();
-  do_tool_and_spindle();
-  do_coolant_and_overrides();
-  do_user_m_code();
-  do_dwell();
-  numeryx_modes();
-  do_non_modal();
-  numeryx_motion();
-  do_stop();
-}
-
 void Interpreter::Impl::check_numeryx_block() const {
   const Block& b = block_;
   check_supported_codes();
