@@ -10,6 +10,21 @@
 
 namespace cncd::interp {
 
+namespace {
+
+// G90/G91 (`absolute_code` 900) or G90.1/G91.1 (901): sets `incremental` and returns the
+// comment LinuxCNC makes of a change; "" when the block keeps the mode in force.
+std::string distance_mode_change(int code, int absolute_code, bool& incremental,
+                                 std::string_view what) {
+  const bool to_incremental = code == absolute_code + 10;
+  if ((code != absolute_code && !to_incremental) || incremental == to_incremental) return "";
+  incremental = to_incremental;
+  return "interpreter: " + std::string(what) + " mode changed to " +
+         (to_incremental ? "incremental" : "absolute");
+}
+
+}  // namespace
+
 // The Numeryx dialect checks its own codes and has its own modes and motion; the rest of the
 // order is LinuxCNC's.
 void Interpreter::Impl::execute_block() {
@@ -289,22 +304,14 @@ void Interpreter::Impl::do_modes() {
     emit(SetMotionControlMode{modal_.control, modal_.tolerance});
     if (path == 640) emit(SetNaivecamTolerance{modal_.naive_tolerance});
   }
-  const int distance = block_.g_code(GGroup::distance);
-  if (distance == 900 && modal_.incremental) {
-    modal_.incremental = false;
-    emit_comment("interpreter: distance mode changed to absolute");
-  } else if (distance == 910 && !modal_.incremental) {
-    modal_.incremental = true;
-    emit_comment("interpreter: distance mode changed to incremental");
-  }
-  const int arc_distance = block_.g_code(GGroup::arc_distance);
-  if (arc_distance == 901 && modal_.arc_incremental) {
-    modal_.arc_incremental = false;
-    emit_comment("interpreter: IJK distance mode changed to absolute");
-  } else if (arc_distance == 911 && !modal_.arc_incremental) {
-    modal_.arc_incremental = true;
-    emit_comment("interpreter: IJK distance mode changed to incremental");
-  }
+  const auto distance = block_.g_code(GGroup::distance);
+  if (auto note = distance_mode_change(distance, 900, modal_.incremental, "distance");
+      !note.empty())
+    emit_comment(note);
+  const auto arc_distance = block_.g_code(GGroup::arc_distance);
+  if (auto note = distance_mode_change(arc_distance, 901, modal_.arc_incremental, "IJK distance");
+      !note.empty())
+    emit_comment(note);
   const int retract = block_.g_code(GGroup::retract);
   if (retract >= 0 && comp_.on()) {
     fail("Cannot change retract mode with cutter radius compensation on");
