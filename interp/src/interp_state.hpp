@@ -203,6 +203,7 @@ struct Interpreter::Impl {
   // The dialect the first line names ("(dialect numeryx)"), else the machine's; the source is
   // read again from its start afterwards. Failure for a name that is no dialect.
   void detect_dialect();
+  std::optional<InterpError> start_program(LineSource source);  // the file's or the text's
   InterpError make_error(const Failure& failure) const;
 
   // execute.cpp: one block in LinuxCNC's order of execution.

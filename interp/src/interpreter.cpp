@@ -254,6 +254,21 @@ void Interpreter::set_machine_position(const Pose& machine) {
   impl_->sync_standalone();
 }
 
+// A program, from a file or a text, runs from its first line in the modal state it starts
+// with, in the dialect it names.
+std::optional<InterpError> Interpreter::Impl::start_program(LineSource source) {
+  sources_.push_back(std::move(source));
+  if (error_) return error_;
+  reset_modal_state();
+  try {
+    detect_dialect();
+  } catch (const Failure& failure) {
+    error_ = make_error(failure);
+    return error_;
+  }
+  return std::nullopt;
+}
+
 std::optional<InterpError> Interpreter::open(const std::filesystem::path& program,
                                              std::shared_ptr<const SubroutineIndex> index) {
   impl_->mdi_ = false;
@@ -270,16 +285,7 @@ std::optional<InterpError> Interpreter::open(const std::filesystem::path& progra
     impl_->error_ = InterpError{program.string(), 0, 0, "Unable to open file: " + why};
     return impl_->error_;
   }
-  impl_->sources_.push_back(std::move(source));
-  if (impl_->error_) return impl_->error_;
-  impl_->reset_modal_state();
-  try {
-    impl_->detect_dialect();
-  } catch (const Failure& failure) {
-    impl_->error_ = impl_->make_error(failure);
-    return impl_->error_;
-  }
-  return std::nullopt;
+  return impl_->start_program(std::move(source));
 }
 
 std::optional<InterpError> Interpreter::open_mdi(std::string line) {
@@ -314,16 +320,7 @@ std::optional<InterpError> Interpreter::open_string(std::string text, std::strin
   impl_->program_name_ = name;
   LineSource source;
   source.open_text(std::move(text), std::move(name));
-  impl_->sources_.push_back(std::move(source));
-  if (impl_->error_) return impl_->error_;
-  impl_->reset_modal_state();
-  try {
-    impl_->detect_dialect();
-  } catch (const Failure& failure) {
-    impl_->error_ = impl_->make_error(failure);
-    return impl_->error_;
-  }
-  return std::nullopt;
+  return impl_->start_program(std::move(source));
 }
 
 Interpreter::Step Interpreter::step(CanonSink& sink) {
