@@ -13,7 +13,7 @@
 namespace cncd::interp {
 namespace {
 
-struct PlaneAxes {
+struct ArcPlane {
   std::size_t first;
   std::size_t second;
   std::size_t normal;
@@ -23,7 +23,7 @@ struct PlaneAxes {
   const char* name;
 };
 
-PlaneAxes plane_axes(Plane plane) {
+ArcPlane arc_plane(Plane plane) {
   switch (plane) {
     case Plane::xz:
       return {kZ, kX, kY, 'k', 'i', 'j', "xz"};
@@ -57,7 +57,7 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
   if (modal_.plane == Plane::uv || modal_.plane == Plane::vw || modal_.plane == Plane::uw) {
     fail("Cannot do an arc in planes G17.1, G18.1, or G19.1");
   }
-  const PlaneAxes axes = plane_axes(modal_.plane);
+  const ArcPlane axes = arc_plane(modal_.plane);
   const bool radius_format = block_.has('r');
   const bool has_offsets = block_.has(axes.first_offset) || block_.has(axes.second_offset);
 
@@ -110,7 +110,7 @@ void Interpreter::Impl::arc(bool clockwise, const Pose& end) {
 // Inverse time: the rate that makes the arc from `start` around `center` take 1/F minutes.
 void Interpreter::Impl::arc_feed_rate(bool clockwise, int turns, const Pose& start,
                                       PlanePoint center, const Pose& end) {
-  const PlaneAxes axes = plane_axes(modal_.plane);
+  const ArcPlane axes = arc_plane(modal_.plane);
   const double start1 = start[axes.first];
   const double start2 = start[axes.second];
   const double radius = std::hypot(start1 - center.a, start2 - center.b);
@@ -126,7 +126,7 @@ void Interpreter::Impl::arc_feed_rate(bool clockwise, int turns, const Pose& sta
 // words give, with LinuxCNC's checks and messages.
 void Interpreter::Impl::arc_center(bool clockwise, PlanePoint start, PlanePoint end,
                                    double& center1, double& center2) const {
-  const PlaneAxes axes = plane_axes(modal_.plane);
+  const ArcPlane axes = arc_plane(modal_.plane);
   const double start1 = start.a;
   const double start2 = start.b;
   const double end1 = end.a;

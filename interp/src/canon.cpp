@@ -3,15 +3,8 @@
 #include <cmath>
 
 namespace cncd::interp {
-namespace {
 
-struct ArcAxes {
-  std::size_t first;
-  std::size_t second;
-  std::size_t normal;
-};
-
-ArcAxes arc_axes(Plane plane) {
+PlaneAxes plane_axes(Plane plane) {
   switch (plane) {
     case Plane::xz:
       return {2, 0, 1};
@@ -29,10 +22,8 @@ ArcAxes arc_axes(Plane plane) {
   }
 }
 
-}  // namespace
-
 Pose ArcFeed::end() const {
-  const ArcAxes axes = arc_axes(plane);
+  const PlaneAxes axes = plane_axes(plane);
   Pose pose{};
   pose[axes.first] = first_end;
   pose[axes.second] = second_end;
@@ -43,7 +34,7 @@ Pose ArcFeed::end() const {
 }
 
 Pose ArcFeed::center() const {
-  const ArcAxes axes = arc_axes(plane);
+  const PlaneAxes axes = plane_axes(plane);
   Pose pose = end();
   pose[axes.first] = first_axis;
   pose[axes.second] = second_axis;
@@ -51,7 +42,7 @@ Pose ArcFeed::center() const {
 }
 
 void ArcFeed::set_end(const Pose& end) {
-  const ArcAxes axes = arc_axes(plane);
+  const PlaneAxes axes = plane_axes(plane);
   first_end = end[axes.first];
   second_end = end[axes.second];
   axis_end_point = end[axes.normal];
@@ -60,7 +51,7 @@ void ArcFeed::set_end(const Pose& end) {
 }
 
 void ArcFeed::set_center(const Pose& center) {
-  const ArcAxes axes = arc_axes(plane);
+  const PlaneAxes axes = plane_axes(plane);
   first_axis = center[axes.first];
   second_axis = center[axes.second];
 }

@@ -76,25 +76,10 @@ void Interpreter::Impl::check_cycle_plane_words() const {
 
 void Interpreter::Impl::do_canned_cycle(int code) {
   CycleGeometry g;
-  switch (modal_.plane) {
-    case Plane::xz:
-      g.a = kZ, g.b = kX, g.c = kY;
-      break;
-    case Plane::yz:
-      g.a = kY, g.b = kZ, g.c = kX;
-      break;
-    case Plane::uv:
-      g.a = kU, g.b = kV, g.c = kW;
-      break;
-    case Plane::uw:
-      g.a = kW, g.b = kU, g.c = kV;
-      break;
-    case Plane::vw:
-      g.a = kV, g.b = kW, g.c = kU;
-      break;
-    case Plane::xy:
-      break;
-  }
+  const PlaneAxes axes = plane_axes(modal_.plane);
+  g.a = axes.first;
+  g.b = axes.second;
+  g.c = axes.normal;
   const char c_letter = kAxisLetters[g.c];
   const bool same_cycle = previous_motion_ == code;
 

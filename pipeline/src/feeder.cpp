@@ -185,7 +185,9 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             std::copy(end.begin(), end.end(), move.end.begin());
             move.feed = feed_per_second();
             if (per_revolution_) move.feed_per_rev = tracker_.feed_per_minute();
-            move.plane_axes = plane_axes(c.plane);
+            const in::PlaneAxes axes = in::plane_axes(c.plane);
+            move.plane_axes = {static_cast<int>(axes.first), static_cast<int>(axes.second),
+                               static_cast<int>(axes.normal)};
             move.center_first = c.first_axis;
             move.center_second = c.second_axis;
             move.turns = c.rotation;

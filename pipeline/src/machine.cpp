@@ -47,22 +47,4 @@ interp::InterpOptions interpreter_options(const config::MachineConfig& config) {
   return options;
 }
 
-std::array<int, 3> plane_axes(interp::Plane plane) {
-  switch (plane) {
-    case interp::Plane::yz:
-      return {1, 2, 0};
-    case interp::Plane::xz:
-      return {2, 0, 1};
-    case interp::Plane::uv:
-      return {6, 7, 8};
-    case interp::Plane::vw:
-      return {7, 8, 6};
-    case interp::Plane::uw:
-      return {8, 6, 7};
-    case interp::Plane::xy:
-    default:
-      return {0, 1, 2};
-  }
-}
-
 }  // namespace cncd::pipeline

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -17,6 +18,15 @@ using Pose = std::array<double, kAxes>;
 
 // CANON_PLANE_XY/YZ/XZ, and G17.1/G19.1/G18.1's CANON_PLANE_UV/VW/UW.
 enum class Plane : std::uint8_t { xy = 1, yz = 2, xz = 3, uv = 4, vw = 5, uw = 6 };
+// The axis indices of a plane as LinuxCNC's ARC_FEED orders them: XY (0, 1, 2), XZ (2, 0, 1),
+// YZ (1, 2, 0), UV (6, 7, 8), VW (7, 8, 6), UW (8, 6, 7). A canned cycle drills along the
+// normal and places its holes on the other two.
+struct PlaneAxes {
+  std::size_t first;
+  std::size_t second;
+  std::size_t normal;
+};
+PlaneAxes plane_axes(Plane plane);
 enum class Units : std::uint8_t { inches = 1, mm = 2, cm = 3 };
 enum class MotionMode : std::uint8_t { exact_stop = 1, exact_path = 2, continuous = 3 };
 // SET_FEED_MODE's mode: inverse time (G93) is per minute here, its rate set move by move.

@@ -22,8 +22,4 @@ double run_from_line_safe_z(const config::MachineConfig& config);
 // path, start-up code, dialect and Numeryx clearance.
 interp::InterpOptions interpreter_options(const config::MachineConfig& config);
 
-// The (first, second, normal) axis indices of an arc's plane, as LinuxCNC's ARC_FEED orders
-// them: XY (0, 1, 2), XZ (2, 0, 1), YZ (1, 2, 0).
-std::array<int, 3> plane_axes(interp::Plane plane);
-
 }  // namespace cncd::pipeline
