@@ -107,6 +107,16 @@ std::string did_you_mean(std::string_view section, std::string_view key) {
   return best.empty() ? "" : "; did you mean " + std::string(best) + "?";
 }
 
+void refuse_unknown_keys(TypedReader& r, std::string_view section, std::string_view whose) {
+  for (const auto& entry : r.ini().entries()) {
+    if (entry.section == section && entry.section_occurrence == 0 &&
+        find_key_spec(section, entry.key) == nullptr) {
+      r.problem(section, entry.key,
+                "unknown key in " + std::string(whose) + did_you_mean(section, entry.key));
+    }
+  }
+}
+
 void check_keys(TypedReader& r) {
   for (const auto& entry : r.ini().entries()) {
     if (entry.section_occurrence != 0) continue;

@@ -151,13 +151,7 @@ void load_cncd(TypedReader& r, CncdConfig& cncd) {
   if (const auto v = r.choice("CNCD", "LOG_LEVEL")) {
     cncd.log_level = *v == "warning" ? "warn" : *v;
   }
-  for (const auto& entry : r.ini().entries()) {
-    if (entry.section == "CNCD" && entry.section_occurrence == 0 &&
-        find_key_spec("CNCD", entry.key) == nullptr) {
-      r.problem("CNCD", entry.key,
-                "unknown key in cncd's own section" + did_you_mean("CNCD", entry.key));
-    }
-  }
+  refuse_unknown_keys(r, "CNCD", "cncd's own section");
 }
 
 // `dir` absolute, without "." or ".." and without a trailing slash.

@@ -145,13 +145,7 @@ void load_web(TypedReader& r, MachineConfig& c) {
   if (const auto v = r.integer("WEB", "SESSION_HOURS")) web.session_hours = static_cast<int>(*v);
   if (const auto v = r.integer("WEB", "MAX_CLIENTS")) web.max_clients = static_cast<int>(*v);
   if (const auto v = r.real("WEB", "JOG_HEARTBEAT")) web.jog_heartbeat_s = *v;
-  for (const auto& entry : r.ini().entries()) {
-    if (entry.section == "WEB" && entry.section_occurrence == 0 &&
-        find_key_spec("WEB", entry.key) == nullptr) {
-      r.problem("WEB", entry.key,
-                "unknown key in cncd-web's section" + did_you_mean("WEB", entry.key));
-    }
-  }
+  refuse_unknown_keys(r, "WEB", "cncd-web's section");
 }
 
 }  // namespace cncd::config

@@ -67,6 +67,9 @@ void check_keys(TypedReader& reader);
 // "; did you mean MAX_VELOCITY?" for a key that is a typo away from a known key of the
 // section, else "".
 std::string did_you_mean(std::string_view section, std::string_view key);
+// A problem for each key of `section` (a section of cncd's own tools, written once) that the
+// key table lacks: "unknown key in <whose>", with did_you_mean's guess.
+void refuse_unknown_keys(TypedReader& reader, std::string_view section, std::string_view whose);
 // Section names: duplicates, bad [JOINT_n] / [AXIS_L] names. False for a LinuxCNC 2.7-style
 // file with numbered [AXIS_n] sections, which cannot be read as joints and axes.
 bool check_sections(TypedReader& reader);
