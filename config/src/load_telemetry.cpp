@@ -13,6 +13,12 @@ std::string value(TypedReader& r, std::string_view key) {
   return std::string(trim(strip_trailing_comment(r.text("TELEMETRY", key).value_or(""))));
 }
 
+// A problem with the value as written: "'VALUE' <why>".
+void refuse(TypedReader& r, std::string_view key, const std::string& written,
+            std::string_view why) {
+  r.problem("TELEMETRY", key, "'" + printable(written) + "' " + std::string(why));
+}
+
 bool id_character(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
          c == '_' || c == '.';
@@ -23,10 +29,9 @@ void load_machine_id(TypedReader& r, const MachineConfig& c, TelemetryConfig& t)
   if (!given.empty()) {
     for (const char ch : given) {
       if (!id_character(ch)) {
-        r.problem("TELEMETRY", "MACHINE_ID",
-                  "'" + printable(given) +
-                      "' may hold only letters, digits, '-', '_' and '.' (it is part of MQTT "
-                      "topics and metric labels)");
+        refuse(r, "MACHINE_ID", given,
+               "may hold only letters, digits, '-', '_' and '.' (it is part of MQTT topics and "
+               "metric labels)");
         return;
       }
     }
@@ -55,9 +60,8 @@ void load_metrics_listen(TypedReader& r, TelemetryConfig& t) {
                        port.find_first_not_of("0123456789") == std::string::npos &&
                        std::stoi(port) >= 1 && std::stoi(port) <= 65535;
   if (!address || !port_ok) {
-    r.problem("TELEMETRY", "METRICS_LISTEN",
-              "'" + printable(text) +
-                  "' is not ADDRESS:PORT (e.g. 127.0.0.1:9877, [::1]:9877, 0.0.0.0:9877) or off");
+    refuse(r, "METRICS_LISTEN", text,
+           "is not ADDRESS:PORT (e.g. 127.0.0.1:9877, [::1]:9877, 0.0.0.0:9877) or off");
     return;
   }
   t.metrics_address = *address;
@@ -73,10 +77,8 @@ void load_topic_prefix(TypedReader& r, TelemetryConfig& t) {
   }
   if (given.find_first_of("+#") != std::string::npos || given.front() == '/' ||
       given.back() == '/' || given.find('\0') != std::string::npos) {
-    r.problem("TELEMETRY", "TOPIC_PREFIX",
-              "'" + printable(given) +
-                  "' is not a topic prefix: no '+' or '#', no '/' at either end (e.g. "
-                  "shop/bay2/mill-1)");
+    refuse(r, "TOPIC_PREFIX", given,
+           "is not a topic prefix: no '+' or '#', no '/' at either end (e.g. shop/bay2/mill-1)");
     return;
   }
   t.topic_prefix = given;
@@ -96,8 +98,7 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
   if (const auto address = ip_address(shdr)) {
     t.shdr_address = *address;
   } else {
-    r.problem("TELEMETRY", "SHDR_LISTEN",
-              "'" + printable(shdr) + "' is not an IP address (e.g. 127.0.0.1, 0.0.0.0 or ::)");
+    refuse(r, "SHDR_LISTEN", shdr, "is not an IP address (e.g. 127.0.0.1, 0.0.0.0 or ::)");
   }
   if (const auto v = r.integer("TELEMETRY", "SHDR_PORT")) t.shdr_port = static_cast<int>(*v);
   t.mqtt_host = value(r, "MQTT_HOST");
@@ -109,13 +110,7 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
   load_topic_prefix(r, t);
   if (const auto v = r.real("TELEMETRY", "POSITION_HZ")) t.position_hz = *v;
   if (const auto v = r.integer("TELEMETRY", "EVENT_QUEUE")) t.event_queue = static_cast<int>(*v);
-  for (const auto& entry : r.ini().entries()) {
-    if (entry.section == "TELEMETRY" && entry.section_occurrence == 0 &&
-        find_key_spec("TELEMETRY", entry.key) == nullptr) {
-      r.problem("TELEMETRY", entry.key,
-                "unknown key in cncd's telemetry section" + did_you_mean("TELEMETRY", entry.key));
-    }
-  }
+  refuse_unknown_keys(r, "TELEMETRY", "cncd's telemetry section");
 }
 
 }  // namespace cncd::config
