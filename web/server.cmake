@@ -1,6 +1,6 @@
 # cncd-web: the HTTP/WebSocket server (Boost.Beast), a client of cncd's socket like cncctl.
-# Logging is cncd's own (daemon/src/logging.cpp, spdlog only), compiled in rather than linked
-# from the daemon's library.
+# Logging and the start shared with cncd-telemetry are cncd's own (daemon/src/logging.cpp,
+# client_start.cpp, spdlog only), compiled in rather than linked from the daemon's library.
 add_executable(cncd-web
   src/server/admin_entry.cpp
   src/server/app.cpp
@@ -11,6 +11,7 @@ add_executable(cncd-web
   src/server/status_watch.cpp
   src/server/web_methods.cpp
   src/server/ws_rpc.cpp
+  ${PROJECT_SOURCE_DIR}/daemon/src/client_start.cpp
   ${PROJECT_SOURCE_DIR}/daemon/src/logging.cpp)
 target_include_directories(cncd-web PRIVATE src/server ${PROJECT_SOURCE_DIR}/daemon/src)
 target_link_libraries(cncd-web PRIVATE cncd_web_core cncd_upstream cncd_config cncd_version cncd_asio

@@ -2,15 +2,14 @@
 // cncd's control socket; serves Prometheus' /metrics, an MTConnect SHDR adapter and MQTT
 // ([TELEMETRY]).
 #include <cstdio>
-#include <iostream>
 #include <string>
 #include <vector>
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/signal_set.hpp>
 
 #include "app.hpp"
+#include "client_start.hpp"
 #include "cncd/config/machine_config.hpp"
 #include "logging.hpp"
 #include "shdr.hpp"
@@ -44,70 +43,47 @@ bool split_listen(const std::string& text, std::string& address, int& port) {
   return port <= 65535;
 }
 
+// An ADDRESS:PORT option given over the INI's address and port; false, said, when it is not
+// that.
+bool listen_option(const char* option, const std::string& text, std::string& address, int& port) {
+  if (text.empty() || split_listen(text, address, port)) return true;
+  std::fprintf(stderr, "cncd-telemetry: %s needs ADDRESS:PORT, not '%s'\n", option, text.c_str());
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::filesystem::path ini;
-  std::string socket_path;
   std::string metrics_listen;
   std::string shdr_listen;
   bool devices = false;
-  std::string log_level = "info";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (arg == "--ini" && has_value) {
-      ini = argv[++i];
-    } else if (arg == "--socket" && has_value) {
-      socket_path = argv[++i];
-    } else if (arg == "--metrics-listen" && has_value) {
-      metrics_listen = argv[++i];
-    } else if (arg == "--shdr-listen" && has_value) {
-      shdr_listen = argv[++i];
-    } else if (arg == "--devices-xml") {
-      devices = true;
-    } else if (arg == "--log-level" && has_value) {
-      log_level = argv[++i];
-    } else if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return 0;
-    } else if (arg == "--version") {
-      std::printf("cncd-telemetry %s\n", cncd::kVersion);
-      return 0;
-    } else {
-      std::fprintf(stderr, "cncd-telemetry: unknown option '%s'\n", arg.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
-  if (ini.empty()) {
-    std::fprintf(stderr, "cncd-telemetry: --ini is required\n");
-    usage(stderr);
-    return 2;
-  }
-  const auto level = cncd::daemon::parse_log_level(log_level);
-  if (!level) {
-    std::fprintf(stderr, "cncd-telemetry: unknown log level '%s'\n", log_level.c_str());
-    return 2;
-  }
-  auto loaded = cncd::config::load_or_report(ini, "cncd-telemetry", std::cerr);
-  if (!loaded) return cncd::config::kExitConfig;
-  const cncd::config::MachineConfig& machine = *loaded;
+  auto start = cncd::daemon::start_client(argc, argv, "cncd-telemetry", usage,
+                                          [&](const std::string& arg, const char* next) {
+                                            if (arg == "--metrics-listen" && next != nullptr) {
+                                              metrics_listen = next;
+                                              return 2;
+                                            }
+                                            if (arg == "--shdr-listen" && next != nullptr) {
+                                              shdr_listen = next;
+                                              return 2;
+                                            }
+                                            if (arg == "--devices-xml") {
+                                              devices = true;
+                                              return 1;
+                                            }
+                                            return 0;
+                                          });
+  if (start.exit_status) return *start.exit_status;
+  const cncd::config::MachineConfig& machine = *start.machine;
   const cncd::config::TelemetryConfig& t = machine.telemetry;
   std::string metrics_address = t.metrics_address;
   int metrics_port = t.metrics_port;
-  if (!metrics_listen.empty() && !split_listen(metrics_listen, metrics_address, metrics_port)) {
-    std::fprintf(stderr, "cncd-telemetry: --metrics-listen needs ADDRESS:PORT, not '%s'\n",
-                 metrics_listen.c_str());
-    return 2;
-  }
   std::string shdr_address = t.shdr_address;
   int shdr_port = t.shdr_port;
-  if (!shdr_listen.empty() && !split_listen(shdr_listen, shdr_address, shdr_port)) {
-    std::fprintf(stderr, "cncd-telemetry: --shdr-listen needs ADDRESS:PORT, not '%s'\n",
-                 shdr_listen.c_str());
+  if (!listen_option("--metrics-listen", metrics_listen, metrics_address, metrics_port) ||
+      !listen_option("--shdr-listen", shdr_listen, shdr_address, shdr_port))
     return 2;
-  }
+  std::string socket_path = start.socket_path;
   if (socket_path.empty()) socket_path = machine.cncd.socket_path;
   std::vector<char> axes;
   for (std::size_t i = 0; i < cncd::config::kAxisLetters.size(); ++i) {
@@ -119,7 +95,7 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  cncd::daemon::init_logging(*level);
+  cncd::daemon::init_logging(start.log_level);
   boost::asio::io_context io;
   cncd::telemetry::App app(io, t, socket_path, axes);
   cncd::telemetry::Endpoints endpoints{metrics_address, metrics_port, !metrics_listen.empty(),
@@ -130,14 +106,10 @@ int main(int argc, char** argv) {
   }
   spdlog::info("cncd-telemetry {} for machine '{}', cncd at {}", cncd::kVersion, t.machine_id,
                socket_path);
-  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
-  signals.async_wait([&](const boost::system::error_code& ec, int signal) {
-    if (ec) return;
-    spdlog::info("signal {}: shutting down", signal);
+  cncd::daemon::run_until_signal(io, [&] {
     app.stop();
     io.stop();
   });
-  io.run();
   spdlog::info("cncd-telemetry stopped");
   return 0;
 }

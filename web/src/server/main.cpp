@@ -4,16 +4,15 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <iostream>
 #include <string>
 #include <vector>
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/signal_set.hpp>
 
 #include "admin_entry.hpp"
 #include "app.hpp"
+#include "client_start.hpp"
 #include "cncd/web/admin_cli.hpp"
 #include "listener.hpp"
 #include "logging.hpp"
@@ -43,53 +42,26 @@ std::filesystem::path exe_dir() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::filesystem::path ini;
-  std::string socket_path;
   std::filesystem::path www;
-  std::string log_level = "info";
   std::vector<std::string> rest;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (arg == "--ini" && has_value) {
-      ini = argv[++i];
-    } else if (arg == "--socket" && has_value) {
-      socket_path = argv[++i];
-    } else if (arg == "--www" && has_value) {
-      www = argv[++i];
-    } else if (arg == "--log-level" && has_value) {
-      log_level = argv[++i];
-    } else if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return 0;
-    } else if (arg == "--version") {
-      std::printf("cncd-web %s\n", cncd::kVersion);
-      return 0;
-    } else if (!rest.empty() || (!arg.empty() && arg[0] != '-')) {
-      rest.push_back(arg);
-    } else {
-      std::fprintf(stderr, "cncd-web: unknown option '%s'\n", arg.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
-  if (ini.empty()) {
-    std::fprintf(stderr, "cncd-web: --ini is required\n");
-    usage(stderr);
-    return 2;
-  }
-  const auto level = cncd::daemon::parse_log_level(log_level);
-  if (!level) {
-    std::fprintf(stderr, "cncd-web: unknown log level '%s'\n", log_level.c_str());
-    return 2;
-  }
-  auto loaded = cncd::config::load_or_report(ini, "cncd-web", std::cerr);
-  if (!loaded) return cncd::config::kExitConfig;
-  auto machine = cncd::web::with_web_defaults(std::move(*loaded));
+  auto start = cncd::daemon::start_client(argc, argv, "cncd-web", usage,
+                                          [&](const std::string& arg, const char* next) {
+                                            if (arg == "--www" && next != nullptr) {
+                                              www = next;
+                                              return 2;
+                                            }
+                                            if (!rest.empty() || (!arg.empty() && arg[0] != '-')) {
+                                              rest.push_back(arg);
+                                              return 1;
+                                            }
+                                            return 0;
+                                          });
+  if (start.exit_status) return *start.exit_status;
+  auto machine = cncd::web::with_web_defaults(std::move(*start.machine));
   if (!rest.empty()) return cncd::web::run_admin(rest, machine.web);
 
-  cncd::daemon::init_logging(*level);
-  if (!socket_path.empty()) machine.cncd.socket_path = socket_path;
+  cncd::daemon::init_logging(start.log_level);
+  if (!start.socket_path.empty()) machine.cncd.socket_path = start.socket_path;
   boost::asio::io_context io;
   try {
     App app(io, std::move(machine), exe_dir() / "cncd-check");
@@ -105,10 +77,7 @@ int main(int argc, char** argv) {
     spdlog::info("cncd-web {} serving {}://{}:{} for cncd at {} (programs in {})", cncd::kVersion,
                  app.tls ? "https" : "http", app.web.listen, listener.endpoint().port(),
                  app.socket_path, app.programs.path().string());
-    boost::asio::signal_set signals(io, SIGTERM, SIGINT);
-    signals.async_wait([&](const boost::system::error_code& ec, int signal) {
-      if (ec) return;
-      spdlog::info("signal {}: shutting down", signal);
+    cncd::daemon::run_until_signal(io, [&] {
       listener.stop();
       watch.stop();
       for (auto* peer : std::vector(app.peers.begin(), app.peers.end()))
@@ -117,7 +86,6 @@ int main(int argc, char** argv) {
       auto timer = std::make_shared<boost::asio::steady_timer>(io, std::chrono::milliseconds(300));
       timer->async_wait([&io, timer](const boost::system::error_code&) { io.stop(); });
     });
-    io.run();
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;
