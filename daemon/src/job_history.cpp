@@ -17,20 +17,20 @@ namespace {
 
 using nlohmann::json;
 
+// A field as the job history's JSON shows it: a number not known (yet) is null.
+template <class T>
+json field_json(const T& value) {
+  return value;
+}
+json field_json(const std::optional<double>& value) {
+  return optional_number(value);
+}
+
 json job_json(const JobRecord& job) {
-  return json{{"id", job.id},
-              {"program", job.program},
-              {"sha256", job.sha256},
-              {"started", job.started},
-              {"ended", optional_number(job.ended)},
-              {"result", job.result},
-              {"error_line", job.error_line},
-              {"error", job.error},
-              {"cycle_s", optional_number(job.cycle_s)},
-              {"estimate_s", optional_number(job.estimate_s)},
-              {"parts", job.parts},
-              {"started_by", job.started_by},
-              {"from_line", job.from_line}};
+  json out = json::object();
+  for_each_job_field(job,
+                     [&](const char* name, const auto& value) { out[name] = field_json(value); });
+  return out;
 }
 
 std::shared_ptr<const std::string> serialized(const json& value) {

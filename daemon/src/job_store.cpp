@@ -37,17 +37,19 @@ class Statement {
   Statement& operator=(const Statement&) = delete;
   bool ok() const { return rc_ == SQLITE_OK; }
   sqlite3_stmt* get() { return s_; }
-  void text(int i, const std::string& v) {
+  void bind(int i, const std::string& v) {
     sqlite3_bind_text(s_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
   }
-  void real(int i, std::optional<double> v) {
+  void bind(int i, const std::optional<double>& v) {
     if (v) {
       sqlite3_bind_double(s_, i, *v);
     } else {
       sqlite3_bind_null(s_, i);
     }
   }
-  void integer(int i, std::int64_t v) { sqlite3_bind_int64(s_, i, v); }
+  void bind(int i, double v) { sqlite3_bind_double(s_, i, v); }
+  void bind(int i, std::int64_t v) { sqlite3_bind_int64(s_, i, v); }
+  void bind(int i, int v) { sqlite3_bind_int64(s_, i, v); }
   int step() { return sqlite3_step(s_); }
   std::string column_text(int i) {
     const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(s_, i));
@@ -59,25 +61,23 @@ class Statement {
     return sqlite3_column_double(s_, i);
   }
   std::int64_t column_int(int i) { return sqlite3_column_int64(s_, i); }
+  void column(int i, std::string& out) { out = column_text(i); }
+  void column(int i, std::optional<double>& out) { out = column_real(i); }
+  void column(int i, double& out) { out = column_real(i).value_or(0); }
+  void column(int i, std::int64_t& out) { out = column_int(i); }
+  void column(int i, int& out) { out = static_cast<int>(column_int(i)); }
 
  private:
   sqlite3_stmt* s_ = nullptr;
   int rc_ = SQLITE_ERROR;
 };
 
+// Every field but the id, as ?1 .. ?12.
 void bind_record(Statement& s, const JobRecord& job) {
-  s.text(1, job.program);
-  s.text(2, job.sha256);
-  s.real(3, job.started);
-  s.real(4, job.ended);
-  s.text(5, job.result);
-  s.integer(6, job.error_line);
-  s.text(7, job.error);
-  s.real(8, job.cycle_s);
-  s.real(9, job.estimate_s);
-  s.integer(10, job.parts);
-  s.text(11, job.started_by);
-  s.integer(12, job.from_line);
+  int column = 0;
+  for_each_job_field(job, [&](std::string_view name, const auto& value) {
+    if (name != "id") s.bind(++column, value);
+  });
 }
 
 }  // namespace
@@ -169,7 +169,7 @@ std::string JobStore::finish(const JobRecord& job) {
               "from_line=?12 WHERE id=?13");
   if (!s.ok()) return failure("cannot write to");
   bind_record(s, job);
-  s.integer(13, job.id);
+  s.bind(13, job.id);
   if (s.step() != SQLITE_DONE) return failure("cannot write to");
   return "";
 }
@@ -180,24 +180,13 @@ std::string JobStore::history(double since, int limit, std::vector<JobRecord>& o
               "estimate_s, parts, started_by, from_line FROM jobs WHERE started >= ?1 "
               "ORDER BY id DESC LIMIT ?2");
   if (!s.ok()) return failure("cannot read");
-  s.real(1, since);
-  s.integer(2, limit);
+  s.bind(1, since);
+  s.bind(2, limit);
   int rc = 0;
   while ((rc = s.step()) == SQLITE_ROW) {
     JobRecord job;
-    job.id = s.column_int(0);
-    job.program = s.column_text(1);
-    job.sha256 = s.column_text(2);
-    job.started = s.column_real(3).value_or(0);
-    job.ended = s.column_real(4);
-    job.result = s.column_text(5);
-    job.error_line = static_cast<int>(s.column_int(6));
-    job.error = s.column_text(7);
-    job.cycle_s = s.column_real(8);
-    job.estimate_s = s.column_real(9);
-    job.parts = static_cast<int>(s.column_int(10));
-    job.started_by = s.column_text(11);
-    job.from_line = static_cast<int>(s.column_int(12));
+    int column = 0;
+    for_each_job_field(job, [&](std::string_view, auto& value) { s.column(column++, value); });
     out.push_back(std::move(job));
   }
   return rc == SQLITE_DONE ? "" : failure("cannot read");
@@ -208,7 +197,7 @@ std::string JobStore::stats(double since, JobStats& out) {
               "SELECT result, COUNT(*), SUM(parts), TOTAL(cycle_s), MAX(id) FROM jobs "
               "WHERE started >= ?1 GROUP BY result");
   if (!s.ok()) return failure("cannot read");
-  s.real(1, since);
+  s.bind(1, since);
   int rc = 0;
   while ((rc = s.step()) == SQLITE_ROW) {
     const std::string result = s.column_text(0);

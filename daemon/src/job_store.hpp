@@ -33,6 +33,26 @@ struct JobRecord {
   int from_line = 0;       // 0: from the top
 };
 
+// Calls `f(name, field)` for each field of `job` (a JobRecord, const or not), in the order of
+// the jobs table's columns, which is also the order of the store's SQL statements: the one
+// list that the store's writes and reads and the job history's JSON go by.
+template <class Record, class F>
+void for_each_job_field(Record& job, F&& f) {
+  f("id", job.id);
+  f("program", job.program);
+  f("sha256", job.sha256);
+  f("started", job.started);
+  f("ended", job.ended);
+  f("result", job.result);
+  f("error_line", job.error_line);
+  f("error", job.error);
+  f("cycle_s", job.cycle_s);
+  f("estimate_s", job.estimate_s);
+  f("parts", job.parts);
+  f("started_by", job.started_by);
+  f("from_line", job.from_line);
+}
+
 struct JobStats {
   std::map<std::string, std::int64_t> by_result;  // result -> jobs
   std::int64_t jobs = 0;
