@@ -70,18 +70,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
   void on_header(beast::error_code ec) {
     if (ec == http::error::body_limit)
-      return send(
-          error_response(parser_->get(), http::status::payload_too_large, "request body too large"),
-          false);
+      return refuse(parser_->get(), http::status::payload_too_large, "request body too large");
     if (ec == http::error::header_limit)
-      return send(error_response(parser_->get(), http::status::request_header_fields_too_large,
-                                 "request header too large"),
-                  false);
+      return refuse(parser_->get(), http::status::request_header_fields_too_large,
+                    "request header too large");
     if (ec && ec.category() == http::make_error_code(http::error::bad_target).category() &&
         ec != http::error::end_of_stream && ec != http::error::partial_message) {
-      return send(error_response(RequestHeader{}, http::status::bad_request,
-                                 "malformed request: " + ec.message()),
-                  false);
+      return refuse(RequestHeader{}, http::status::bad_request,
+                    "malformed request: " + ec.message());
     }
     if (ec) return close();
     auto& req = parser_->get();
@@ -89,13 +85,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (req.method() == http::verb::put && target_path(req).starts_with("/api/programs/"))
       return start_upload();
     if (req.method() == http::verb::put)
-      return send(error_response(req, http::status::method_not_allowed, "PUT only on programs"),
-                  false);
+      return refuse(req, http::status::method_not_allowed, "PUT only on programs");
     // Beast checks a body limit against Content-Length only while parsing the header, which
     // is done: a declared length is checked here, a chunked body while it is read.
     if (const auto length = parser_->content_length(); length && *length > app_.limits.body_bytes)
-      return send(error_response(req, http::status::payload_too_large, "request body too large"),
-                  false);
+      return refuse(req, http::status::payload_too_large, "request body too large");
     body_parser_.emplace(std::move(*parser_));
     body_parser_->body_limit(app_.limits.body_bytes);
     beast::get_lowest_layer(stream_).expires_after(body_time());
@@ -107,9 +101,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
   void on_body(beast::error_code ec) {
     if (ec == http::error::body_limit)
-      return send(error_response(body_parser_->get(), http::status::payload_too_large,
-                                 "request body too large"),
-                  false);
+      return refuse(body_parser_->get(), http::status::payload_too_large, "request body too large");
     if (ec) return close();
     beast::get_lowest_layer(stream_).expires_never();
     handle_request(app_, body_parser_->release(), peer_,
@@ -121,7 +113,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   void upgrade() {
     auto& req = parser_->get();
     if (!target_is(req, "/ws"))
-      return send(error_response(req, http::status::not_found, "WebSocket only at /ws"), false);
+      return refuse(req, http::status::not_found, "WebSocket only at /ws");
     auto check = check_upgrade(app_, req, peer_);
     if (check.refusal) return send(std::move(*check.refusal), false);
     beast::get_lowest_layer(stream_).expires_never();
@@ -137,8 +129,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     user_ = check.user;
     FileStatus status;
     upload_ = app_.programs.start_upload(status);
-    if (!upload_)
-      return send(error_response(parser_->get(), status_of(status.error), status.message), false);
+    if (!upload_) return refuse(parser_->get(), status_of(status.error), status.message);
     upload_parser_.emplace(std::move(*parser_));
     upload_parser_->body_limit(static_cast<std::uint64_t>(app_.programs.max_upload_bytes()));
     if (beast::iequals(upload_parser_->get()[http::field::expect], "100-continue")) {
@@ -171,11 +162,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     const auto& req = upload_parser_->get();
     if (ec == http::error::body_limit) {
       upload_.reset();  // nothing of it stays
-      return send(error_response(req, http::status::payload_too_large,
-                                 "the program is over the limit of " +
-                                     std::to_string(app_.programs.max_upload_bytes() >> 20) +
-                                     " MB ([WEB] MAX_UPLOAD_MB)"),
-                  false);
+      return refuse(req, http::status::payload_too_large,
+                    "the program is over the limit of " +
+                        std::to_string(app_.programs.max_upload_bytes() >> 20) +
+                        " MB ([WEB] MAX_UPLOAD_MB)");
     }
     if (ec) {
       upload_.reset();
@@ -186,7 +176,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       const auto status = upload_->write(std::string_view(chunk_.data(), got));
       if (!status.ok()) {
         upload_.reset();
-        return send(error_response(req, status_of(status.error), status.message), false);
+        return refuse(req, status_of(status.error), status.message);
       }
     }
     if (!upload_parser_->is_done()) return read_chunk();
@@ -197,6 +187,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       return send(error_response(req, status_of(status.error), status.message), true);
     spdlog::info("{} at {} uploaded program {} ({} bytes)", user_, peer_.address, name_, size);
     send(json_response(req, http::status::created, {{"name", name_}, {"size", size}}), true);
+  }
+
+  // An error answer, then the connection closes: what is left of the request is not read.
+  void refuse(const RequestHeader& req, http::status status, const std::string& message) {
+    send(error_response(req, status, message), false);
   }
 
   // Sends `answer`; reads the next request after it when both sides keep the connection.
