@@ -1,8 +1,5 @@
 #include "program_open.hpp"
 
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <utility>
 
 #include "cncd/pipeline/program_check.hpp"
@@ -59,36 +56,36 @@ OpenOutcome check_for_open(std::uint64_t job, const OpenRequest& request,
 
 }  // namespace
 
-ProgramOpener::ProgramOpener(const config::MachineConfig& machine)
-    : machine_(machine), thread_([this] { work(); }) {}
+ProgramOpener::ProgramOpener(const config::MachineConfig& machine) : machine_(machine) {
+  // The servo thread and the control socket come first; the check's time budget counts this
+  // thread's processor time, so a busy machine makes it slower, not shorter.
+  worker_.start(
+      10, [this] { return next_.has_value(); }, [this](WorkerThread::Lock& lock) { work(lock); });
+}
 
 ProgramOpener::~ProgramOpener() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
+  worker_.stop([this] {
     next_.reset();
     wanted_ = 0;
     cancel_.store(true);
-  }
-  wake_.notify_one();
-  thread_.join();
+  });
 }
 
 std::uint64_t ProgramOpener::start(OpenRequest request) {
   const std::uint64_t job = ++last_job_;
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(worker_.mutex());
     next_.emplace(job, std::move(request));
     wanted_ = job;
     done_.reset();
     cancel_.store(true);
   }
-  wake_.notify_one();
+  worker_.wake();
   return job;
 }
 
 void ProgramOpener::cancel() {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(worker_.mutex());
   next_.reset();
   wanted_ = 0;
   done_.reset();
@@ -96,26 +93,18 @@ void ProgramOpener::cancel() {
 }
 
 std::optional<OpenOutcome> ProgramOpener::take() {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(worker_.mutex());
   return std::exchange(done_, std::nullopt);
 }
 
-void ProgramOpener::work() {
-  // The servo thread and the control socket come first; the check's time budget counts this
-  // thread's processor time, so a busy machine makes it slower, not shorter.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
-  std::unique_lock lock(mutex_);
-  for (;;) {
-    wake_.wait(lock, [this] { return stopping_ || next_.has_value(); });
-    if (stopping_) return;
-    auto [job, request] = std::move(*next_);
-    next_.reset();
-    cancel_.store(false);
-    lock.unlock();
-    OpenOutcome outcome = check_for_open(job, request, machine_, cancel_);
-    lock.lock();
-    if (job == wanted_ && !cancel_.load()) done_ = std::move(outcome);
-  }
+void ProgramOpener::work(WorkerThread::Lock& lock) {
+  auto [job, request] = std::move(*next_);
+  next_.reset();
+  cancel_.store(false);
+  lock.unlock();
+  OpenOutcome outcome = check_for_open(job, request, machine_, cancel_);
+  lock.lock();
+  if (job == wanted_ && !cancel_.load()) done_ = std::move(outcome);
 }
 
 }  // namespace cncd::daemon

@@ -8,19 +8,17 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "task_outcome.hpp"
+#include "worker_thread.hpp"
 
 namespace cncd::daemon {
 
@@ -66,20 +64,17 @@ class ProgramOpener {
   std::optional<OpenOutcome> take();
 
  private:
-  void work();
+  void work(WorkerThread::Lock& lock);
 
   const config::MachineConfig& machine_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  // Guarded by mutex_:
+  // Guarded by worker_.mutex():
   std::optional<std::pair<std::uint64_t, OpenRequest>> next_;
   std::optional<OpenOutcome> done_;
   std::uint64_t wanted_ = 0;  // the job whose outcome is wanted, 0 = none
-  bool stopping_ = false;
   // Stops the check under way; cleared by the worker when it takes the next job.
   std::atomic<bool> cancel_{false};
   std::uint64_t last_job_ = 0;  // loop thread only
-  std::thread thread_;
+  WorkerThread worker_;
 };
 
 }  // namespace cncd::daemon

@@ -1,26 +1,22 @@
 #include "program_preview.hpp"
 
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <algorithm>
 
 #include "cncd/pipeline/program_preview.hpp"
 
 namespace cncd::daemon {
 
-ProgramPreviewer::ProgramPreviewer(const config::MachineConfig& machine)
-    : machine_(machine), thread_([this] { work(); }) {}
+ProgramPreviewer::ProgramPreviewer(const config::MachineConfig& machine) : machine_(machine) {
+  // The servo thread, the control socket and program.open's check come first.
+  worker_.start(
+      15, [this] { return !jobs_.empty(); }, [this](WorkerThread::Lock& lock) { work(lock); });
+}
 
 ProgramPreviewer::~ProgramPreviewer() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
+  worker_.stop([this] {
     jobs_.clear();
     cancel_.store(true);
-  }
-  wake_.notify_one();
-  thread_.join();
+  });
 }
 
 void ProgramPreviewer::open(const std::filesystem::path& program,
@@ -36,7 +32,7 @@ void ProgramPreviewer::open(const std::filesystem::path& program,
   cached_.clear();
   has_program_ = true;
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(worker_.mutex());
     ++generation_;
     program_ = program;
     options_ = options;
@@ -69,17 +65,17 @@ void ProgramPreviewer::request(double tolerance, std::uint64_t token) {
   }
   waiting_[tolerance].push_back(token);
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(worker_.mutex());
     jobs_.push_back({generation_, tolerance});
   }
-  wake_.notify_one();
+  worker_.wake();
 }
 
 std::vector<std::pair<std::uint64_t, TaskOutcome>> ProgramPreviewer::take() {
   std::vector<Done> done;
   std::uint64_t generation = 0;
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(worker_.mutex());
     done.swap(done_);
     generation = generation_;
   }
@@ -97,41 +93,33 @@ std::vector<std::pair<std::uint64_t, TaskOutcome>> ProgramPreviewer::take() {
   return std::exchange(ready_, {});
 }
 
-void ProgramPreviewer::work() {
-  // The servo thread, the control socket and program.open's check come first.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 15);
-  std::unique_lock lock(mutex_);
-  for (;;) {
-    wake_.wait(lock, [this] { return stopping_ || !jobs_.empty(); });
-    if (stopping_) return;
-    const Job job = jobs_.front();
-    jobs_.pop_front();
-    const std::filesystem::path program = program_;
-    pipeline::CheckOptions check;
-    check.interp = options_;
-    check.machine = &machine_;
-    check.start_machine = start_;
-    check.max_problems = 1;
-    check.max_seconds = kMaxSeconds;
-    check.max_seconds_cpu = true;
-    check.cancel = &cancel_;
-    cancel_.store(false);
-    lock.unlock();
-    pipeline::PreviewOptions options;
-    options.tolerance = job.tolerance;
-    const auto preview = pipeline::preview_program(program, check, options);
-    std::shared_ptr<const std::string> json;
-    if (!preview.report.cancelled) {
-      nlohmann::json object = pipeline::preview_json(preview);
-      object["path"] = program.string();
-      object["tolerance_asked"] = job.tolerance;
-      json = std::make_shared<const std::string>(
-          object.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
-    }
-    lock.lock();
-    if (json && job.generation == generation_)
-      done_.push_back({job.generation, job.tolerance, json});
+void ProgramPreviewer::work(WorkerThread::Lock& lock) {
+  const Job job = jobs_.front();
+  jobs_.pop_front();
+  const std::filesystem::path program = program_;
+  pipeline::CheckOptions check;
+  check.interp = options_;
+  check.machine = &machine_;
+  check.start_machine = start_;
+  check.max_problems = 1;
+  check.max_seconds = kMaxSeconds;
+  check.max_seconds_cpu = true;
+  check.cancel = &cancel_;
+  cancel_.store(false);
+  lock.unlock();
+  pipeline::PreviewOptions options;
+  options.tolerance = job.tolerance;
+  const auto preview = pipeline::preview_program(program, check, options);
+  std::shared_ptr<const std::string> json;
+  if (!preview.report.cancelled) {
+    nlohmann::json object = pipeline::preview_json(preview);
+    object["path"] = program.string();
+    object["tolerance_asked"] = job.tolerance;
+    json = std::make_shared<const std::string>(
+        object.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   }
+  lock.lock();
+  if (json && job.generation == generation_) done_.push_back({job.generation, job.tolerance, json});
 }
 
 }  // namespace cncd::daemon

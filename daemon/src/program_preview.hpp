@@ -7,21 +7,19 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/interpreter.hpp"
 #include "task_outcome.hpp"
+#include "worker_thread.hpp"
 
 namespace cncd::daemon {
 
@@ -60,7 +58,7 @@ class ProgramPreviewer {
     double tolerance = 0;
     std::shared_ptr<const std::string> json;
   };
-  void work();
+  void work(WorkerThread::Lock& lock);
 
   const config::MachineConfig& machine_;
   // Loop thread only:
@@ -68,19 +66,16 @@ class ProgramPreviewer {
   std::vector<std::pair<double, std::shared_ptr<const std::string>>> cached_;  // newest last
   std::vector<std::pair<std::uint64_t, TaskOutcome>> ready_;
   bool has_program_ = false;
-  // Guarded by mutex_:
-  std::mutex mutex_;
-  std::condition_variable wake_;
+  // Guarded by worker_.mutex():
   std::uint64_t generation_ = 0;
   std::filesystem::path program_;
   interp::InterpOptions options_;
   interp::Pose start_{};
   std::deque<Job> jobs_;
   std::vector<Done> done_;
-  bool stopping_ = false;
   // Stops the preview under way when the program changes or the daemon stops.
   std::atomic<bool> cancel_{false};
-  std::thread thread_;
+  WorkerThread worker_;
 };
 
 }  // namespace cncd::daemon

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <condition_variable>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -66,57 +65,51 @@ std::optional<std::string> output_of(const std::vector<std::string>& argv) {
 
 Estimates::Estimates(std::filesystem::path check, std::filesystem::path ini)
     : check_(std::move(check)), ini_(std::move(ini)) {
-  if (!check_.empty()) thread_ = std::thread([this] { run(); });
+  if (!check_.empty()) {
+    worker_.start(
+        0, [this] { return !queue_.empty(); },
+        [this](daemon::WorkerThread::Lock& lock) { run(lock); });
+  }
 }
 
 Estimates::~Estimates() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  worker_.stop();
 }
 
 std::optional<double> Estimates::get(const std::filesystem::path& file, std::int64_t size,
                                      std::chrono::system_clock::time_point mtime) {
   const Key key{file.string(), size, ticks(mtime)};
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(worker_.mutex());
   if (const auto found = done_.find(key); found != done_.end()) return found->second;
   if (!check_.empty() && queue_.size() < kMaxQueued &&
       std::find(queue_.begin(), queue_.end(), key) == queue_.end()) {
     queue_.push_back(key);
-    wake_.notify_all();
+    worker_.wake();
   }
   return std::nullopt;
 }
 
 void Estimates::put(const std::filesystem::path& file, std::int64_t size,
                     std::chrono::system_clock::time_point mtime, double seconds) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(worker_.mutex());
   if (done_.size() >= kMaxCached) done_.clear();
   done_[Key{file.string(), size, ticks(mtime)}] = seconds;
 }
 
-void Estimates::run() {
-  std::unique_lock lock(mutex_);
-  for (;;) {
-    wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-    if (stopping_) return;
-    const Key key = queue_.front();
-    lock.unlock();
-    std::optional<double> seconds;
-    if (const auto out = output_of(
-            {check_.string(), "--plan", "--json", "--ini", ini_.string(), std::get<0>(key)})) {
-      const auto json = nlohmann::json::parse(*out, nullptr, false);
-      if (json.is_object() && json.value("cycle_time_s", nlohmann::json()).is_number())
-        seconds = json["cycle_time_s"].get<double>();
-    }
-    lock.lock();
-    queue_.pop_front();
-    if (done_.size() >= kMaxCached) done_.clear();
-    done_[key] = seconds;
+void Estimates::run(daemon::WorkerThread::Lock& lock) {
+  const Key key = queue_.front();
+  lock.unlock();
+  std::optional<double> seconds;
+  if (const auto out = output_of(
+          {check_.string(), "--plan", "--json", "--ini", ini_.string(), std::get<0>(key)})) {
+    const auto json = nlohmann::json::parse(*out, nullptr, false);
+    if (json.is_object() && json.value("cycle_time_s", nlohmann::json()).is_number())
+      seconds = json["cycle_time_s"].get<double>();
   }
+  lock.lock();
+  queue_.pop_front();
+  if (done_.size() >= kMaxCached) done_.clear();
+  done_[key] = seconds;
 }
 
 }  // namespace cncd::web

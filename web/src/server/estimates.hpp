@@ -4,16 +4,15 @@
 #pragma once
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <tuple>
+
+#include "worker_thread.hpp"
 
 namespace cncd::web {
 
@@ -36,16 +35,13 @@ class Estimates {
 
  private:
   using Key = std::tuple<std::string, std::int64_t, std::int64_t>;
-  void run();
+  void run(daemon::WorkerThread::Lock& lock);
 
   std::filesystem::path check_;
   std::filesystem::path ini_;
-  std::mutex mutex_;
   std::map<Key, std::optional<double>> done_;  // nullopt: cncd-check could not tell
   std::deque<Key> queue_;
-  bool stopping_ = false;
-  std::condition_variable_any wake_;
-  std::thread thread_;
+  daemon::WorkerThread worker_;  // guards done_ and queue_
 };
 
 }  // namespace cncd::web
