@@ -14,7 +14,7 @@ add_executable(cncd-web
   ${PROJECT_SOURCE_DIR}/daemon/src/client_start.cpp
   ${PROJECT_SOURCE_DIR}/daemon/src/logging.cpp)
 target_include_directories(cncd-web PRIVATE src/server ${PROJECT_SOURCE_DIR}/daemon/src)
-target_link_libraries(cncd-web PRIVATE cncd_web_core cncd_upstream cncd_config cncd_version cncd_asio
+target_link_libraries(cncd-web PRIVATE cncd_web_core cncd_http cncd_upstream cncd_config cncd_version cncd_asio
                                        OpenSSL::SSL spdlog::spdlog nlohmann_json::nlohmann_json)
 set_target_properties(cncd-web PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${CNCD_BIN_DIR}")
 # The page's target is made after this file (web/www/www.cmake): checked at the end.

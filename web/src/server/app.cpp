@@ -5,6 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "http_common.hpp"
+
 namespace cncd::web {
 config::MachineConfig with_web_defaults(config::MachineConfig machine) {
   if (machine.web.program_dir.empty() && !machine.program_dirs.empty())
@@ -108,11 +110,7 @@ nlohmann::json App::lease_json() const {
 }
 
 bool App::origin_allowed(std::string_view origin, std::string_view host, bool secure) const {
-  if (origin.empty()) return true;
-  if (lower(origin) == lower(std::string(secure ? "https://" : "http://") + std::string(host)))
-    return true;
-  return std::any_of(web.allowed_origins.begin(), web.allowed_origins.end(),
-                     [&](const std::string& allowed) { return lower(allowed) == lower(origin); });
+  return web::origin_allowed(origin, host, secure, web.allowed_origins);
 }
 
 nlohmann::json lease_holder_json(const std::optional<LeaseHolder>& holder) {

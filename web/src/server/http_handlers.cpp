@@ -24,42 +24,6 @@ bool origin_allowed(const App& app, const RequestHeader& req, const Peer& peer) 
   return app.origin_allowed(req[http::field::origin], req[http::field::host], peer.tls);
 }
 
-std::string_view content_type(std::string_view name) {
-  static const std::array<std::pair<std::string_view, std::string_view>, 12> types = {{
-      {".html", "text/html; charset=utf-8"},
-      {".js", "text/javascript; charset=utf-8"},
-      {".mjs", "text/javascript; charset=utf-8"},
-      {".css", "text/css; charset=utf-8"},
-      {".json", "application/json"},
-      {".svg", "image/svg+xml"},
-      {".png", "image/png"},
-      {".ico", "image/x-icon"},
-      {".woff2", "font/woff2"},
-      {".txt", "text/plain; charset=utf-8"},
-      {".md", "text/plain; charset=utf-8"},
-      {".map", "application/json"},
-  }};
-  for (const auto& [ext, type] : types) {
-    if (name.size() >= ext.size() && name.substr(name.size() - ext.size()) == ext) return type;
-  }
-  return "application/octet-stream";
-}
-
-void secure_headers(http::fields& fields) {
-  fields.set("X-Content-Type-Options", "nosniff");
-  fields.set("X-Frame-Options", "DENY");
-  fields.set("Referrer-Policy", "no-referrer");
-}
-
-std::string http_date(std::chrono::system_clock::time_point t) {
-  const std::time_t seconds = std::chrono::system_clock::to_time_t(t);
-  std::tm tm{};
-  gmtime_r(&seconds, &tm);
-  char text[64];
-  std::strftime(text, sizeof text, "%a, %d %b %Y %H:%M:%S GMT", &tm);
-  return text;
-}
-
 std::string cookie(const std::string& value, bool tls, long max_age) {
   return "cncd_session=" + value +
          "; HttpOnly; SameSite=Strict; Path=/; Max-Age=" + std::to_string(max_age) +
@@ -77,59 +41,6 @@ http::message_generator redirect(const RequestHeader& req, std::string_view to) 
   res.prepare_payload();  // Content-Length: 0, or the client waits for the connection to end
   res.keep_alive(keeps_alive(req));
   return res;
-}
-
-// Serves www/<relative> (segments already checked), or 404.
-http::message_generator serve_file(App& app, const RequestHeader& req,
-                                   const std::string& relative) {
-  const auto path = app.www_dir / relative;
-  struct stat st {};
-  if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
-    return error_response(req, http::status::not_found, "no such file: /" + relative);
-  const auto mtime = std::chrono::system_clock::from_time_t(st.st_mtime);
-  const std::string modified = http_date(mtime);
-  if (req[http::field::if_modified_since] == modified) {
-    http::response<http::empty_body> res{http::status::not_modified, req.version()};
-    res.set(http::field::cache_control, "no-cache");
-    res.set(http::field::last_modified, modified);
-    res.keep_alive(keeps_alive(req));
-    // 304 has no body by definition: no Content-Length needed.
-    return res;
-  }
-  http::file_body::value_type body;
-  boost::beast::error_code ec;
-  body.open(path.c_str(), boost::beast::file_mode::scan, ec);
-  if (ec) return error_response(req, http::status::not_found, "cannot read /" + relative);
-  const auto size = body.size();
-  http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body)),
-                                      std::make_tuple(http::status::ok, req.version())};
-  res.set(http::field::content_type, content_type(relative));
-  // Revalidated on every load: after an upgrade the page and its scripts agree.
-  res.set(http::field::cache_control, "no-cache");
-  res.set(http::field::last_modified, modified);
-  secure_headers(res.base());
-  res.content_length(size);
-  res.keep_alive(keeps_alive(req));
-  if (req.method() == http::verb::head) {
-    http::response<http::empty_body> head{http::status::ok, req.version()};
-    head.base() = res.base();
-    return head;
-  }
-  return res;
-}
-
-// The path's segments decoded and checked like program names: no "..", no hidden files.
-std::optional<std::string> static_path(std::string_view path) {
-  std::string relative;
-  while (!path.empty()) {
-    path.remove_prefix(1);  // the '/'
-    const auto end = path.find('/');
-    const auto decoded = percent_decode(path.substr(0, end));
-    if (!decoded.ok() || !check_program_name(decoded.text).empty()) return std::nullopt;
-    relative += (relative.empty() ? "" : "/") + decoded.text;
-    path = end == std::string_view::npos ? std::string_view() : path.substr(end);
-  }
-  return relative;
 }
 
 json session_json(const Identity& who) {
@@ -248,36 +159,6 @@ http::message_generator download(App& app, const RequestHeader& req, std::string
 
 }  // namespace
 
-StringResponse json_response(const RequestHeader& req, http::status status, const json& body) {
-  StringResponse res{status, req.version()};
-  res.set(http::field::content_type, "application/json");
-  res.set(http::field::cache_control, "no-store");
-  secure_headers(res.base());
-  res.body() = body.dump(-1, ' ', false, json::error_handler_t::replace);
-  res.prepare_payload();
-  res.keep_alive(keeps_alive(req));
-  return res;
-}
-
-StringResponse error_response(const RequestHeader& req, http::status status,
-                              const std::string& message) {
-  return json_response(req, status, {{"error", message}});
-}
-
-bool keeps_alive(const RequestHeader& req) {
-  http::token_list connection{req[http::field::connection]};
-  return req.version() >= 11 ? !connection.exists("close") : connection.exists("keep-alive");
-}
-
-std::string_view target_path(const RequestHeader& req) {
-  const std::string_view target = req.target();
-  return target.substr(0, target.find('?'));
-}
-
-bool target_is(const RequestHeader& req, std::string_view path) {
-  return target_path(req) == path;
-}
-
 void handle_request(App& app, StringRequest&& req, const Peer& peer,
                     std::function<void(http::message_generator)> done) {
   const std::string_view path = target_path(req);
@@ -317,7 +198,7 @@ void handle_request(App& app, StringRequest&& req, const Peer& peer,
     return done(error_response(req, http::status::method_not_allowed, "GET only"));
   if (path == "/" || path == "/index.html") {
     if (!who) return done(redirect(req, "/login.html"));
-    return done(serve_file(app, req, "index.html"));
+    return done(serve_file(app.www_dir, req, "index.html"));
   }
   const auto relative = static_path(path);
   if (!relative) return done(error_response(req, http::status::not_found, "no such file"));
@@ -325,7 +206,7 @@ void handle_request(App& app, StringRequest&& req, const Peer& peer,
       std::find(kPublicFiles.begin(), kPublicFiles.end(), *relative) != kPublicFiles.end();
   if (!is_public && !who)
     return done(error_response(req, http::status::unauthorized, "log in first"));
-  done(serve_file(app, req, *relative));
+  done(serve_file(app.www_dir, req, *relative));
 }
 
 UploadCheck check_upload(App& app, const RequestHeader& req, const Peer& peer) {

@@ -10,25 +10,15 @@
 #include <boost/beast/http.hpp>
 
 #include "app.hpp"
+#include "http_common.hpp"
 
 namespace cncd::web {
-
-namespace http = boost::beast::http;
-using StringRequest = http::request<http::string_body>;
-using StringResponse = http::response<http::string_body>;
-using RequestHeader = http::request_header<>;
 
 // The connection a request came on.
 struct Peer {
   std::string address;  // remote IP address, as written in logs and the event log
   bool tls = false;
 };
-
-// A JSON answer {"error": message} (or `body` when given) with `status`.
-StringResponse json_response(const RequestHeader& req, http::status status,
-                             const nlohmann::json& body);
-StringResponse error_response(const RequestHeader& req, http::status status,
-                              const std::string& message);
 
 // The HTTP status a refused file operation is answered with.
 http::status status_of(FileError error);
@@ -53,12 +43,5 @@ struct UpgradeCheck {
   Identity identity;
 };
 UpgradeCheck check_upgrade(App& app, const RequestHeader& req, const Peer& peer);
-
-// True when the client keeps the connection after the answer (HTTP/1.1 unless "close").
-bool keeps_alive(const RequestHeader& req);
-// True when the target's path (without query) is `path`.
-bool target_is(const RequestHeader& req, std::string_view path);
-// The path of a request target, without the query.
-std::string_view target_path(const RequestHeader& req);
 
 }  // namespace cncd::web

@@ -3,8 +3,8 @@
 #pragma once
 
 #include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/steady_timer.hpp>
 
+#include "accept_loop.hpp"
 #include "app.hpp"
 
 namespace cncd::web {
@@ -13,16 +13,15 @@ class Listener {
  public:
   // Binds; throws boost::system::system_error naming the address when it cannot.
   explicit Listener(App& app);
-  void start();
-  void stop();
-  boost::asio::ip::tcp::endpoint endpoint() const { return acceptor_.local_endpoint(); }
+  void start() { loop_.start(); }
+  void stop() { loop_.stop(); }
+  boost::asio::ip::tcp::endpoint endpoint() const { return loop_.endpoint(); }
 
  private:
-  void accept_next();
+  void on_socket(boost::asio::ip::tcp::socket socket);
 
   App& app_;
-  boost::asio::ip::tcp::acceptor acceptor_;
-  boost::asio::steady_timer retry_;
+  AcceptLoop loop_;
 };
 
 }  // namespace cncd::web

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <chrono>
-#include <deque>
 #include <memory>
 #include <string>
 
@@ -19,6 +18,7 @@
 
 #include "app.hpp"
 #include "upstream.hpp"
+#include "ws_outbox.hpp"
 #include "ws_rpc.hpp"
 
 namespace cncd::web {
@@ -32,6 +32,7 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
         rpc_(app, std::move(who), address),
         address_(std::move(address)),
         session_id_(rpc_.identity().session.id),
+        out_(app.limits.ws_queue_bytes),
         kill_timer_(app.io) {
     ++app_.connections;
   }
@@ -111,28 +112,13 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
 
   void queue(const std::string& text) {
     if (closing_) return;
-    queued_bytes_ += text.size();
-    if (queued_bytes_ > app_.limits.ws_queue_bytes) {
+    if (!out_.push(text)) {
       spdlog::warn("{} at {}: WebSocket closed, {} bytes unread", rpc_.identity().user, address_,
-                   queued_bytes_);
+                   out_.bytes() + text.size());
       return shut("the client does not read what it is sent");
     }
-    out_.push_back(text);
-    if (!writing_) write_next();
-  }
-
-  void write_next() {
-    if (out_.empty() || closing_) return;
-    writing_ = true;
-    ws_.text(true);
-    ws_.async_write(boost::asio::buffer(out_.front()),
-                    [self = this->shared_from_this()](boost::beast::error_code ec, std::size_t) {
-                      self->writing_ = false;
-                      if (ec) return self->cleanup();
-                      self->queued_bytes_ -= self->out_.front().size();
-                      self->out_.pop_front();
-                      self->write_next();
-                    });
+    out_.pump(ws_, this->shared_from_this(),
+              [self = this->shared_from_this()](auto) { self->cleanup(); });
   }
 
   // Closes with `reason`; a client that does not take the close frame is cut off.
@@ -157,7 +143,8 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
   // was its session's last.
   void cleanup() {
     if (closing_) return;
-    closing_ = true;                      // out_ stays: a write may still be reading its front
+    closing_ = true;
+    out_.stop();
     if (!app_.peers.erase(this)) return;  // never accepted
     if (upstream_) {
       for (auto& line : rpc_.on_close())
@@ -179,9 +166,7 @@ class WsSession : public WsPeer, public std::enable_shared_from_this<WsSession<S
   std::string session_id_;
   boost::beast::http::request<boost::beast::http::empty_body> req_;
   boost::beast::flat_buffer in_;
-  std::deque<std::string> out_;
-  std::size_t queued_bytes_ = 0;
-  bool writing_ = false;
+  WsOutbox out_;
   bool closing_ = false;
   std::shared_ptr<client::Upstream> upstream_;
   boost::asio::steady_timer kill_timer_;
