@@ -32,30 +32,13 @@ MqttPublisher::~MqttPublisher() {
 }
 
 std::string MqttPublisher::start() {
-  static const int init = mosquitto_lib_init();
-  if (init != MOSQ_ERR_SUCCESS) return "libmosquitto: " + std::string(mosquitto_strerror(init));
-  mosq_ = mosquitto_new(nullptr, true, this);
-  if (mosq_ == nullptr) return "libmosquitto: cannot make a client";
-  mosquitto_int_option(mosq_, MOSQ_OPT_PROTOCOL_VERSION,
-                       options_.protocol == 5 ? MQTT_PROTOCOL_V5 : MQTT_PROTOCOL_V311);
-  if (!options_.username.empty() &&
-      mosquitto_username_pw_set(mosq_, options_.username.c_str(),
-                                options_.password.empty() ? nullptr : options_.password.c_str()) !=
-          MOSQ_ERR_SUCCESS) {
-    return "MQTT: the user name or password is not valid";
-  }
-  if (!options_.tls_ca.empty()) {
-    if (const int rc =
-            mosquitto_tls_set(mosq_, options_.tls_ca.c_str(), nullptr, nullptr, nullptr, nullptr);
-        rc != MOSQ_ERR_SUCCESS) {
-      return "MQTT: cannot use the CA file " + options_.tls_ca + ": " + mosquitto_strerror(rc);
-    }
-  }
+  std::string error;
+  mosq_ = new_client(options_.broker, this, error);
+  if (mosq_ == nullptr) return error;
   const std::string will = "offline";
   const std::string availability = options_.prefix + "/availability";
   mosquitto_will_set(mosq_, availability.c_str(), static_cast<int>(will.size()), will.data(), 1,
                      true);
-  mosquitto_reconnect_delay_set(mosq_, 1, 60, true);
   // libmosquitto's thread calls these; the work is done on the io_context's.
   mosquitto_connect_callback_set(mosq_, [](mosquitto*, void* self, int rc) {
     auto* me = static_cast<MqttPublisher*>(self);
@@ -86,13 +69,8 @@ std::string MqttPublisher::start() {
       if (*alive) me->on_publish(mid);
     });
   });
-  // A broker that is not there yet is tried again by the loop; only bad options fail here.
-  if (const int rc = mosquitto_connect_async(mosq_, options_.host.c_str(), options_.port, 30);
-      rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO) {
-    return std::string("MQTT: cannot connect: ") + mosquitto_strerror(rc);
-  }
-  if (const int rc = mosquitto_loop_start(mosq_); rc != MOSQ_ERR_SUCCESS)
-    return std::string("MQTT: ") + mosquitto_strerror(rc);
+  if (auto problem = connect_in_background(mosq_, options_.broker); !problem.empty())
+    return problem;
   started_ = true;
   return "";
 }
@@ -194,7 +172,7 @@ void MqttPublisher::stop() {
   if (connected_) publish(options_.prefix + "/availability", "offline", 1, true);
   // MQTT 5 can say so: the broker then publishes the will as well, should the "offline"
   // above not have gone out before the disconnect.
-  if (options_.protocol == 5) {
+  if (options_.broker.protocol == 5) {
     mosquitto_disconnect_v5(mosq_, 4, nullptr);
   } else {
     mosquitto_disconnect(mosq_);

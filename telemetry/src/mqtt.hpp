@@ -16,17 +16,14 @@
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
 
+#include "mqtt_client.hpp"
+
 struct mosquitto;
 
 namespace cncd::telemetry {
 
 struct MqttOptions {
-  std::string host;  // empty: no MQTT
-  int port = 1883;
-  std::string username;
-  std::string password;
-  std::string tls_ca;  // a CA file: TLS; empty: plain TCP
-  int protocol = 5;    // 5 or 311
+  BrokerOptions broker;
   std::string prefix;  // topics are prefix + "/state" ...
   std::size_t queue = 10000;
 };
