@@ -1,5 +1,8 @@
 // [TELEMETRY]: the part count the daemon's job history keeps, and cncd-telemetry's keys (the
 // daemon reads them too: one file, checked whole).
+#include <unistd.h>
+
+#include <algorithm>
 #include <string>
 
 #include "loader.hpp"
@@ -84,6 +87,43 @@ void load_topic_prefix(TypedReader& r, TelemetryConfig& t) {
   t.topic_prefix = given;
 }
 
+// The machine's own dashboard as the fleet page links it: given, "off", or cncd-web's address
+// from [WEB] when the INI has that section (a wildcard LISTEN: this host's name).
+void load_dashboard_url(TypedReader& r, const MachineConfig& c, TelemetryConfig& t) {
+  const std::string given = value(r, "DASHBOARD_URL");
+  if (given == "off") return;
+  if (!given.empty()) {
+    const bool scheme = given.starts_with("http://") || given.starts_with("https://");
+    const bool clean = std::none_of(given.begin(), given.end(), [](char ch) {
+      return static_cast<unsigned char>(ch) <= ' ' || ch == '"' || ch == '<' || ch == '>' ||
+             ch == '\\' || ch == 0x7f;
+    });
+    if (!scheme || !clean || given.size() > 1024) {
+      r.problem("TELEMETRY", "DASHBOARD_URL",
+                "'" + printable(given) +
+                    "' is not an http:// or https:// URL without blanks, quotes or <> (e.g. "
+                    "http://mill-1.shop:8080/), nor off");
+      return;
+    }
+    t.dashboard_url = given;
+    return;
+  }
+  const auto& entries = r.ini().entries();
+  if (std::none_of(entries.begin(), entries.end(),
+                   [](const auto& entry) { return entry.section == "WEB"; })) {
+    return;
+  }
+  std::string host = c.web.listen;
+  if (host == "0.0.0.0" || host == "::") {
+    char name[256] = {};
+    host = ::gethostname(name, sizeof name - 1) == 0 && name[0] != '\0' ? name : "localhost";
+  } else if (host.find(':') != std::string::npos) {
+    host = "[" + host + "]";
+  }
+  t.dashboard_url = std::string(c.web.tls_cert.empty() ? "http://" : "https://") + host + ":" +
+                    std::to_string(c.web.port) + "/";
+}
+
 }  // namespace
 
 void load_telemetry(TypedReader& r, MachineConfig& c) {
@@ -110,6 +150,7 @@ void load_telemetry(TypedReader& r, MachineConfig& c) {
   load_topic_prefix(r, t);
   if (const auto v = r.real("TELEMETRY", "POSITION_HZ")) t.position_hz = *v;
   if (const auto v = r.integer("TELEMETRY", "EVENT_QUEUE")) t.event_queue = static_cast<int>(*v);
+  load_dashboard_url(r, c, t);
   refuse_unknown_keys(r, "TELEMETRY", "cncd's telemetry section");
 }
 

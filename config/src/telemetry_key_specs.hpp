@@ -40,6 +40,10 @@ constexpr std::array kTelemetryKeys{
     integer_key("TELEMETRY", "EVENT_QUEUE", "10000", 1, 10000000, "",
                 "cncd-telemetry: events and jobs kept while the broker is away; beyond, the "
                 "oldest are dropped, counted and logged"),
+    text_key("TELEMETRY", "DASHBOARD_URL", "",
+             "cncd-telemetry: the machine's own dashboard as the fleet page links it (http:// or "
+             "https://); empty: cncd-web's address from [WEB] when the INI has that section; "
+             "off: none"),
 };
 
 }  // namespace cncd::config

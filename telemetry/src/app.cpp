@@ -45,12 +45,7 @@ std::string App::start(const Endpoints& e) {
   }
   if (!config_.mqtt_host.empty()) {
     MqttOptions options;
-    options.host = config_.mqtt_host;
-    options.port = config_.mqtt_port;
-    options.username = config_.mqtt_username;
-    options.password = config_.mqtt_password;
-    options.tls_ca = config_.mqtt_tls_ca.string();
-    options.protocol = config_.mqtt_protocol;
+    options.broker = broker_options(config_);
     options.prefix = config_.topic_prefix;
     options.queue = static_cast<std::size_t>(config_.event_queue);
     mqtt_ = std::make_unique<MqttPublisher>(io_, options);
@@ -79,7 +74,7 @@ void App::on_status() {
 // Only when something in it changed: a position moving is not a new state.
 void App::publish_state() {
   if (!mqtt_) return;
-  json state = state_payload(feed_, config_.machine_id, last_error_);
+  json state = state_payload(feed_, config_.machine_id, last_error_, config_.dashboard_url);
   if (state == last_state_) return;
   last_state_ = state;
   state["time"] = unix_time();
@@ -100,6 +95,7 @@ void App::on_event(const json& event) {
 
 void App::on_jobs() {
   if (shdr_on_) shdr_.changed();
+  publish_state();  // the part count
   const json& job = feed_.last_job();
   const bool known = job.is_object() && job.contains("id");
   if (jobs_told_ < 0) {

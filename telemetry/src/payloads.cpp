@@ -24,10 +24,12 @@ double unix_time() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-json state_payload(const MachineFeed& feed, const std::string& machine_id, const json& last_error) {
+json state_payload(const MachineFeed& feed, const std::string& machine_id, const json& last_error,
+                   const std::string& dashboard) {
   const json& s = feed.status();
+  const json link = dashboard.empty() ? json(nullptr) : json(dashboard);
   if (!feed.connected() || !s.contains("state"))
-    return {{"machine", machine_id}, {"cncd", "unreachable"}};
+    return {{"machine", machine_id}, {"cncd", "unreachable"}, {"dashboard", link}};
   const json& program = object_at(s, "program");
   const json& spindle = object_at(s, "spindle");
   const json& tool = object_at(s, "tool");
@@ -52,7 +54,9 @@ json state_payload(const MachineFeed& feed, const std::string& machine_id, const
           {"overrides", object_at(s, "overrides")},
           {"wait", s.contains("wait") ? s["wait"] : json(nullptr)},
           {"fault", text_at(s, "fault")},
-          {"last_error", last_error}};
+          {"last_error", last_error},
+          {"parts", number_or_null(feed.jobs(), "parts")},
+          {"dashboard", link}};
 }
 
 json position_payload(const MachineFeed& feed, const std::string& machine_id) {

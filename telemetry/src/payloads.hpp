@@ -10,9 +10,10 @@
 
 namespace cncd::telemetry {
 
-// .../state: without "time", so that two can be compared for a change.
+// .../state: without "time", so that two can be compared for a change. `dashboard`: the
+// machine's own page ([TELEMETRY] DASHBOARD_URL), "" for none.
 nlohmann::json state_payload(const MachineFeed& feed, const std::string& machine_id,
-                             const nlohmann::json& last_error);
+                             const nlohmann::json& last_error, const std::string& dashboard);
 nlohmann::json position_payload(const MachineFeed& feed, const std::string& machine_id);
 // .../events and .../job: cncd's event or job row with the machine's id.
 nlohmann::json with_machine(nlohmann::json payload, const std::string& machine_id);

@@ -1,6 +1,7 @@
 // [TELEMETRY]: the job history's part count and cncd-telemetry's keys, their defaults and what
 // is refused.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <string>
 #include <vector>
@@ -114,6 +115,30 @@ TEST_F(TelemetryConfigTest, BadValuesAreRefusedNamingTheKey) {
   EXPECT_EQ(problem("TOPIC_PREFX = x\n"),
             "[TELEMETRY] TOPIC_PREFX: unknown key in cncd's telemetry section; did you mean "
             "TOPIC_PREFIX?");
+}
+
+// The fleet page links each machine's own dashboard: given, off, or cncd-web's from [WEB].
+TEST_F(TelemetryConfigTest, DashboardUrlIsGivenOrCncdWebs) {
+  const auto url = [&](const std::string& text) {
+    const auto result = load(text);
+    EXPECT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+    return result.ok() ? result.config->telemetry.dashboard_url : std::string("?");
+  };
+  EXPECT_EQ(url(""), "");
+  EXPECT_EQ(url("DASHBOARD_URL = https://mill-1.shop/cnc/\n"), "https://mill-1.shop/cnc/");
+  EXPECT_EQ(url("[WEB]\nLISTEN = 127.0.0.1\nPORT = 8081\n"), "http://127.0.0.1:8081/");
+  EXPECT_EQ(url("[WEB]\nLISTEN = ::1\n"), "http://[::1]:8080/");
+  EXPECT_EQ(url("DASHBOARD_URL = off\n[WEB]\nLISTEN = 127.0.0.1\n"), "");
+  char host[256] = {};
+  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+  EXPECT_EQ(url("[WEB]\nLISTEN = 0.0.0.0\nPORT = 80\n"), "http://" + std::string(host) + ":80/");
+  for (const std::string bad : {"javascript:alert(1)", "http://a b/", "ftp://x/", "http://x/\"<"}) {
+    EXPECT_EQ(problem("DASHBOARD_URL = " + bad + "\n"),
+              "[TELEMETRY] DASHBOARD_URL: '" + bad +
+                  "' is not an http:// or https:// URL without blanks, quotes or <> (e.g. "
+                  "http://mill-1.shop:8080/), nor off")
+        << bad;
+  }
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ class MqttTest : public TelemetryTest {
   void configure_mqtt(int port, const std::string& more = "") {
     std::ofstream(ini_, std::ios::trunc)
         << base_ini_ << "\n[TELEMETRY]\nMACHINE_ID = mill-1\nMQTT_HOST = 127.0.0.1\n"
-        << "MQTT_PORT = " << port << "\n"
+        << "MQTT_PORT = " << port << "\nDASHBOARD_URL = http://mill-1.shop:8080/\n"
         << more;
   }
   // cncd-telemetry started again on the INI as it is now.
@@ -136,6 +136,9 @@ TEST_F(MqttTest, ARunGivesItsEventsInOrderAndOneJob) {
   expect_no_gap(seqs);
   EXPECT_TRUE(sub.got("/events", "first"));
   EXPECT_TRUE(sub.got("/events", "second"));
+  // The fleet page's part count and link come with the state.
+  EXPECT_TRUE(sub.got("/state", "\"parts\":1"));
+  EXPECT_TRUE(sub.got("/state", "\"dashboard\":\"http://mill-1.shop:8080/\""));
 }
 
 TEST_F(MqttTest, AKilledTelemetryLeavesItsLastWill) {

@@ -228,6 +228,8 @@ struct TelemetryConfig {
   std::string topic_prefix;
   double position_hz = 5;
   int event_queue = 10000;
+  // The machine's own dashboard, published in the state for the fleet page; "" = none.
+  std::string dashboard_url;
 };
 
 struct WebConfig {
