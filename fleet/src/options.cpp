@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -45,7 +46,8 @@ std::string usage() {
          "  --ini MACHINE.ini         take the broker and credentials from its [TELEMETRY]\n"
          "  --broker HOST[:PORT]      the MQTT broker (default 127.0.0.1:1883)\n"
          "  --username NAME           the broker's user name\n"
-         "  --password-file FILE      the broker's password, the file's first line\n"
+         "  --password-file FILE      the broker's password, the file's first line (default\n"
+         "                            $CREDENTIALS_DIRECTORY/mqtt-password when it exists)\n"
          "  --tls-ca FILE             a CA certificate: the broker is reached over TLS\n"
          "  --protocol 5|3.1.1        the MQTT version (default 5)\n"
          "  --topics PATTERN          machines' topic prefixes, '+' a level (default cncd/+)\n"
@@ -145,6 +147,12 @@ Parsed parse_options(const std::vector<std::string>& args) {
   if (!username.empty()) o.broker.username = username;
   if (!tls_ca.empty()) o.broker.tls_ca = tls_ca;
   if (!protocol.empty()) o.broker.protocol = protocol == "5" ? 5 : 311;
+  // systemd's LoadCredential=mqtt-password:FILE, when no file is named.
+  if (const char* credentials = std::getenv("CREDENTIALS_DIRECTORY");
+      password_file.empty() && credentials != nullptr &&
+      std::filesystem::exists(std::filesystem::path(credentials) / "mqtt-password")) {
+    password_file = (std::filesystem::path(credentials) / "mqtt-password").string();
+  }
   if (!password_file.empty()) {
     std::ifstream in(password_file);
     std::string line;

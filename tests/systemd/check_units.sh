@@ -6,7 +6,7 @@ if ! command -v systemd-analyze >/dev/null; then
   echo "systemd-analyze not installed: skipped"
   exit 77
 fi
-for service in cncd.service cncd-web.service cncd-telemetry.service; do
+for service in cncd.service cncd-web.service cncd-telemetry.service cncd-fleet.service; do
   report=$(systemd-analyze security --offline=true --no-pager "$units/$service")
   score=$(printf '%s\n' "$report" | sed -n "s/.*Overall exposure level for $service: \\([0-9.]*\\).*/\\1/p")
   echo "$service exposure: ${score:-unknown}"
@@ -19,3 +19,5 @@ grep -q '^Type=notify$' "$units/cncd.service"
 grep -q '^Requires=cncd.socket$' "$units/cncd-web.service"
 grep -q '^After=cncd.socket' "$units/cncd-web.service"
 grep -q '^Requires=cncd.socket$' "$units/cncd-telemetry.service"
+# cncd-fleet reads the broker only: it has nothing to do with cncd's socket.
+! grep -qF 'cncd.socket' "$units/cncd-fleet.service"
