@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
   const int broker_port = free_port();
   std::ofstream(dir / "mosquitto.conf")
       << "listener " << broker_port << " 127.0.0.1\nallow_anonymous true\n"
-      << "persistence false\nmax_queued_messages 100000\n";
+      << "persistence false\nmax_queued_messages 100000\nset_tcp_nodelay true\n";
   const pid_t broker = spawn({"/usr/sbin/mosquitto", "-c", (dir / "mosquitto.conf").string()},
                              (dir / "mosquitto.log").string());
   wait_listening(broker_port, "mosquitto");

@@ -31,7 +31,7 @@ std::string Subscriber::start() {
     auto* me = static_cast<Subscriber*>(self);
     if (rc == 0) {
       for (const auto& filter : me->filters_)
-        mosquitto_subscribe(m, nullptr, filter.c_str(), 1);
+        mosquitto_subscribe(m, nullptr, filter.c_str(), 0);
     }
     boost::asio::post(me->io_, [me, alive = me->alive_, rc] {
       if (!*alive) return;
