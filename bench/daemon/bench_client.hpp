@@ -118,6 +118,27 @@ inline void write_program(const std::filesystem::path& path, long lines) {
   out << "M2\n";
 }
 
+// Starts args[0] with the rest as its arguments, its output to `log` when given; its pid.
+inline pid_t spawn_process(std::vector<std::string> args, const std::string& log = "") {
+  std::vector<char*> argv;
+  for (auto& arg : args)
+    argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!log.empty()) {
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (fd >= 0) {
+        dup2(fd, 1);
+        dup2(fd, 2);
+      }
+    }
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
 // Starts cncd on `dir`/sim_mm.ini with `args` added to its command line; returns its pid.
 // $CNCD_BENCH_BINARY names another cncd to run (an older build, to compare).
 inline pid_t start_cncd(const std::filesystem::path& dir, const std::string& sock,
@@ -126,16 +147,7 @@ inline pid_t start_cncd(const std::filesystem::path& dir, const std::string& soc
   const char* other = std::getenv("CNCD_BENCH_BINARY");
   const std::string binary = other != nullptr && *other != '\0' ? other : CNCD_BINARY;
   args.insert(args.begin(), {binary, "--ini", ini, "--socket", sock});
-  std::vector<char*> argv;
-  for (auto& arg : args)
-    argv.push_back(arg.data());
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
+  return spawn_process(std::move(args));
 }
 
 // A connection to the daemon at `sock`, waiting up to 10 s for it to listen; exits without.

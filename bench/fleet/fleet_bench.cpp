@@ -29,6 +29,8 @@
 #include <thread>
 #include <vector>
 
+#include "../daemon/bench_client.hpp"
+
 namespace {
 
 using nlohmann::json;
@@ -61,20 +63,7 @@ int free_port() {
 }
 
 pid_t spawn(std::vector<std::string> args, const std::string& log) {
-  std::vector<char*> argv;
-  for (auto& arg : args)
-    argv.push_back(arg.data());
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::FILE* out = std::fopen(log.c_str(), "w");
-    if (out != nullptr) {
-      dup2(fileno(out), 1);
-      dup2(fileno(out), 2);
-    }
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
+  const pid_t pid = cncd::bench::spawn_process(std::move(args), log);
   children.push_back(pid);
   return pid;
 }

@@ -26,7 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "web"))
 
 from browser_fixture import Browser, require_browser  # noqa: E402
-from web_fixture import Machine, free_port, skip, wait_until  # noqa: E402
+from web_fixture import Machine, Rpc, StatusWatcher, free_port, skip, wait_until  # noqa: E402
 
 MOSQUITTO = "/usr/sbin/mosquitto"
 # About a minute at F100 on the sim mill: it is still running when the page is read.
@@ -57,22 +57,8 @@ class FleetMachine(Machine):
                     f"MQTT_PORT = {self.broker_port}\nMETRICS_LISTEN = off\nSHDR_PORT = 0\n"
                     "POSITION_HZ = 0\n")
 
-    def start_cncd(self):
-        self.cncd = self._spawn("cncd", [self.args.cncd, "--ini", self.ini, "--state-dir",
-                                         self.state, "--socket", self.sock])
-
     def start_telemetry(self):
-        from web_fixture import Rpc, StatusWatcher
-
-        def daemon_up():
-            if self.cncd.poll() is not None:
-                raise AssertionError(f"cncd exited {self.cncd.returncode}:\n{self.log('cncd')}")
-            try:
-                Rpc(self.sock).close()
-                return True
-            except OSError:
-                return False
-        wait_until(daemon_up, 60, f"{self.name}'s cncd socket")
+        self.wait_daemon(60)  # three debug daemons start at once
         self.telemetry = self._spawn("cncd-telemetry", [self.args.cncd_telemetry, "--ini",
                                                         self.ini, "--socket", self.sock])
         self.status = StatusWatcher(self.sock)
@@ -153,7 +139,7 @@ def main():
     try:
         machines = [FleetMachine(args, f"mill-{i}", broker_port) for i in (1, 2, 3)]
         for m in machines:
-            m.start_cncd()
+            m.spawn_daemon()  # all three start at once
         for m in machines:
             m.start_telemetry()
         running, estop, offline = machines

@@ -224,19 +224,24 @@ class Machine:
         except OSError:
             return ""
 
-    def start(self):
-        cncd = self._spawn("cncd", [self.args.cncd, "--ini", self.ini, "--state-dir",
-                                    self.state, "--socket", self.sock])
+    def spawn_daemon(self):
+        self.cncd = self._spawn("cncd", [self.args.cncd, "--ini", self.ini, "--state-dir",
+                                         self.state, "--socket", self.sock])
 
+    def wait_daemon(self, timeout=30):
         def daemon_up():
-            if cncd.poll() is not None:
-                raise AssertionError(f"cncd exited {cncd.returncode}:\n{self.log('cncd')}")
+            if self.cncd.poll() is not None:
+                raise AssertionError(f"cncd exited {self.cncd.returncode}:\n{self.log('cncd')}")
             try:
                 Rpc(self.sock).close()
                 return True
             except OSError:
                 return False
-        wait_until(daemon_up, 30, "cncd's socket")
+        wait_until(daemon_up, timeout, "cncd's socket")
+
+    def start(self):
+        self.spawn_daemon()
+        self.wait_daemon()
         web = self._spawn("cncd-web", [self.args.cncd_web, "--ini", self.ini,
                                        "--socket", self.sock])
 
