@@ -14,6 +14,7 @@ $CNCD_FLEET_SCREENSHOT, when set, names a file the page's screenshot is copied t
 import argparse
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -150,7 +151,9 @@ def main():
         running.status.wait(lambda s: s["program"]["path"].endswith("long.ngc")
                             and not s["program"]["opening"], 60, "long.ngc open")
         running.rpc.call("program.run")
-        running.status.wait(lambda s: s["exec"] == "running", 60, "mill-1 running")
+        running.status.wait(lambda s: s["exec"] == "running"
+                            and s["program"].get("remaining_s") is not None, 60,
+                            "mill-1 running, its time left estimated")
 
         port = free_port()
         fleet = subprocess.Popen([args.cncd_fleet, "--broker", f"127.0.0.1:{broker_port}",
@@ -158,14 +161,15 @@ def main():
                                  stdout=open(fleet_log, "wb"), stderr=subprocess.STDOUT)
         browser = Browser(1280, 720)
         browser.driver.get(f"http://127.0.0.1:{port}/")
-        r1 = wait_row(browser, "mill-1", lambda r: r["status"] == "running" and r["progress"],
-                      "running with its progress")
+        r1 = wait_row(browser, "mill-1", lambda r: r["status"] == "running" and r["progress"]
+                      and r["remaining"], "running with its progress and time left")
         r2 = wait_row(browser, "mill-2", lambda r: r["status"] == "estop", "in estop")
         wait_row(browser, "mill-3", lambda r: r["online"] == "online", "online")
         print("mill-1:", r1, "\nmill-2:", r2, flush=True)
         assert r1["online"] == "online" and r1["state"] == "running", r1
         assert r1["program"] == "long.ngc", r1
         assert r1["progress"].endswith("%"), r1
+        assert re.fullmatch(r"\d+:\d\d", r1["remaining"]), r1
         assert r1["link"] == f"http://127.0.0.1:{running.port}/", (r1, running.port)
         assert r2["online"] == "online" and r2["state"] == "estop", r2
         assert r2["link"] == f"http://127.0.0.1:{estop.port}/", r2
