@@ -66,8 +66,9 @@ class FleetMachine(Machine):
         self.rpc = Rpc(self.sock)
 
 
-def mqtt_publish(port, topic, payload):
-    """One retained QoS 0 message through a minimal MQTT 3.1.1 client (no library needed)."""
+def mqtt_publish(port, messages):
+    """Retained QoS 0 messages, [(topic, payload)], through a minimal MQTT 3.1.1 client (no
+    library needed)."""
     def string(text):
         data = text.encode()
         return struct.pack(">H", len(data)) + data
@@ -83,7 +84,8 @@ def mqtt_publish(port, topic, payload):
         s.sendall(packet(0x10, string("MQTT") + bytes([4, 2]) + struct.pack(">H", 30) +
                          string("fleet-test")))
         assert s.recv(4)[:2] == b"\x20\x02", "no CONNACK"
-        s.sendall(packet(0x31, string(topic) + payload.encode()))
+        s.sendall(b"".join(packet(0x31, string(topic) + payload.encode())
+                           for topic, payload in messages))
         s.sendall(b"\xe0\x00")  # DISCONNECT
 
 
@@ -191,11 +193,11 @@ def main():
         if os.environ.get("CNCD_FLEET_SCREENSHOT"):
             shutil.copy(shot, os.environ["CNCD_FLEET_SCREENSHOT"])
 
-        mqtt_publish(broker_port, "cncd/intruder/state", json.dumps({
+        mqtt_publish(broker_port, [("cncd/intruder/state", json.dumps({
             "machine": HOSTILE, "cncd": "connected", "state": "on", "exec": "idle",
             "program": {"path": "<img src=y onerror=window.fleetXss=2>"},
             "dashboard": "javascript:window.fleetXss=3",
-            "last_error": {"seq": 1, "time": 1795913600, "message": "<b onmouseover=x>bold</b>"}}))
+            "last_error": {"seq": 1, "time": 1795913600, "message": "<b onmouseover=x>bold</b>"}}))])
 
 
         intruder = wait_row(browser, HOSTILE, lambda r: True, "shown as text")
@@ -204,6 +206,14 @@ def main():
         assert intruder["program"] == "<img src=y onerror=window.fleetXss=2>", intruder
         assert "<b onmouseover=x>bold</b>" in intruder["alarm"], intruder
         assert browser.driver.execute_script("return window.fleetXss") is None, "markup ran"
+
+        # A thousand more machines at once: the page takes them all and goes on.
+        mqtt_publish(broker_port, [(f"cncd/load-{i:04}/state", json.dumps({
+            "machine": f"load-{i:04}", "cncd": "connected", "state": "on", "exec": "running",
+            "program": {"path": "/x.ngc", "progress": i / 1000}})) for i in range(1000)])
+        browser.wait(lambda: browser.text("#count-machines") == "1004", "1004 machines counted")
+        wait_row(browser, "load-0999", lambda r: r["status"] == "running", "running")
+        wait_row(browser, "mill-1", lambda r: r["status"] == "running", "still running")
         print("fleet page: three machines shown as they are; screenshot", shot)
     finally:
         if browser is not None:
