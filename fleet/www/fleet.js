@@ -99,7 +99,8 @@ function fill(entry, m) {
   c.parts.textContent = typeof m.parts === 'number' ? String(m.parts) : '';
   const alarm = m.alarm;
   if (alarm && typeof alarm.message === 'string') {
-    c.alarm.replaceChildren(el('span', 'when', clock(alarm.time)), el('span', 'text', alarm.message));
+    c.alarm.replaceChildren(el('span', 'when', clock(alarm.time)),
+                            el('span', 'text', alarm.message));
     c.alarm.title = alarm.message;
   } else {
     c.alarm.replaceChildren();
@@ -153,7 +154,8 @@ function setLink(state, text) {
 
 let retry = 1000;
 function connect() {
-  const ws = new WebSocket((location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws');
+  const scheme = location.protocol === 'https:' ? 'wss://' : 'ws://';
+  const ws = new WebSocket(scheme + location.host + '/ws');
   ws.onopen = () => { retry = 1000; };
   ws.onmessage = e => {
     const msg = JSON.parse(e.data);

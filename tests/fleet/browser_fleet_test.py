@@ -197,7 +197,8 @@ def main():
             "machine": HOSTILE, "cncd": "connected", "state": "on", "exec": "idle",
             "program": {"path": "<img src=y onerror=window.fleetXss=2>"},
             "dashboard": "javascript:window.fleetXss=3",
-            "last_error": {"seq": 1, "time": 1795913600, "message": "<b onmouseover=x>bold</b>"}}))])
+            "last_error": {"seq": 1, "time": 1795913600,
+                           "message": "<b onmouseover=x>bold</b>"}}))])
 
 
         intruder = wait_row(browser, HOSTILE, lambda r: True, "shown as text")
