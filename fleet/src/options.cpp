@@ -117,6 +117,8 @@ Parsed parse_options(const std::vector<std::string>& args) {
     const std::string& value = args[++i];
     if (!it->second(value)) {
       if (arg == "--topics") return fail(check_pattern(value));
+      if (arg == "--listen")
+        return fail("'" + value + "' is not ADDRESS:PORT (e.g. 127.0.0.1:8090, [::1]:8090)");
       return fail("'" + value + "' is not a valid value for " + arg);
     }
   }

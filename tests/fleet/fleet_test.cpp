@@ -192,5 +192,22 @@ TEST_F(FleetTest, AWebSocketFromAnotherSiteIsRefused) {
   EXPECT_EQ(own.next()["type"], "snapshot");
 }
 
+TEST_F(FleetTest, BadOptionsAreRefusedNamingWhatIsWrong) {
+  const auto run = [](std::vector<std::string> args) {
+    args.insert(args.begin(), CNCD_FLEET_BINARY);
+    BackgroundCommand fleet(args);
+    return fleet.wait();
+  };
+  auto r = run({"--topics", "cncd/#"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("'cncd/#' is not a topic pattern"), std::string::npos) << r.err;
+  r = run({"--listen", "localhost"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("'localhost' is not ADDRESS:PORT"), std::string::npos) << r.err;
+  r = run({"--max-machines", "0"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("'0' is not a valid value for --max-machines"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace cncd::test
