@@ -1,18 +1,21 @@
 // cncd-fleet: every machine that publishes to an MQTT broker on one page (docs/fleet.md). It
 // reads the broker only (the state, availability and events cncd-telemetry publishes); it
 // never talks to a machine.
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "accept_loop.hpp"
+#include "client_start.hpp"
 #include "fleet_app.hpp"
 #include "logging.hpp"
-#include "run_until_signal.hpp"
 #include "sessions.hpp"
 #include "subscriber.hpp"
 #include "version.hpp"
@@ -78,10 +81,13 @@ int main(int argc, char** argv) {
     listener.start();
     spdlog::info("cncd-fleet {} serving http://{}:{} for the machines under {}", cncd::kVersion,
                  options.listen_address, listener.endpoint().port(), options.pattern);
-    cncd::web::run_until_signal(io, [&] {
+    cncd::daemon::run_until_signal(io, [&] {
       listener.stop();
       subscriber.stop();
       app.close_all("cncd-fleet is shutting down");
+      // The WebSockets' close frames go out, then the loop ends.
+      auto timer = std::make_shared<boost::asio::steady_timer>(io, std::chrono::milliseconds(300));
+      timer->async_wait([&io, timer](const boost::system::error_code&) { io.stop(); });
     });
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
