@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "logging.hpp"
 #include "version.hpp"
@@ -61,12 +62,17 @@ ClientStart start_client(int argc, char** argv, const char* program, void (*usag
   return out;
 }
 
-void run_until_signal(boost::asio::io_context& io, const std::function<void()>& stop) {
+void run_until_signal(boost::asio::io_context& io, const std::function<void()>& stop,
+                      std::chrono::milliseconds linger) {
   boost::asio::signal_set signals(io, SIGTERM, SIGINT);
+  boost::asio::steady_timer last(io);
   signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
     spdlog::info("signal {}: shutting down", signal);
     stop();
+    if (linger.count() == 0) return;
+    last.expires_after(linger);
+    last.async_wait([&io](const boost::system::error_code&) { io.stop(); });
   });
   io.run();
 }

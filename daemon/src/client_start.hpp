@@ -3,6 +3,7 @@
 // and the loop that serves until a signal.
 #pragma once
 
+#include <chrono>
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -32,8 +33,10 @@ using ClientOption = std::function<int(const std::string& arg, const char* next)
 ClientStart start_client(int argc, char** argv, const char* program, void (*usage)(std::FILE*),
                          const ClientOption& own);
 
-// Runs `io` until SIGTERM or SIGINT, which is logged and calls `stop`: that ends the loop, at
-// once or once what it starts is done.
-void run_until_signal(boost::asio::io_context& io, const std::function<void()>& stop);
+// Runs `io` until SIGTERM or SIGINT, which is logged and calls `stop`. With `linger` 0, `stop`
+// ends the loop itself; else the loop is stopped that long after (the close frames of
+// WebSockets `stop` closed go out meanwhile).
+void run_until_signal(boost::asio::io_context& io, const std::function<void()>& stop,
+                      std::chrono::milliseconds linger = std::chrono::milliseconds(0));
 
 }  // namespace cncd::daemon

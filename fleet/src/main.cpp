@@ -10,7 +10,6 @@
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
 
 #include "accept_loop.hpp"
 #include "client_start.hpp"
@@ -81,14 +80,14 @@ int main(int argc, char** argv) {
     listener.start();
     spdlog::info("cncd-fleet {} serving http://{}:{} for the machines under {}", cncd::kVersion,
                  options.listen_address, listener.endpoint().port(), options.pattern);
-    cncd::daemon::run_until_signal(io, [&] {
-      listener.stop();
-      subscriber.stop();
-      app.close_all("cncd-fleet is shutting down");
-      // The WebSockets' close frames go out, then the loop ends.
-      auto timer = std::make_shared<boost::asio::steady_timer>(io, std::chrono::milliseconds(300));
-      timer->async_wait([&io, timer](const boost::system::error_code&) { io.stop(); });
-    });
+    cncd::daemon::run_until_signal(
+        io,
+        [&] {
+          listener.stop();
+          subscriber.stop();
+          app.close_all("cncd-fleet is shutting down");
+        },
+        std::chrono::milliseconds(300));  // the WebSockets' close frames go out
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;

@@ -77,15 +77,16 @@ int main(int argc, char** argv) {
     spdlog::info("cncd-web {} serving {}://{}:{} for cncd at {} (programs in {})", cncd::kVersion,
                  app.tls ? "https" : "http", app.web.listen, listener.endpoint().port(),
                  app.socket_path, app.programs.path().string());
-    cncd::daemon::run_until_signal(io, [&] {
-      listener.stop();
-      watch.stop();
-      for (auto* peer : std::vector(app.peers.begin(), app.peers.end()))
-        peer->close_with("cncd-web is shutting down");
-      // The WebSockets' close frames and their jog stops go out, then the loop ends.
-      auto timer = std::make_shared<boost::asio::steady_timer>(io, std::chrono::milliseconds(300));
-      timer->async_wait([&io, timer](const boost::system::error_code&) { io.stop(); });
-    });
+    // The WebSockets' close frames and their jog stops go out, then the loop ends.
+    cncd::daemon::run_until_signal(
+        io,
+        [&] {
+          listener.stop();
+          watch.stop();
+          for (auto* peer : std::vector(app.peers.begin(), app.peers.end()))
+            peer->close_with("cncd-web is shutting down");
+        },
+        std::chrono::milliseconds(300));
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;
