@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libmodbus-dev libgpiod-dev libspdlog-dev
           nlohmann-json3-dev libssl-dev libsystemd-dev libgtest-dev clang-14 libclang-rt-14-dev ccache
           libboost1.81-dev libargon2-dev libsqlite3-dev libjs-three
-          libmosquitto-dev python3-prometheus-client)
+          libmosquitto-dev python3-prometheus-client python3-jsonschema)
 for option in "$@"; do
   case "$option" in
     # LinuxCNC's standalone interpreter, used by the differential tests when present.

@@ -82,6 +82,37 @@ class MqttTest : public TelemetryTest {
     for (std::size_t i = 1; i < seqs.size(); ++i)
       EXPECT_EQ(seqs[i], seqs[i - 1] + 1) << "at " << i;
   }
+  // Validates the payloads against docs/telemetry-schemas.json (python3-jsonschema); the
+  // count of payloads by topic, empty on a failure (which fails the test).
+  json schema_check(const std::vector<Message>& messages) {
+    static constexpr const char* kCheck = R"(
+import json, sys
+from jsonschema import Draft202012Validator
+schemas = json.load(open(sys.argv[1]))
+Draft202012Validator.check_schema(schemas)
+seen = {}
+for line in open(sys.argv[2]):
+    m = json.loads(line)
+    topic = m["topic"].rsplit("/", 1)[1]
+    if topic == "availability":
+        continue
+    name = {"events": "event"}.get(topic, topic)
+    v = Draft202012Validator({"$ref": "#/$defs/" + name, "$defs": schemas["$defs"]})
+    for e in v.iter_errors(json.loads(m["payload"])):
+        sys.exit(f"{topic}: {e.message} at {list(e.absolute_path)} in {m['payload'][:400]}")
+    seen[topic] = seen.get(topic, 0) + 1
+print(json.dumps(seen))
+)";
+    std::string lines;
+    for (const auto& m : messages)
+      lines += json{{"topic", m.topic}, {"payload", m.payload}}.dump() + "\n";
+    const auto file = broker_dir_.write("payloads.jsonl", lines);
+    const auto r =
+        run_command({CNCD_PYTHON3, "-c", kCheck,
+                     std::string(CNCD_SOURCE_DIR) + "/docs/telemetry-schemas.json", file.string()});
+    EXPECT_EQ(r.exit_status, 0) << r.err;
+    return r.exit_status == 0 ? json::parse(r.out, nullptr, false) : json::object();
+  }
   void run_part() {
     start_program("part.ngc", "G21 G90 F3000\n(MSG, first)\nG1 X5\n(MSG, second)\nG1 Y5\nM30\n");
     wait_until([](const json& s) { return s["exec"] == "idle" && s["program"]["result"] != ""; });
@@ -139,6 +170,13 @@ TEST_F(MqttTest, ARunGivesItsEventsInOrderAndOneJob) {
   // The fleet page's part count and link come with the state.
   EXPECT_TRUE(sub.got("/state", "\"parts\":1"));
   EXPECT_TRUE(sub.got("/state", "\"dashboard\":\"http://mill-1.shop:8080/\""));
+  // cncd away: the state says so.
+  daemon_.stop();
+  ASSERT_TRUE(sub.got("/state", "\"cncd\":\"unreachable\""));
+  // Every payload as docs/telemetry-schemas.json describes it.
+  const json seen = schema_check(sub.messages());
+  for (const char* topic : {"state", "position", "events", "job"})
+    EXPECT_GE(seen.value(topic, 0), 1) << topic << " not seen: " << seen.dump();
 }
 
 TEST_F(MqttTest, AKilledTelemetryLeavesItsLastWill) {
