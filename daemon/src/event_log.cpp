@@ -7,6 +7,10 @@
 namespace cncd::daemon {
 
 void EventLog::add(std::string level, std::string kind, std::string message) {
+  add(std::move(level), std::move(kind), std::move(message), "");
+}
+
+void EventLog::add(std::string level, std::string kind, std::string message, std::string code) {
   // The log line names who, unless the message does already.
   const std::string by =
       actor_.empty() || message.find(actor_) != std::string::npos ? "" : " (by " + actor_ + ")";
@@ -19,7 +23,8 @@ void EventLog::add(std::string level, std::string kind, std::string message) {
   }
   const auto wall = std::chrono::system_clock::now().time_since_epoch();
   events_.push_back(Event{next_seq_++, std::chrono::duration<double>(wall).count(),
-                          std::move(level), std::move(kind), std::move(message), actor_});
+                          std::move(level), std::move(kind), std::move(message), actor_,
+                          std::move(code)});
   if (events_.size() > kCapacity) events_.pop_front();
 }
 

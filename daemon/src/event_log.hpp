@@ -17,7 +17,8 @@ struct Event {
   std::string level;  // "error" | "warning" | "info"
   std::string kind;   // "program" | "fault" | "machine" | "message" ...
   std::string message;
-  std::string by;  // who caused it: the peer, or a person through it; empty when no request did
+  std::string by;    // who caused it: the peer, or a person through it; empty when no request did
+  std::string code;  // the servo thread's event code ("following_error"), empty for others
 };
 
 class EventLog {
@@ -26,6 +27,8 @@ class EventLog {
 
   // Records an event (and logs it through spdlog at the matching level).
   void add(std::string level, std::string kind, std::string message);
+  // The same, with the servo thread's code for the event.
+  void add(std::string level, std::string kind, std::string message, std::string code);
   // Who the entries added from now on are caused by ("" when by no request).
   void set_actor(std::string by) { actor_ = std::move(by); }
   const std::string& actor() const { return actor_; }

@@ -280,6 +280,7 @@ json event_json(const Event& event) {
               {"kind", event.kind},
               {"message", event.message}};
   if (!event.by.empty()) out["by"] = event.by;
+  if (!event.code.empty()) out["code"] = event.code;
   return out;
 }
 

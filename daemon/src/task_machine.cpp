@@ -146,7 +146,8 @@ void Task::drain_servo_events() {
     const char* level = event.level == motion::Event::Level::fault     ? "error"
                         : event.level == motion::Event::Level::warning ? "warning"
                                                                        : "info";
-    events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text);
+    events_.add(level, event.level == motion::Event::Level::fault ? "fault" : "servo", event.text,
+                motion::event_code_name(event.record.code));
   }
   drivers::DriverNotice notice;
   for (auto* driver : drivers_) {

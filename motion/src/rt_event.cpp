@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
 
 #include "cncd/config/machine_config.hpp"
 
@@ -147,6 +148,45 @@ std::size_t format_event(const RtEvent& event, char* out, std::size_t size) noex
   out[0] = '\0';
   const int n = format(event, out, size);
   return n < 0 ? 0 : static_cast<std::size_t>(n);
+}
+
+const char* event_code_name(RtEvent::Code code) noexcept {
+  // In the enum's order.
+  static constexpr const char* kNames[] = {"",
+                                           "estop",
+                                           "estop_input",
+                                           "home_ignored_not_on",
+                                           "home_ignored_moving",
+                                           "homing_aborted",
+                                           "homing_in_progress",
+                                           "homing_failed",
+                                           "homing_needs_switch",
+                                           "jog_ignored",
+                                           "feedback_not_a_number",
+                                           "drive_fault",
+                                           "feedback_stale",
+                                           "min_limit_switch",
+                                           "max_limit_switch",
+                                           "following_error",
+                                           "set_point_not_finite",
+                                           "joints_apart",
+                                           "off_path",
+                                           "spindle_not_at_speed",
+                                           "spindle_fault",
+                                           "spindle_stale",
+                                           "no_spindle",
+                                           "spindle_not_oriented",
+                                           "probe_tripped_at_start",
+                                           "probe_untripped_at_start",
+                                           "probe_no_contact",
+                                           "probe_contact_kept",
+                                           "sync_overrun",
+                                           "sync_stalled",
+                                           "sync_jump",
+                                           "sync_not_at_rest"};
+  static_assert(std::size(kNames) == static_cast<std::size_t>(RtEvent::Code::sync_not_at_rest) + 1);
+  const auto index = static_cast<std::size_t>(code);
+  return index < std::size(kNames) ? kNames[index] : "";
 }
 
 std::string format_event(const RtEvent& event) {

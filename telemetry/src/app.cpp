@@ -83,6 +83,10 @@ void App::publish_state() {
 
 void App::on_event(const json& event) {
   ++counters_.events[{text_at(event, "level"), text_at(event, "kind")}];
+  if (text_at(event, "kind") == "fault") {
+    const std::string code = text_at(event, "code");
+    ++counters_.faults[code.empty() ? "other" : code];
+  }
   if (text_at(event, "level") == "error") {
     last_error_ = {{"seq", count_at(event, "seq")},
                    {"time", number_at(event, "time")},

@@ -190,6 +190,11 @@ std::string prometheus_text(const MachineFeed& feed, const Counters& counters,
     w.sample("cncd_events_total", static_cast<double>(count),
              "level=\"" + escaped(key.first) + "\",kind=\"" + escaped(key.second) + "\"");
   }
+  w.family("cncd_faults_total", "counter",
+           "Faults that stopped the machine, by the servo thread's code (following_error, "
+           "drive_fault, feedback_stale, min_limit_switch ...)");
+  for (const auto& [code, count] : counters.faults)
+    w.sample("cncd_faults_total", static_cast<double>(count), "code=\"" + escaped(code) + "\"");
   if (counters.mqtt) {
     w.single("cncd_telemetry_mqtt_connected", "gauge", "1 while the MQTT broker is connected",
              counters.mqtt_connected ? 1 : 0);

@@ -16,6 +16,7 @@ namespace cncd::telemetry {
 // What the telemetry process counts itself, beside the feed.
 struct Counters {
   std::map<std::pair<std::string, std::string>, std::uint64_t> events;  // (level, kind) -> n
+  std::map<std::string, std::uint64_t> faults;  // the servo thread's fault code -> n
   // The MQTT publisher's own state, when there is one ([TELEMETRY] MQTT_HOST).
   bool mqtt = false;
   bool mqtt_connected = false;

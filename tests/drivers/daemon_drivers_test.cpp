@@ -255,6 +255,15 @@ TEST(DriversEndToEnd, KilledModbusDrivesLatchAFaultAndTheDaemonCarriesOn) {
   EXPECT_NE(faulted["state"], "on");
   EXPECT_NE(faulted["fault"].get<std::string>().find("modbus"), std::string::npos)
       << faulted["fault"];
+  // The fault event names the servo thread's code; the failed exchanges are counted.
+  const json events = result(client.call("errors.list"))["events"];
+  const auto fault = std::find_if(events.begin(), events.end(),
+                                  [](const json& e) { return e["kind"] == "fault"; });
+  ASSERT_NE(fault, events.end()) << events.dump();
+  EXPECT_TRUE(fault->value("code", "") == "drive_fault" ||
+              fault->value("code", "") == "feedback_stale")
+      << fault->dump();
+  EXPECT_GT(result(client.call("status.get"))["rt"]["modbus_errors"].get<double>(), 0);
   const json stopped = wait_until([](const json& s) { return s["exec"] == "idle"; });
   EXPECT_NE(stopped["program"]["result"], "done");
   // The daemon is alive and commands nothing further.

@@ -3,6 +3,7 @@
 #include "cncd/motion/rt_event.hpp"
 
 #include <cstring>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -162,6 +163,23 @@ TEST(CopyText, CutsToFit) {
   EXPECT_STREQ(out, "abc");
   drivers::copy_text(out, sizeof out, "");
   EXPECT_STREQ(out, "");
+}
+
+// The event log and /metrics name a fault by its code: one name per code, as the enum spells it.
+TEST(EventCodeName, EachCodeHasItsOwnName) {
+  EXPECT_STREQ(event_code_name(Code::none), "");
+  EXPECT_STREQ(event_code_name(Code::estop), "estop");
+  EXPECT_STREQ(event_code_name(Code::following_error), "following_error");
+  EXPECT_STREQ(event_code_name(Code::drive_fault), "drive_fault");
+  EXPECT_STREQ(event_code_name(Code::sync_not_at_rest), "sync_not_at_rest");
+  std::set<std::string> names;
+  const auto last = static_cast<int>(Code::sync_not_at_rest);
+  for (int c = 1; c <= last; ++c) {
+    const std::string name = event_code_name(static_cast<Code>(c));
+    EXPECT_FALSE(name.empty()) << c;
+    EXPECT_TRUE(names.insert(name).second) << name << " twice";
+  }
+  EXPECT_STREQ(event_code_name(static_cast<Code>(last + 1)), "");
 }
 
 }  // namespace

@@ -70,5 +70,7 @@ struct RtEvent {
 std::size_t format_event(const RtEvent& event, char* out, std::size_t size) noexcept;
 // Not RT: the words cut to kEventTextSize.
 std::string format_event(const RtEvent& event);
+// The code's name as the enum spells it ("following_error"), "" for none.
+const char* event_code_name(RtEvent::Code code) noexcept;
 
 }  // namespace cncd::motion
