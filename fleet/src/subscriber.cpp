@@ -62,9 +62,13 @@ std::string Subscriber::start() {
     }
     me->deliver(m->topic, std::string(static_cast<const char*>(m->payload), bytes));
   });
-  if (auto problem = telemetry::connect_in_background(mosq_, options_); !problem.empty())
+  std::string first_failure;
+  if (auto problem = telemetry::connect_in_background(mosq_, options_, first_failure);
+      !problem.empty())
     return problem;
   started_ = true;
+  if (!first_failure.empty())
+    spdlog::warn("MQTT: cannot reach the broker: {}; trying again", first_failure);
   return "";
 }
 

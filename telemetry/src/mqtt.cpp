@@ -69,9 +69,11 @@ std::string MqttPublisher::start() {
       if (*alive) me->on_publish(mid);
     });
   });
-  if (auto problem = connect_in_background(mosq_, options_.broker); !problem.empty())
+  std::string first_failure;
+  if (auto problem = connect_in_background(mosq_, options_.broker, first_failure); !problem.empty())
     return problem;
   started_ = true;
+  if (!first_failure.empty()) unreachable(first_failure);
   return "";
 }
 

@@ -46,14 +46,17 @@ mosquitto* new_client(const BrokerOptions& options, void* self, std::string& err
   return client;
 }
 
-std::string connect_in_background(mosquitto* client, const BrokerOptions& options) {
-  // A broker that is not there yet is tried again by the loop; only bad options fail here.
-  if (const int rc = mosquitto_connect_async(client, options.host.c_str(), options.port, 30);
-      rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO) {
+std::string connect_in_background(mosquitto* client, const BrokerOptions& options,
+                                  std::string& unreachable) {
+  // Only options that can never work fail here. A broker that is not there yet, a name that
+  // does not resolve yet, a certificate the CA did not sign: all tried again by the loop, as
+  // when they happen later.
+  const int rc = mosquitto_connect_async(client, options.host.c_str(), options.port, 30);
+  if (rc == MOSQ_ERR_INVAL || rc == MOSQ_ERR_NOMEM || rc == MOSQ_ERR_NOT_SUPPORTED)
     return std::string("MQTT: cannot connect: ") + mosquitto_strerror(rc);
-  }
-  if (const int rc = mosquitto_loop_start(client); rc != MOSQ_ERR_SUCCESS)
-    return std::string("MQTT: ") + mosquitto_strerror(rc);
+  unreachable = rc == MOSQ_ERR_SUCCESS ? "" : mosquitto_strerror(rc);
+  if (const int loop = mosquitto_loop_start(client); loop != MOSQ_ERR_SUCCESS)
+    return std::string("MQTT: ") + mosquitto_strerror(loop);
   return "";
 }
 

@@ -27,7 +27,9 @@ BrokerOptions broker_options(const config::TelemetryConfig& config);
 // of `options`, `self` handed to its callbacks; nullptr and `error` set when it cannot be made.
 mosquitto* new_client(const BrokerOptions& options, void* self, std::string& error);
 // Connects in the background (a broker not there yet is tried again) on libmosquitto's own
-// thread; "" or what is wrong.
-std::string connect_in_background(mosquitto* client, const BrokerOptions& options);
+// thread; "" or what is wrong with the options. `unreachable` says why the first try failed
+// ("" when it has not, yet).
+std::string connect_in_background(mosquitto* client, const BrokerOptions& options,
+                                  std::string& unreachable);
 
 }  // namespace cncd::telemetry
