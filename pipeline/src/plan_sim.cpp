@@ -225,6 +225,7 @@ class Simulation final : motion::MoveQueue {
 
   void account(const motion::Segment& segment) {
     ++pushed_;
+    if (options_.on_segment) options_.on_segment(segment);
     // A blend arc is part of the moves it joins; a segment may also complete several moves.
     for (std::uint32_t k = 0; k < segment.moves; ++k) {
       result_.move_start_s.push_back(result_.moves == 0 ? 0.0

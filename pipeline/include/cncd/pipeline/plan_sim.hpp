@@ -45,6 +45,9 @@ struct PlanSimOptions {
   // Called with every programmed move, in order, as the planner plans it alone: the geometry
   // the bounds use, before a blend or a merge shortens it.
   std::function<void(const motion::Segment&)> on_move;
+  // Called with every segment the planner hands to the servo loop, in order: the trimmed lines,
+  // blend arcs and arcs with the limits it set on them.
+  std::function<void(const motion::Segment&)> on_segment;
   // Set from another thread to stop the simulation early (PlanSimResult::stopped says so).
   const std::atomic<bool>* cancel = nullptr;
 };
