@@ -10,9 +10,13 @@
 // 3D_Chips) it also prints the path alone against its own feed-limited bound and the floors of
 // path_floor.hpp: the time from the start of its first move to the end of its last within the
 // whole program (from the simulation's per-move start times), and the path run alone from
-// rest where it starts (a program of its lines after G92), on cncd and LinuxCNC.
+// rest where it starts (a program of its lines after G92), on cncd and LinuxCNC, and the
+// time-optimal reference of path_reference.hpp on its exact path and within its G64 P; for
+// 3D_Chips and the surface finish, where the time goes (path_diagnosis.hpp).
 //
-//   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] [--jerk J]
+//   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] [--jerk J] [--only TEXT]
+//
+// --only TEXT runs the programs whose name contains TEXT.
 //
 // --jerk J runs cncd with S-curve profiles ([TRAJ] MAX_LINEAR_JERK = J mm/s^3) and without
 // LinuxCNC, whose 2.9 planner has none (the floors stay those of trapezoids).
@@ -22,6 +26,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -34,7 +39,9 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/pipeline/plan_sim.hpp"
+#include "path_diagnosis.hpp"
 #include "path_floor.hpp"
+#include "path_reference.hpp"
 #include "planner_programs.hpp"
 
 namespace {
@@ -99,12 +106,15 @@ struct Bench {
   std::string run_sh;
   fs::path lcnc_ini;
 
-  cncd::pipeline::PlanSimResult simulate(const fs::path& program,
-                                         std::vector<cncd::motion::Segment>* path_moves = nullptr,
-                                         int first_line = 0, int last_line = 0) const {
+  cncd::pipeline::PlanSimResult simulate(
+      const fs::path& program, std::vector<cncd::motion::Segment>* path_moves = nullptr,
+      int first_line = 0, int last_line = 0,
+      std::vector<cncd::motion::Segment>* segments = nullptr) const {
     cncd::pipeline::PlanSimOptions options;
     options.interp = cncd::pipeline::interpreter_options(machine);
     options.start_machine = cncd::interp::Pose{};
+    if (segments != nullptr)
+      options.on_segment = [segments](const cncd::motion::Segment& s) { segments->push_back(s); };
     if (path_moves != nullptr)
       options.on_move = [&](const cncd::motion::Segment& move) {
         if (move.line >= first_line && move.line <= last_line) path_moves->push_back(move);
@@ -174,11 +184,39 @@ struct Bench {
         program.path_first_line, program.path_last_line, moves.size(), floors.length,
         floors.bound_s, floors.start_stop_s, floors.start_stop_s / floors.bound_s,
         floors.exact_path_s, floors.exact_path_s / floors.bound_s);
-    const auto ratios = [&floors](const char* who, const char* how, double s) {
+    cncd::bench::ReferenceOptions exact;
+    cncd::bench::ReferenceOptions within;
+    within.blend_corners = true;
+    within.tolerance = program.tolerance;
+    cncd::bench::ReferenceOptions merged = within;
+    merged.merge_tolerance = program.merge_tolerance;
+    const auto started = std::chrono::steady_clock::now();
+    const auto ref_exact = cncd::bench::time_optimal(machine, moves, exact);
+    const auto ref_within = cncd::bench::time_optimal(machine, moves, within);
+    const auto ref = cncd::bench::time_optimal(machine, moves, merged);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - started;
+    const auto change = [&](cncd::bench::ReferenceOptions o, const cncd::bench::PathReference& at) {
+      o.max_step /= 2;
+      o.max_turn /= 2;
+      return 100 * (cncd::bench::time_optimal(machine, moves, o).time_s / at.time_s - 1);
+    };
+    std::printf(
+        "    time-optimal reference: exact path %.3f s (%.4f x bound, %zu corner stops)   "
+        "within P%g %.3f s (%.4f x bound, %zu blends)   within P%g Q%g %.3f s (%.4f x bound, "
+        "%zu blends)\n"
+        "      %zu, %zu and %zu grid steps in %.2f s; halving the grid changes them by %+.3f %%, "
+        "%+.3f %% and %+.3f %%\n",
+        ref_exact.time_s, ref_exact.time_s / floors.bound_s, ref_exact.stops, program.tolerance,
+        ref_within.time_s, ref_within.time_s / floors.bound_s, ref_within.blends, program.tolerance,
+        program.merge_tolerance, ref.time_s, ref.time_s / floors.bound_s, ref.blends,
+        ref_exact.steps, ref_within.steps, ref.steps, took.count(), change(exact, ref_exact),
+        change(within, ref_within), change(merged, ref));
+    const auto ratios = [&floors, &ref](const char* who, const char* how, double s) {
       std::printf(
           "    %-9s %-18s %.3f s  ratio %.4f  over start/stop floor %.4f  "
-          "over exact-path floor %.4f\n",
-          who, how, s, s / floors.bound_s, s / floors.start_stop_s, s / floors.exact_path_s);
+          "over exact-path floor %.4f  over reference within P, Q %.4f\n",
+          who, how, s, s / floors.bound_s, s / floors.start_stop_s, s / floors.exact_path_s,
+          s / ref.time_s);
     };
     ratios("cncd", "in the program", in_program_s);
     const fs::path alone = cncd::bench::write_path_alone(program, dir, moves.front().start);
@@ -186,7 +224,8 @@ struct Bench {
       std::printf("    (cannot write the path alone)\n");
       return;
     }
-    const auto a = simulate(alone);
+    std::vector<cncd::motion::Segment> segments;
+    const auto a = simulate(alone, nullptr, 0, 0, &segments);
     if (!a.complete()) {
       std::printf("    cncd alone: %s\n",
                   (a.error ? a.error->to_string() : a.stopped->to_string()).c_str());
@@ -195,6 +234,16 @@ struct Bench {
     ratios("cncd", "alone", a.cycle_time_s);
     if (std::abs(a.feed_bound_s - floors.bound_s) > 1e-6 * floors.bound_s)
       std::printf("    (the path alone's feed bound is %.3f s)\n", a.feed_bound_s);
+    if (program.diagnose && a.move_start_s.size() == moves.size()) {
+      std::vector<double> cncd_s(moves.size());
+      for (std::size_t i = 0; i < moves.size(); ++i)
+        cncd_s[i] =
+            (i + 1 < moves.size() ? a.move_start_s[i + 1] : a.cycle_time_s) - a.move_start_s[i];
+      cncd::bench::print_diagnosis(
+          machine, moves, program.merge_tolerance, cncd_s, ref,
+          cncd::bench::planned_optimal(machine, segments, moves.size()),
+          cncd::bench::planned_optimal(machine, segments, moves.size(), true));
+    }
     if (const auto l = linuxcnc_run(alone)) {
       ratios("LinuxCNC", "alone (moving)", l->moving_s);
       std::printf("    cncd/LinuxCNC alone %.4f (LinuxCNC run, cycle start to idle, %.3f s)\n",
@@ -209,6 +258,7 @@ int main(int argc, char** argv) {
   bool linuxcnc = true;
   bool keep = false;
   double jerk = 0;
+  std::string only;
   std::string run_sh = default_run_sh();
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -216,6 +266,8 @@ int main(int argc, char** argv) {
       linuxcnc = false;
     } else if (arg == "--keep") {
       keep = true;
+    } else if (arg == "--only" && i + 1 < argc) {
+      only = argv[++i];
     } else if (arg == "--run-sh" && i + 1 < argc) {
       run_sh = argv[++i];
     } else if (arg == "--jerk" && i + 1 < argc && std::atof(argv[i + 1]) >= 1) {
@@ -224,7 +276,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] "
-                   "[--jerk J (>= 1 mm/s^3)]\n");
+                   "[--jerk J (>= 1 mm/s^3)] [--only TEXT]\n");
       return 64;
     }
   }
@@ -276,6 +328,7 @@ int main(int argc, char** argv) {
       build, dir.c_str());
   const Bench bench{machine, dir, linuxcnc, run_sh, lcnc_ini};
   for (const auto& program : programs) {
+    if (program.name.find(only) == std::string::npos) continue;
     std::printf("%s  (%s)\n", program.name.c_str(), program.path.filename().c_str());
     std::vector<cncd::motion::Segment> path_moves;
     const auto r =

@@ -1,8 +1,10 @@
 #include "planner_programs.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -103,6 +105,31 @@ BenchProgram write_raster(const fs::path& path, const std::string& name, int fee
   p.add("M2");
   p.write(path);
   return program;
+}
+
+// The G64 P and Q in force after the program's first `lines` lines (0: none; Q is P when
+// only P is given, as in LinuxCNC).
+void blend_tolerances(BenchProgram& program) {
+  std::ifstream in(program.path);
+  int count = 0;
+  const auto value = [](const std::string& text, std::size_t at, char letter) {
+    const auto found = text.find(letter, at);
+    return found == std::string::npos ? -1.0 : std::strtod(text.c_str() + found + 1, nullptr);
+  };
+  for (std::string line; count < program.prelude_lines && std::getline(in, line); ++count) {
+    std::string text;
+    for (char c : line)
+      if (!std::isspace(static_cast<unsigned char>(c)))
+        text += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    const auto g64 = text.find("G64");
+    if (g64 == std::string::npos ||
+        (g64 + 3 < text.size() && std::isdigit(static_cast<unsigned char>(text[g64 + 3]))))
+      continue;
+    const double p = value(text, g64 + 3, 'P');
+    const double q = value(text, g64 + 3, 'Q');
+    program.tolerance = std::max(0.0, p);
+    program.merge_tolerance = q >= 0 ? q : program.tolerance;
+  }
 }
 
 // (b) a circle of R30 mm in 0.1 mm chords at F9000, `laps` times round in one G1 chain, after
@@ -255,7 +282,12 @@ std::vector<BenchProgram> write_programs(const fs::path& dir, const fs::path& ch
   programs.push_back({"(c) G81/G83 grid", dir / "drill_grid.ngc", true});
   write_drilling(programs.back().path);
   std::error_code ec;
-  if (fs::exists(chips_ngc, ec)) programs.push_back(chips_program(chips_ngc));
+  if (fs::exists(chips_ngc, ec)) {
+    programs.push_back(chips_program(chips_ngc));
+    programs.back().diagnose = true;
+  }
+  for (auto& program : programs)
+    blend_tolerances(program);
   return programs;
 }
 

@@ -22,6 +22,9 @@ struct BenchProgram {
   int path_first_line = 0;
   int path_last_line = 0;
   int prelude_lines = 0;
+  double tolerance = 0;        // the path's G64 P (0: none), for the reference within P
+  double merge_tolerance = 0;  // its G64 Q (P when only P is given)
+  bool diagnose = false;       // print where the time goes along the path
 };
 
 // Writes the cncd INI (sim drives) into `dir`; returns its path.
