@@ -74,29 +74,36 @@ double surface_z(double x, double y) {
          0.5 * std::sin(2 * std::numbers::pi * x / 20) * std::cos(2 * std::numbers::pi * y / 30);
 }
 
-// (a) 3D surfacing: 21 rows of 1000 G1 segments of 0.1 mm along X over a 100 x 10 mm patch,
-// 0.5 mm step-over, rows alternating in direction; the path is the rows and step-overs.
-BenchProgram write_raster(const fs::path& path, const std::string& name, int feed,
-                          const std::string& blend) {
-  constexpr int kRows = 21;
-  constexpr int kSteps = 1000;
+// A raster along X over z(x, y): `rows` rows of `steps` G1 segments of `step`, `stepover`
+// apart in Y, alternating in direction; the path is the rows and the step-overs between them.
+struct Raster {
+  int rows;
+  int steps;
+  double step;
+  double stepover;
+  double (*z)(double, double);
+  int feed;
+  std::string blend;  // the G64 line
+  std::string title;
+};
+
+BenchProgram write_raster(const fs::path& path, const std::string& name, const Raster& r) {
   BenchProgram program{name, path};
   Program p;
-  p.add("(planner bench: 3D surfacing raster, 100 x 10 mm, 21 rows of 0.1 mm G1 segments, F" +
-        std::to_string(feed) + ", " + blend + ")");
+  p.add("(planner bench: " + r.title + ", F" + std::to_string(r.feed) + ", " + r.blend + ")");
   p.add(kModes);
-  program.prelude_lines = p.add(blend);
+  program.prelude_lines = p.add(r.blend);
   p.add("G0 Z5");
   p.add("G0 X0 Y0");
-  p.add("G1 Z" + number(surface_z(0, 0)) + " F" + std::to_string(feed));
-  for (int row = 0; row < kRows; ++row) {
-    const double y = 0.5 * row;
-    if (row > 0) p.add("Y" + number(y) + " Z" + number(surface_z(row % 2 ? 100 : 0, y)));
-    for (int k = 1; k <= kSteps; ++k) {
-      const double x = 0.1 * (row % 2 ? kSteps - k : k);
-      const std::string move = "X" + number(x) + " Z" + number(surface_z(x, y));
-      const int line =
-          p.add(row == 0 && k == 1 ? "G1 " + move + " F" + std::to_string(feed) : move);
+  const std::string feed = " F" + std::to_string(r.feed);
+  p.add("G1 Z" + number(r.z(0, 0)) + feed);
+  for (int row = 0; row < r.rows; ++row) {
+    const double y = r.stepover * row;
+    if (row > 0) p.add("Y" + number(y) + " Z" + number(r.z(row % 2 ? r.steps * r.step : 0, y)));
+    for (int k = 1; k <= r.steps; ++k) {
+      const double x = r.step * (row % 2 ? r.steps - k : k);
+      const std::string move = "X" + number(x) + " Z" + number(r.z(x, y));
+      const int line = p.add(row == 0 && k == 1 ? "G1 " + move + feed : move);
       if (row == 0 && k == 1) program.path_first_line = line;
       program.path_last_line = line;
     }
@@ -105,6 +112,33 @@ BenchProgram write_raster(const fs::path& path, const std::string& name, int fee
   p.add("M2");
   p.write(path);
   return program;
+}
+
+// (a) 3D surfacing: 21 rows of 1000 G1 segments of 0.1 mm along X over a 100 x 10 mm patch,
+// 0.5 mm step-over, over surface_z.
+BenchProgram write_surfacing(const fs::path& path, const std::string& name, int feed,
+                             const std::string& blend) {
+  return write_raster(path, name,
+                      {21, 1000, 0.1, 0.5, surface_z, feed, blend,
+                       "3D surfacing raster, 100 x 10 mm, 21 rows of 0.1 mm G1 segments"});
+}
+
+// (e) 3D surface finishing as CAM writes it: 100 rows of 2000 G1 segments of 0.05 mm along X
+// (200,000 lines) over a 100 x 29.7 mm patch, 0.3 mm step-over, coordinates to 4 decimals
+// (their rounding turns every segment by up to 0.06 degrees), F6000 under G64 P0.01, over
+// z = -3 + 1.5 sin(2 pi x / 40) cos(2 pi y / 25) + 0.4 sin(2 pi (x + 2 y) / 15). Its curvature
+// needs up to (1.5 (2 pi / 40)^2 + 0.4 (2 pi / 15)^2) 100^2 = 1070 mm/s^2 of Z at the feed
+// (limit 1000): in places the axes, not the feed, set the speed.
+double finish_z(double x, double y) {
+  const double two_pi = 2 * std::numbers::pi;
+  return -3.0 + 1.5 * std::sin(two_pi * x / 40) * std::cos(two_pi * y / 25) +
+         0.4 * std::sin(two_pi * (x + 2 * y) / 15);
+}
+
+BenchProgram write_finish(const fs::path& path) {
+  return write_raster(path, "(e) 3D surface finish, 200,000 lines",
+                      {100, 2000, 0.05, 0.3, finish_z, 6000, "G64 P0.01",
+                       "3D surface finish, 100 rows of 2000 G1 segments of 0.05 mm"});
 }
 
 // The G64 P and Q in force after the program's first `lines` lines (0: none; Q is P when
@@ -273,10 +307,10 @@ fs::path write_linuxcnc_ini(const fs::path& dir, const fs::path& axis_mm_ini, st
 
 std::vector<BenchProgram> write_programs(const fs::path& dir, const fs::path& chips_ngc) {
   std::vector<BenchProgram> programs;
-  programs.push_back(write_raster(dir / "raster_f3000.ngc", "(a) raster F3000", 3000, "G64"));
-  programs.push_back(write_raster(dir / "raster_f6000.ngc", "(a) raster F6000", 6000, "G64"));
-  programs.push_back(write_raster(dir / "raster_f6000_p005.ngc", "(a) raster F6000 under G64 P0.05",
-                                  6000, "G64 P0.05"));
+  programs.push_back(write_surfacing(dir / "raster_f3000.ngc", "(a) raster F3000", 3000, "G64"));
+  programs.push_back(write_surfacing(dir / "raster_f6000.ngc", "(a) raster F6000", 6000, "G64"));
+  programs.push_back(write_surfacing(dir / "raster_f6000_p005.ngc",
+                                     "(a) raster F6000 under G64 P0.05", 6000, "G64 P0.05"));
   programs.push_back(write_circle(dir / "circle_f9000.ngc", "(b) circle F9000, 10 laps", 10));
   programs.push_back(write_circle(dir / "circle_f9000_1lap.ngc", "(b) circle F9000, 1 lap", 1));
   programs.push_back({"(c) G81/G83 grid", dir / "drill_grid.ngc", true});
@@ -286,6 +320,8 @@ std::vector<BenchProgram> write_programs(const fs::path& dir, const fs::path& ch
     programs.push_back(chips_program(chips_ngc));
     programs.back().diagnose = true;
   }
+  programs.push_back(write_finish(dir / "surface_finish.ngc"));
+  programs.back().diagnose = true;
   for (auto& program : programs)
     blend_tolerances(program);
   return programs;

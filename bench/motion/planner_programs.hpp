@@ -1,7 +1,8 @@
 // The planner benchmark's machine and programs, generated so that every figure can be
 // reproduced: a small fast mill (X/Y 200 mm/s and 2000 mm/s^2, Z 100 mm/s and 1000 mm/s^2,
 // 1 ms servo period) as a cncd INI and as a LinuxCNC INI derived from LinuxCNC's sim
-// axis_mm.ini, and the programs (a) to (d) of the motion issue.
+// axis_mm.ini, and the programs (a) to (d) of the motion issue and (e), a 3D surface finish of
+// 200,000 lines.
 #pragma once
 
 #include <filesystem>
