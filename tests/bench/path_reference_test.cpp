@@ -246,13 +246,16 @@ TEST_F(PlannedPath, ExactReferenceLiesBetweenTheExactPathFloorAndCncdUnderG61) {
 }
 
 TEST_F(PlannedPath, BlendedReferenceIsNoSlowerThanCncdOnItsBlends) {
+  // G64 P alone merges within Q = P too: the reference within P and Q runs cncd's geometry.
   std::vector<Segment> moves;
   const double cncd = cncd_s(zigzag("G64 P0.02"), moves);
   ReferenceOptions options;
   options.blend_corners = true;
-  options.tolerance = 0.02;
+  options.tolerance = options.merge_tolerance = 0.02;
   const auto reference = time_optimal(machine_, moves, options);
-  EXPECT_GT(reference.blends, 150u);
+  // The wave's gentle rows merge into a few dozen lines.
+  EXPECT_GT(reference.blends, 20u);
+  EXPECT_LT(reference.blends, 100u);
   EXPECT_LE(reference.time_s, cncd);
   EXPECT_LT(reference.time_s, time_optimal(machine_, moves, {}).time_s);
 }
