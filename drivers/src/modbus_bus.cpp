@@ -65,17 +65,22 @@ ModbusBus::ModbusBus(BusSettings bus, std::vector<DriveSettings> drives, IoSetti
       state_(drives_.size()),
       io_(std::move(io)),
       point_written_(io_.points.size(), std::numeric_limits<double>::quiet_NaN()) {
-  const VfdSettings& v = io_.vfd;
-  // Readings further apart than a few updates and a slow reply: the bus was down.
-  const std::int64_t gap_ns = (4LL * bus_.update_period_ms + bus_.timeout_ms) * 1'000'000;
-  vfd_position_.configure(v.position_width, v.position_scale, v.max_acceleration, gap_ns);
+  if (io_.vfd) {
+    // Readings further apart than a few updates and a slow reply: the bus was down.
+    const std::int64_t gap_ns = (4LL * bus_.update_period_ms + bus_.timeout_ms) * 1'000'000;
+    // ACCELERATION is in rpm/s, the tracker wants rev/s^2.
+    vfd_position_.configure(io_.vfd->position_width, io_.vfd->position_scale,
+                            io_.vfd->acceleration / 60.0, gap_ns);
+  }
   if (bus_.rtu && bus_.baud > 0) {
     // A read request is 8 bytes on the line, each a start bit, its data, parity and stop bits:
     // the drive reads its counter once the last of them has arrived.
     const int bits = 1 + bus_.data_bits + (bus_.parity == 'N' ? 0 : 1) + bus_.stop_bits;
     request_ns_ = 8LL * bits * 1'000'000'000 / bus_.baud;
     // The answer: address, function, byte count, the registers and the CRC.
-    response_ns_ = (5LL + 2LL * v.position_width / 16) * bits * 1'000'000'000 / bus_.baud;
+    if (io_.vfd) {
+      response_ns_ = (5LL + 2LL * io_.vfd->position_width / 16) * bits * 1'000'000'000 / bus_.baud;
+    }
   }
 }
 
@@ -322,13 +327,13 @@ void ModbusBus::exchange_io(bool connected) {
     vfd_reason_.clear();
   }
   bool ok = connected && !link_failed_;
-  if (!connected && io_.vfd.present) {
+  if (!connected && io_.vfd) {
     vfd_problem(bus_.rtu ? "cannot open the serial line" : "cannot connect");
   }
   if (ok) {
     errno = 0;
     ok = exchange_points(setpoint.command);
-    if (ok && io_.vfd.present) ok = exchange_vfd(setpoint.command);
+    if (ok && io_.vfd) ok = exchange_vfd(setpoint.command);
     if (!ok) link_failed_ = true;
   }
   if (!ok) vfd_healthy_since_ns_ = 0;

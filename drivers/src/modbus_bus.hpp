@@ -7,10 +7,12 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "cncd/config/machine_config.hpp"
 #include "cncd/drivers/driver.hpp"
 #include "cncd/drivers/fault_reason.hpp"
 #include "cncd/drivers/seqlock.hpp"
@@ -73,36 +75,12 @@ struct IoPoint {
   }
 };
 
-// A spindle VFD's register profile (config::SpindleConfig's modbus fields).
-struct VfdSettings {
-  bool present = false;
-  int slave = 1;
-  double speed_scale = 1;  // register value = rpm x speed_scale
-  int command_register = 0;
-  int speed_register = 1;
-  int actual_speed_register = 0;   // -1 = none
-  int status_register = 1;         // -1 = none
-  bool actual_speed_input = true;  // input registers (function 4), else holding (3)
-  bool status_input = true;
-  int command_stop = 0;
-  int command_forward = 1;
-  int command_reverse = 2;
-  int running_bit = 0;  // -1 = none
-  int at_speed_bit = 1;
-  int fault_bit = 2;
-  // The shaft's position counter (config::SpindleConfig::position_register ...); -1 = none.
-  int position_register = -1;
-  bool position_input = true;
-  int position_width = 32;
-  bool position_high_first = true;
-  double position_scale = 1;    // counts a revolution
-  double max_acceleration = 0;  // rev/s^2, 0 = unknown
-};
-
 struct IoSettings {
   std::vector<IoPoint> points;
-  VfdSettings vfd;
-  bool empty() const { return points.empty() && !vfd.present; }
+  // The spindle VFD, when [SPINDLE_0] is a Modbus drive on this bus: its register profile is
+  // the section's modbus keys.
+  std::optional<config::SpindleConfig> vfd;
+  bool empty() const { return points.empty() && !vfd; }
 };
 
 // Servo thread -> I/O thread: the latest outputs, and how many times the spindle was started

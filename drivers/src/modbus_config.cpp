@@ -131,33 +131,10 @@ std::string collect_io(const config::MachineConfig& machine, std::map<int, IoSet
       problem.empty()) {
     problem = section + "RUNNING_BIT, AT_SPEED_BIT and FAULT_BIT are 0 .. 15, or -1 for none";
   }
-  VfdSettings& v = by_bus[std::max(0, sp.modbus)].vfd;
-  v.present = true;
-  v.slave = sp.slave;
-  v.speed_scale = sp.speed_scale;
-  v.command_register = sp.command_register;
-  v.speed_register = sp.speed_register;
-  v.actual_speed_register = sp.actual_speed_register;
-  v.status_register = sp.status_register;
-  v.actual_speed_input = sp.actual_speed_table != config::SignalAddress::Table::holding;
-  v.status_input = sp.status_table != config::SignalAddress::Table::holding;
-  v.command_stop = sp.command_stop;
-  v.command_forward = sp.command_forward;
-  v.command_reverse = sp.command_reverse;
-  v.running_bit = sp.running_bit;
-  v.at_speed_bit = sp.at_speed_bit;
-  v.fault_bit = sp.fault_bit;
-  if (sp.position_register >= 0) {
-    if (sp.position_scale == 0 && problem.empty()) {
-      problem = section + "POSITION_REGISTER needs POSITION_SCALE (counts a revolution)";
-    }
-    v.position_register = sp.position_register;
-    v.position_input = sp.position_table != config::SignalAddress::Table::holding;
-    v.position_width = sp.position_width;
-    v.position_high_first = sp.position_high_first;
-    v.position_scale = sp.position_scale;
-    v.max_acceleration = sp.acceleration / 60.0;
+  if (sp.position_register >= 0 && sp.position_scale == 0 && problem.empty()) {
+    problem = section + "POSITION_REGISTER needs POSITION_SCALE (counts a revolution)";
   }
+  by_bus[std::max(0, sp.modbus)].vfd = sp;
   return problem;
 }
 

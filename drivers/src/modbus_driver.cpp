@@ -89,8 +89,7 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
   for (const auto& [number, io] : io_by_bus) {
     if (!machine.ini->has_section("MODBUS_" + std::to_string(number))) {
       return "no section [MODBUS_" + std::to_string(number) + "] for " +
-             (io.vfd.present ? std::string("the spindle ([SPINDLE_0] MODBUS)")
-                             : "a modbus: signal");
+             (io.vfd ? std::string("the spindle ([SPINDLE_0] MODBUS)") : "a modbus: signal");
     }
     by_bus.try_emplace(number);
   }
@@ -123,7 +122,7 @@ std::string ModbusDriver::configure(const config::MachineConfig& machine,
       if (p.signal == IoPoint::Signal::panel_counter) io_slot.panel_counters[n] = true;
       if (p.signal == IoPoint::Signal::panel_analog) io_slot.panel_analog[n] = true;
     }
-    io_slot.vfd = io.vfd.present;
+    io_slot.vfd = io.vfd.has_value();
     io_slot.stale_ns = stale_ns;
     const bool serves_io = !io.empty();
     buses_.push_back(std::make_unique<ModbusBus>(settings, std::move(drives), std::move(io)));

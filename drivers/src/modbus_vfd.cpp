@@ -22,6 +22,12 @@ using modbus_detail::is_exception;
 // A VFD told to run shows its running bit within this time, or it has tripped.
 constexpr std::int64_t kVfdStartNs = 1'000'000'000;
 
+// Whether the drive keeps a read-only register among its input registers (function 4) rather
+// than its holding registers (function 3).
+bool input_table(config::SignalAddress::Table table) {
+  return table != config::SignalAddress::Table::holding;
+}
+
 }  // namespace
 
 void ModbusBus::vfd_problem(const char* format, ...) {
@@ -29,8 +35,8 @@ void ModbusBus::vfd_problem(const char* format, ...) {
   vfd_reason_.copy(current.text.data(), current.text.size());
   if (current.text[0] != '\0') return;  // the first problem is the one to tell
   char text[kFaultReasonSize];
-  const int n = std::snprintf(text, sizeof text,
-                              "modbus bus %d slave %d (spindle VFD): ", bus_.number, io_.vfd.slave);
+  const int n = std::snprintf(
+      text, sizeof text, "modbus bus %d slave %d (spindle VFD): ", bus_.number, io_.vfd->slave);
   const auto used = static_cast<std::size_t>(std::clamp(n, 0, static_cast<int>(sizeof text) - 1));
   va_list args;
   va_start(args, format);
@@ -40,7 +46,7 @@ void ModbusBus::vfd_problem(const char* format, ...) {
 }
 
 bool ModbusBus::exchange_vfd(const IoCommand& command) {
-  const VfdSettings& v = io_.vfd;
+  const config::SpindleConfig& v = *io_.vfd;
   modbus_t* ctx = as_ctx(ctx_);
   modbus_set_slave(ctx, v.slave);
   const SpindleCommand& sp = command.spindle;
@@ -100,7 +106,7 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
   const bool has_position = v.position_register >= 0;
   if (has_position) {
     const std::int64_t sent = monotonic_ns();
-    if (!read(v.position_input, v.position_register, v.position_width / 16)) {
+    if (!read(input_table(v.position_table), v.position_register, v.position_width / 16)) {
       return is_exception(errno);
     }
     const std::int64_t earliest = sent + request_ns_;
@@ -119,20 +125,20 @@ bool ModbusBus::exchange_vfd(const IoCommand& command) {
   const bool has_speed = v.actual_speed_register >= 0;
   const bool has_status = v.status_register >= 0;
   bool ok = true;
-  if (has_speed && has_status && v.actual_speed_input == v.status_input &&
+  if (has_speed && has_status && input_table(v.actual_speed_table) == input_table(v.status_table) &&
       std::abs(v.actual_speed_register - v.status_register) < 8) {
     const int first = std::min(v.actual_speed_register, v.status_register);
     const int count = std::abs(v.actual_speed_register - v.status_register) + 1;
-    ok = read(v.status_input, first, count);
+    ok = read(input_table(v.status_table), first, count);
     raw_speed = regs[v.actual_speed_register - first];
     status = regs[v.status_register - first];
   } else {
     if (ok && has_speed) {
-      ok = read(v.actual_speed_input, v.actual_speed_register, 1);
+      ok = read(input_table(v.actual_speed_table), v.actual_speed_register, 1);
       raw_speed = regs[0];
     }
     if (ok && has_status) {
-      ok = read(v.status_input, v.status_register, 1);
+      ok = read(input_table(v.status_table), v.status_register, 1);
       status = regs[0];
     }
   }
