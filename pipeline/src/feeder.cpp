@@ -77,9 +77,7 @@ void ProgramFeeder::begin_move(motion::Move& next, int line) {
   // A tap brings the spindle to rest before it starts: no need to wait for its speed.
   if (next.kind != motion::Move::Kind::traverse && next.spindle_sync != motion::SpindleSync::tap &&
       need_at_speed_) {
-    motion::IoAction a;
-    a.kind = motion::IoAction::Kind::wait_at_speed;
-    add_action(a, line);
+    add_action({.kind = motion::IoAction::Kind::wait_at_speed}, line);
     need_at_speed_ = false;
   }
   if (!unsupported_ && machine_ != nullptr) {
@@ -111,11 +109,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
   };
   auto coolant = [&](bool& flag, bool on) {
     flag = on;
-    Action a;
-    a.kind = Action::Kind::coolant;
-    a.flood = flood_;
-    a.mist = mist_;
-    add_action(a, m.line);
+    add_action({.kind = Action::Kind::coolant, .flood = flood_, .mist = mist_}, m.line);
     return false;
   };
   auto hold = [&](HoldInfo info) { add_hold(std::move(info), m.line); };
@@ -245,12 +239,11 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             // The spindle stops for it, and the program goes on once it is oriented.
             spindle_direction_ = 0;
             need_at_speed_ = false;
-            Action a;
-            a.kind = Action::Kind::orient_spindle;
-            a.value = c.angle_deg;
-            a.mode = static_cast<std::int8_t>(c.mode);
-            a.timeout_s = kOrientTimeoutS;
-            add_action(a, m.line);
+            add_action({.kind = Action::Kind::orient_spindle,
+                        .mode = static_cast<std::int8_t>(c.mode),
+                        .value = c.angle_deg,
+                        .timeout_s = kOrientTimeoutS},
+                       m.line);
             return false;
           },
           [&](const in::WaitOrientSpindle& c) {
@@ -261,10 +254,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               pending_.back().action.timeout_s = c.timeout_s;
               return false;
             }
-            Action a;
-            a.kind = Action::Kind::wait_orient;
-            a.timeout_s = c.timeout_s;
-            add_action(a, m.line);
+            add_action({.kind = Action::Kind::wait_orient, .timeout_s = c.timeout_s}, m.line);
             return false;
           },
           [&](const in::StopSpeedFeedSynch&) {
@@ -303,10 +293,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             return false;
           },
           [&](const in::SetSpindleOverrideEnable& c) {
-            Action a;
-            a.kind = Action::Kind::spindle_override_enable;
-            a.on = c.on;
-            add_action(a, m.line);
+            add_action({.kind = Action::Kind::spindle_override_enable, .on = c.on}, m.line);
             return false;
           },
           [&](const in::SetOutputBit& c) {
@@ -316,11 +303,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               sync_.set = c.on ? sync_.set | bit : sync_.set & ~bit;
               sync_.clear = c.on ? sync_.clear & ~bit : sync_.clear | bit;
             } else {
-              Action a;
-              a.kind = Action::Kind::digital_output;
-              a.index = static_cast<std::int16_t>(c.index);
-              a.on = c.on;
-              add_action(a, m.line);
+              add_action({.kind = Action::Kind::digital_output,
+                          .on = c.on,
+                          .index = static_cast<std::int16_t>(c.index)},
+                         m.line);
             }
             return false;
           },
@@ -331,22 +317,20 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
                 sync_.analog_mask |= 1u << c.index;
               }
             } else {
-              Action a;
-              a.kind = Action::Kind::analog_output;
-              a.index = static_cast<std::int16_t>(c.index);
-              a.value = c.value;
-              add_action(a, m.line);
+              add_action({.kind = Action::Kind::analog_output,
+                          .index = static_cast<std::int16_t>(c.index),
+                          .value = c.value},
+                         m.line);
             }
             return false;
           },
           [&](const in::WaitInput& c) {
-            Action a;
-            a.kind = Action::Kind::wait_input;
-            a.index = static_cast<std::int16_t>(c.index);
-            a.digital = c.digital;
-            a.mode = static_cast<std::int8_t>(c.mode);
-            a.timeout_s = c.timeout_s;
-            add_action(a, m.line);
+            add_action({.kind = Action::Kind::wait_input,
+                        .digital = c.digital,
+                        .mode = static_cast<std::int8_t>(c.mode),
+                        .index = static_cast<std::int16_t>(c.index),
+                        .timeout_s = c.timeout_s},
+                       m.line);
             input_wait_seen_ = true;
             return false;
           },
