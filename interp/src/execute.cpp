@@ -205,23 +205,19 @@ void Interpreter::Impl::do_coolant_and_overrides() {
   }
   const int code = block_.m_code(MGroup::overrides);
   if (code < 0) return;
+  // M48 turns both overrides on and M49 both off; M50-M53 turn theirs on, or off with P0.
   const bool has_p = block_.has('p');
-  const bool on = !has_p || block_.get('p') != 0.0;
+  const bool on = code == 48 || (code != 49 && (!has_p || block_.get('p') != 0.0));
   if (comp_.on()) {
-    fail(code == 48 || (code != 49 && on)
-             ? "Cannot enable overrides with cutter radius compensation on"
-             : "Cannot disable overrides with cutter radius compensation on");
+    fail(on ? "Cannot enable overrides with cutter radius compensation on"
+            : "Cannot disable overrides with cutter radius compensation on");
   }
   switch (code) {
     case 48:
-      modal_.feed_override = modal_.speed_override = true;
-      emit(SetFeedOverrideEnable{true});
-      emit(SetSpindleOverrideEnable{true});
-      break;
     case 49:
-      modal_.feed_override = modal_.speed_override = false;
-      emit(SetFeedOverrideEnable{false});
-      emit(SetSpindleOverrideEnable{false});
+      modal_.feed_override = modal_.speed_override = on;
+      emit(SetFeedOverrideEnable{on});
+      emit(SetSpindleOverrideEnable{on});
       break;
     case 50:
       modal_.feed_override = on;
