@@ -11,21 +11,9 @@ namespace cncd::daemon {
 namespace {
 
 const char* wait_kind_name(motion::WaitStatus::Kind kind) {
-  switch (kind) {
-    case motion::WaitStatus::Kind::none:
-      return "";
-    case motion::WaitStatus::Kind::spindle_at_speed:
-      return "spindle_at_speed";
-    case motion::WaitStatus::Kind::input:
-      return "input";
-    case motion::WaitStatus::Kind::tool_change:
-      return "tool_change";
-    case motion::WaitStatus::Kind::user_m:
-      return "user_m";
-    case motion::WaitStatus::Kind::spindle_orient:
-      return "spindle_orient";
-  }
-  return "";
+  static constexpr const char* kNames[] = {"",       "spindle_at_speed", "input", "tool_change",
+                                           "user_m", "spindle_orient"};
+  return enum_name(kind, kNames);
 }
 
 }  // namespace

@@ -84,8 +84,9 @@ struct IoReport {
 
 // What a running program waits for ("" kind: nothing).
 struct WaitReport {
-  std::string kind;  // "tool_change" | "spindle_at_speed" | "input" | "user_m" | ""
-  int tool = 0;      // tool_change
+  // "tool_change" | "spindle_at_speed" | "input" | "user_m" | "spindle_orient" | ""
+  std::string kind;
+  int tool = 0;  // tool_change
   std::string message;
   double since_s = 0;  // how long it has waited
 };

@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 
+#include "cncd/config/enum_name.hpp"
 #include "cncd/config/evdev_codes.hpp"
 #include "evdev_reader.hpp"
 #include "panel_wiring.hpp"
@@ -39,15 +40,9 @@ std::string where(const std::string& key, const SignalAddress& a) {
 }
 
 const char* kind_of(EvdevCode::Type type) {
-  switch (type) {
-    case EvdevCode::Type::key:
-      return "a button (KEY_, BTN_)";
-    case EvdevCode::Type::rel:
-      return "a relative axis (REL_)";
-    case EvdevCode::Type::abs:
-      return "an absolute axis (ABS_)";
-  }
-  return "";
+  static constexpr const char* kNames[] = {"a button (KEY_, BTN_)", "a relative axis (REL_)",
+                                           "an absolute axis (ABS_)"};
+  return config::enum_name(type, kNames);
 }
 
 EvdevCode::Type type_for(Target target) {

@@ -4,6 +4,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cncd/config/enum_name.hpp"
+
 namespace cncd::fleet {
 
 using nlohmann::json;
@@ -39,19 +41,10 @@ std::string printable(std::string_view text) {
 }
 
 const char* refusal_name(MachineTable::Refusal why) {
-  switch (why) {
-    case MachineTable::Refusal::too_large:
-      return "payload over the size limit";
-    case MachineTable::Refusal::bad_topic:
-      return "topic outside the pattern";
-    case MachineTable::Refusal::bad_json:
-      return "payload not JSON";
-    case MachineTable::Refusal::table_full:
-      return "machine beyond the table's limit";
-    case MachineTable::Refusal::bad_value:
-      return "payload not as expected";
-  }
-  return "?";
+  static constexpr const char* kNames[] = {
+      "payload over the size limit", "topic outside the pattern", "payload not JSON",
+      "machine beyond the table's limit", "payload not as expected"};
+  return config::enum_name(why, kNames);
 }
 
 json number(const json& object, const char* key) {
