@@ -127,39 +127,39 @@ json rt_object(const motion::RtStats& rt) {
           {"memory_locked", rt.memory_locked}};
 }
 
+// An axis index as its letter ("X"), null for none.
+json axis_letter(int axis) {
+  return axis >= 0 && static_cast<std::size_t>(axis) < config::kAxisLetters.size()
+             ? json(std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)]))
+             : json(nullptr);
+}
+
 json manual_holder_object(const std::optional<ManualHolder>& holder) {
   if (!holder) return nullptr;
-  const int axis = holder->axis;
-  return {{"by", holder->by},
-          {"panel", holder->panel},
-          {"axis", axis >= 0 && static_cast<std::size_t>(axis) < config::kAxisLetters.size()
-                       ? json(std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)]))
-                       : json(nullptr)}};
+  return {{"by", holder->by}, {"panel", holder->panel}, {"axis", axis_letter(holder->axis)}};
+}
+
+// {"KEY": true, ...} of the panel's inputs or lights.
+json flags_object(const std::vector<std::pair<std::string, bool>>& flags) {
+  json out = json::object();
+  for (const auto& [key, on] : flags)
+    out[key] = on;
+  return out;
 }
 
 json panel_object(const std::optional<PanelReport>& panel) {
   if (!panel) return nullptr;
-  json inputs = json::object();
-  for (const auto& [key, on] : panel->inputs)
-    inputs[key] = on;
-  json lights = json::object();
-  for (const auto& [key, on] : panel->lights)
-    lights[key] = on;
-  const int axis = panel->mpg_axis;
-  return json{
-      {"inputs", inputs},
-      {"mpg",
-       {{"axis", axis >= 0 && static_cast<std::size_t>(axis) < config::kAxisLetters.size()
-                     ? json(std::string(1, config::kAxisLetters[static_cast<std::size_t>(axis)]))
-                     : json(nullptr)},
-        {"step", panel->mpg_step},
-        {"counts", panel->mpg_counts},
-        {"jogging", panel->mpg_jogging}}},
-      {"door", panel->door},
-      {"single_block", panel->single_block},
-      {"optional_stop", panel->optional_stop},
-      {"block_delete", panel->block_delete},
-      {"lights", lights}};
+  return json{{"inputs", flags_object(panel->inputs)},
+              {"mpg",
+               {{"axis", axis_letter(panel->mpg_axis)},
+                {"step", panel->mpg_step},
+                {"counts", panel->mpg_counts},
+                {"jogging", panel->mpg_jogging}}},
+              {"door", panel->door},
+              {"single_block", panel->single_block},
+              {"optional_stop", panel->optional_stop},
+              {"block_delete", panel->block_delete},
+              {"lights", flags_object(panel->lights)}};
 }
 
 }  // namespace
