@@ -136,15 +136,20 @@ void Planner::take(Segment seg, const Move& move) {
   }
   const double full_length = seg.length;
   next_reserved_ = false;
+  next_entry_speed_ = 1e300;
   if (held_) join(seg, move);
   if (seg.kind == Segment::Kind::dwell || move.path_mode == Move::PathMode::exact_stop) {
     seg.continuous = false;
     output_.push_back(seg);
     return;
   }
-  held_ = Held{
-      seg,           move.path_mode, move.tolerance, full_length, move.kind == Move::Kind::traverse,
-      next_reserved_};
+  held_ = Held{seg,
+               move.path_mode,
+               move.tolerance,
+               full_length,
+               move.kind == Move::Kind::traverse,
+               next_reserved_,
+               next_entry_speed_};
 }
 
 void Planner::flush() {
@@ -262,7 +267,16 @@ void Planner::join(Segment& next, const Move& move) {
   } else {
     blend.feed = std::max(prev.feed, next.feed);  // a traverse has none
   }
-  set_blend_limits(blend);
+  // The fastest the line before the arc can be left: from the speed bound at its start,
+  // accelerating all along what the arc leaves of it (and two servo periods' margin).
+  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
+  const double line_left = prev.length - reach;
+  const double entry = std::min(prev.axis_velocity,
+                                std::sqrt(held.entry_speed * held.entry_speed +
+                                          2.0 * prev.max_acceleration * std::max(0.0, line_left))) +
+                       2.0 * prev.max_acceleration * dt;
+  set_blend_limits(blend, entry);
+  next_entry_speed_ = blend.axis_velocity;
 
   prev.end = blend.start;
   prev.length -= reach;
@@ -314,7 +328,7 @@ void Planner::reserve_for_kink(Segment& seg) {
   seg.max_velocity = std::min(seg.max_velocity, seg.axis_velocity);
 }
 
-void Planner::set_blend_limits(Segment& blend) const {
+void Planner::set_blend_limits(Segment& blend, double entry_speed) const {
   // Along the arc, axis i's share of the unit tangent is T_i = w cos(phi + alpha) and of the
   // unit normal (towards the centre) N_i = -w sin(phi + alpha), w = |(u_i, v_i)| its share of
   // the plane. Two bounds hold for its acceleration a_t T_i + a_n N_i: the orthogonal one,
@@ -349,30 +363,70 @@ void Planner::set_blend_limits(Segment& blend) const {
     linear = linear || i < 3;
   }
   if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
+  // The speed limit and the tangential acceleration limit of the arc when its centripetal
+  // part is sized for `fastest`.
+  auto limits = [&](double fastest, double& cap, double& accel) {
+    double v_orthogonal = v;
+    double a_orthogonal = 0;
+    curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v_orthogonal, a_orthogonal);
+    // The sum bound: the centripetal part takes what the fastest speed needs (at most the
+    // share of what every axis allows), the tangential part what each axis has left.
+    double centripetal = fastest * fastest / blend.radius;
+    if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
+    const double v_sum = std::min(v, std::sqrt(centripetal * blend.radius));
+    double a_sum = 1e300;
+    for (std::size_t k = 0; k < kAxes; ++k) {
+      if (max_t[k] <= 1e-12) continue;
+      const double left = config_.axes[k].max_acceleration - centripetal * max_n[k];
+      a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
+    }
+    // Only where it allows both as much speed and more acceleration: a blend left with little
+    // tangential acceleration would slow everything that has to brake through it.
+    const bool sum_better = v_sum >= v_orthogonal * (1 - 1e-12) && a_sum > a_orthogonal;
+    cap = sum_better ? v_sum : v_orthogonal;
+    accel = sum_better ? a_sum : a_orthogonal;
+  };
   const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
-  double v_orthogonal = v;
-  double a_orthogonal = 0;
-  curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v_orthogonal, a_orthogonal);
-  // The sum bound: the centripetal part takes what the fastest speed needs (at most the share
-  // of what every axis allows), the tangential part what each axis has left.
-  double v_sum = v;
-  double centripetal = fastest * fastest / blend.radius;
-  if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
-  v_sum = std::min(v_sum, std::sqrt(centripetal * blend.radius));
-  double a_sum = 1e300;
-  for (int i = 0; i < kAxes; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (max_t[k] <= 1e-12) continue;
-    const double left = config_.axes[k].max_acceleration - centripetal * max_n[k];
-    a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
+  limits(fastest, blend.axis_velocity, blend.max_acceleration);
+  auto set_feed_limit = [&blend] {
+    blend.max_velocity =
+        blend.feed > 0 ? std::min(blend.axis_velocity, blend.feed) : blend.axis_velocity;
+  };
+  set_feed_limit();
+  // No profile within the limits before the arc enters it faster than `entry_speed`, nor
+  // leaves it faster than sqrt(entry^2 + 2 a_t length) (with a margin of two servo periods'
+  // acceleration each for the servo loop's steps). Sizing the centripetal part for the lowest
+  // speed limit that still lets every such profile through leaves the rest of the
+  // acceleration to the tangential part: every profile that fitted the old limits fits the
+  // new ones, and the arc may speed up and slow down faster.
+  if (!(entry_speed < blend.axis_velocity)) return;
+  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
+  auto lets_through = [&](double cap, double accel) {
+    const double peak = std::sqrt(entry_speed * entry_speed + 2.0 * accel * blend.length);
+    return cap >= peak + 2.0 * accel * dt;
+  };
+  if (!lets_through(blend.axis_velocity, blend.max_acceleration)) return;
+  double lo = 0;
+  double hi = fastest;
+  double hi_cap = blend.axis_velocity;
+  double hi_accel = blend.max_acceleration;
+  for (int step = 0; step < 24; ++step) {
+    const double mid = 0.5 * (lo + hi);
+    double cap = 0;
+    double accel = 0;
+    limits(mid, cap, accel);
+    if (lets_through(cap, accel)) {
+      hi = mid;
+      hi_cap = cap;
+      hi_accel = accel;
+    } else {
+      lo = mid;
+    }
   }
-  // Only where it allows both as much speed and more acceleration: a blend left with little
-  // tangential acceleration would slow everything that has to brake through it.
-  const bool sum_better = v_sum >= v_orthogonal * (1 - 1e-12) && a_sum > a_orthogonal;
-  blend.axis_velocity = sum_better ? v_sum : v_orthogonal;
-  blend.max_velocity =
-      blend.feed > 0 ? std::min(blend.axis_velocity, blend.feed) : blend.axis_velocity;
-  blend.max_acceleration = sum_better ? a_sum : a_orthogonal;
+  if (hi_accel <= blend.max_acceleration) return;
+  blend.axis_velocity = hi_cap;
+  blend.max_acceleration = hi_accel;
+  set_feed_limit();
 }
 
 }  // namespace cncd::motion

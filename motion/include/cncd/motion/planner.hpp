@@ -75,7 +75,10 @@ class Planner {
   void set_limits(Segment& seg) const;
   static void set_directions(Segment& seg);
   // Path speed and acceleration limits of a blend arc (blend_u, blend_v and radius set).
-  void set_blend_limits(Segment& blend) const;
+  // `entry_speed`: a bound on the speed at which any profile within the limits of the
+  // segments before it can enter the arc; below the arc's speed limit, the centripetal part
+  // is sized for the fastest such profile and the tangential part gets the rest.
+  void set_blend_limits(Segment& blend, double entry_speed = 1e300) const;
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
   // a blend arc (trimming both lines), or leaves a stop. Emits the held segment.
   void join(Segment& next, const Move& move);
@@ -102,6 +105,9 @@ class Planner {
     double full_length = 0;  // before any blend trimmed it
     bool traverse = false;
     bool reserved = false;  // its acceleration is already reduced for a kink
+    // A bound on the speed at its start: the speed limit of the blend arc before it (no
+    // bound after any other junction).
+    double entry_speed = 1e300;
   };
 
   // Consecutive G1 lines of the same feed whose points all lie within Q of the line from the
@@ -125,7 +131,8 @@ class Planner {
   AxisPose end_{};
   std::optional<Merge> merge_;
   std::optional<Held> held_;
-  bool next_reserved_ = false;  // join() reduced the next segment's limits for a kink
+  bool next_reserved_ = false;       // join() reduced the next segment's limits for a kink
+  double next_entry_speed_ = 1e300;  // join() ended the held segment in a blend arc this fast
   // Outputs of moves that went nowhere, for the next segment to set (SyncOutputs).
   SyncOutputs pending_sync_{};
   // Adds the `earlier` settings of outputs to `into`, whose own settings win.

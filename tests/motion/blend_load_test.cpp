@@ -1,0 +1,140 @@
+// Blend arcs sized for the speed they can actually be entered at: below its curvature's speed
+// limit an arc leaves more of the acceleration to speeding up and slowing down, and at every
+// point of every arc each axis stays within its velocity and acceleration limits.
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using motion::AxisPose;
+using motion::Move;
+using motion::Segment;
+
+// Plans G64 P`p` lines from `start` through `points` at `feeds` (150 where not given).
+std::deque<Segment> plan_path(const config::MachineConfig& config, const AxisPose& start,
+                              const std::vector<AxisPose>& points, double p,
+                              const std::vector<double>& feeds = {}) {
+  motion::Planner planner(config);
+  planner.reset(start);
+  std::string error;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const double feed = k < feeds.size() ? feeds[k] : 150.0;
+    Move move = line_to(Move::Kind::feed, points[k][0], points[k][1], points[k][2], feed);
+    move.path_mode = Move::PathMode::blend;
+    move.tolerance = p;
+    EXPECT_TRUE(planner.push(move, true, error)) << error;
+  }
+  planner.flush();
+  return planner.output();
+}
+
+// The worst acceleration and velocity of each axis anywhere on `arc` at its speed limit and its
+// full tangential acceleration, of either sign, against the axes' limits (largest ratio).
+double worst_load(const config::MachineConfig& config, const Segment& arc) {
+  const double v = arc.axis_velocity;
+  const double a_n = v * v / arc.radius;
+  double worst = 0;
+  for (int k = 0; k <= 64; ++k) {
+    const double phi = arc.sweep * k / 64.0;
+    for (int i = 0; i < 3; ++i) {
+      const auto& axis = config.axes[static_cast<std::size_t>(i)];
+      const double t = -std::sin(phi) * arc.blend_u[i] + std::cos(phi) * arc.blend_v[i];
+      const double n = -(std::cos(phi) * arc.blend_u[i] + std::sin(phi) * arc.blend_v[i]);
+      worst = std::max(
+          worst, (std::abs(arc.max_acceleration * t) + std::abs(a_n * n)) / axis.max_acceleration);
+      worst = std::max(worst, std::abs(v * t) / axis.max_velocity);
+    }
+  }
+  return worst;
+}
+
+// A sharp corner (slow, tight blend), a short line, then a gentle corner whose curvature alone
+// would allow far more speed than the short line can reach from the sharp corner.
+TEST(BlendLoad, AnArcEnteredBelowItsTopSpeedGetsMoreTangentialAcceleration) {
+  const auto config = small_mill();
+  const double h1 = 2 * std::numbers::pi / 3;          // 120 degrees at a
+  const double h2 = h1 + 20 * std::numbers::pi / 180;  // then 20 degrees at b
+  const AxisPose a{10, 0, 0};
+  auto step = [](const AxisPose& from, double heading, double length) {
+    return AxisPose{from[0] + length * std::cos(heading), from[1] + length * std::sin(heading), 0};
+  };
+  const AxisPose b = step(a, h1, 2);
+  const AxisPose c = step(b, h2, 10);
+  const auto out = plan_path(config, AxisPose{}, {a, b, c}, 0.1);
+  std::vector<Segment> arcs;
+  std::vector<Segment> lines;
+  for (const auto& seg : out)
+    (seg.kind == Segment::Kind::blend ? arcs : lines).push_back(seg);
+  ASSERT_EQ(arcs.size(), 2u);
+  ASSERT_EQ(lines.size(), 3u);
+  const Segment& sharp = arcs[0];
+  const Segment& soft = arcs[1];
+  const Segment& between = lines[1];
+  // The same gentle corner at the end of the same 2 mm line, entered straight on from further
+  // back (no corner before it): the arc sized for its top speed.
+  const auto reference = plan_path(config, step(b, h1, -4), {step(b, h1, -2), b, c}, 0.1);
+  const Segment* top = nullptr;
+  for (const auto& seg : reference)
+    if (seg.kind == Segment::Kind::blend) top = &seg;
+  ASSERT_NE(top, nullptr);
+  EXPECT_NEAR(top->radius, soft.radius, 1e-9);
+  // At its top speed the centripetal part takes 0.95 of the plane's 2000: 0.31 is left.
+  EXPECT_NEAR(top->axis_velocity, std::sqrt(0.95 * 2000 * top->radius), 1e-9);
+  EXPECT_LE(top->max_acceleration, std::sqrt(1 - 0.95 * 0.95) * 2000 * (1 + 1e-9));
+  // Entered from the sharp corner over the short line, the arc can be reached no faster than
+  // sqrt(v_sharp^2 + 2 a L): it keeps a speed limit at least that high (plus the arc's own
+  // speeding up) and gets much more of the acceleration along the path.
+  const double reach = std::sqrt(sharp.axis_velocity * sharp.axis_velocity +
+                                 2 * between.max_acceleration * between.length);
+  EXPECT_LT(soft.axis_velocity, top->axis_velocity);
+  EXPECT_GE(soft.axis_velocity, std::sqrt(reach * reach + 2 * soft.max_acceleration * soft.length));
+  EXPECT_GT(soft.max_acceleration, 1.5 * top->max_acceleration);
+  EXPECT_LE(worst_load(config, soft), 1 + 1e-9);
+  EXPECT_LE(worst_load(config, *top), 1 + 1e-9);
+}
+
+// Random dense 3D paths of short lines with small and large turns, random feeds and
+// tolerances: every blend arc, at its speed limit with its full tangential acceleration of
+// either sign, keeps every axis within its velocity and acceleration limits.
+TEST(BlendLoad, RandomDensePathsKeepEveryAxisWithinItsLimitsOnTheArcs) {
+  const auto config = small_mill();
+  std::mt19937 rng(28);
+  std::uniform_real_distribution<double> unit(0, 1);
+  int arcs = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<AxisPose> points;
+    std::vector<double> feeds;
+    AxisPose p{};
+    double heading = unit(rng) * 2 * std::numbers::pi;
+    double climb = (unit(rng) - 0.5) * 0.6;
+    for (int k = 0; k < 60; ++k) {
+      const double turn =
+          (unit(rng) < 0.2 ? 40 + 80 * unit(rng) : 3 + 27 * unit(rng)) * std::numbers::pi / 180;
+      heading += unit(rng) < 0.5 ? turn : -turn;
+      climb = std::clamp(climb + (unit(rng) - 0.5) * 0.4, -0.8, 0.8);
+      const double length = 0.3 + 6 * unit(rng);
+      p[0] += length * std::cos(climb) * std::cos(heading);
+      p[1] += length * std::cos(climb) * std::sin(heading);
+      p[2] += length * std::sin(climb);
+      points.push_back(p);
+      feeds.push_back(20 + 200 * unit(rng));
+    }
+    const double tolerance = 0.01 + 0.2 * unit(rng);
+    for (const auto& seg : plan_path(config, AxisPose{}, points, tolerance, feeds)) {
+      if (seg.kind != Segment::Kind::blend) continue;
+      ++arcs;
+      EXPECT_LE(worst_load(config, seg), 1 + 1e-9) << "trial " << trial;
+      EXPECT_LE(seg.max_velocity, seg.axis_velocity);
+    }
+  }
+  EXPECT_GT(arcs, 1000);
+}
+
+}  // namespace
+}  // namespace cncd::test
