@@ -86,9 +86,16 @@ class SaveFailureTest : public ::testing::Test {
     fs::remove(state_ / "probe");
   }
 
+  // A remount read-only is refused (EBUSY) while a file there is open for writing: at start
+  // the job history opens jobs.db on its own thread (marking runs cut short), then closes it.
   void make_read_only() {
-    ASSERT_EQ(mount("tmpfs", state_.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, "size=64k"), 0)
-        << std::strerror(errno);
+    int rc = -1;
+    for (int i = 0; i < 1000; ++i) {
+      rc = mount("tmpfs", state_.c_str(), "tmpfs", MS_REMOUNT | MS_RDONLY, "size=64k");
+      if (rc == 0 || errno != EBUSY) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_EQ(rc, 0) << std::strerror(errno);
   }
 
   // The files in the state directory that are neither the state files nor the filler: a
