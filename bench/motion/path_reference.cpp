@@ -229,6 +229,7 @@ void solve(const config::MachineConfig& machine, const std::vector<Segment>& mov
     after = true;
   }
   out.steps = grid.solve(out.move_s);
+  if (options.profile) out.profile = grid.profile();
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
@@ -33,6 +34,15 @@ struct ReferenceOptions {
   // (rad); at least two steps a curve.
   double max_step = 0.02;
   double max_turn = 0.01;
+  bool profile = false;  // fill PathReference::profile
+};
+
+// A point of a speed profile: the path speed v (units/s) at path length s (units, along the
+// path as the reference rounds its corners) in the move `move` counts in.
+struct SpeedPoint {
+  double s = 0;
+  double v = 0;
+  std::uint32_t move = 0;
 };
 
 struct PathReference {
@@ -41,9 +51,10 @@ struct PathReference {
   // it included, as Status::moves_done counts moves) to its end; dwells their time; a run of
   // merged moves counts in its last.
   std::vector<double> move_s;
-  std::size_t steps = 0;   // grid steps
-  std::size_t stops = 0;   // corners the path stops at (the ends not counted)
-  std::size_t blends = 0;  // corners rounded
+  std::size_t steps = 0;            // grid steps
+  std::size_t stops = 0;            // corners the path stops at (the ends not counted)
+  std::size_t blends = 0;           // corners rounded
+  std::vector<SpeedPoint> profile;  // with ReferenceOptions::profile
 };
 
 // `moves`: the path's programmed moves in order (lines, arcs, dwells), as the planner plans

@@ -15,11 +15,18 @@
 // 3D_Chips and the surface finish, where the time goes (path_diagnosis.hpp).
 //
 //   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] [--jerk J] [--only TEXT]
+//                      [--speed-svg FILE [--speed-window FROM,TO]]
 //
 // --only TEXT runs the programs whose name contains TEXT.
 //
 // --jerk J runs cncd with S-curve profiles ([TRAJ] MAX_LINEAR_JERK = J mm/s^3) and without
 // LinuxCNC, whose 2.9 planner has none (the floors stay those of trapezoids).
+//
+// --speed-svg FILE writes the picture of speed_svg.hpp for the first program with a diagnosis
+// (3D_Chips when it is there): the path speed against path length along the path alone,
+// cncd's from the servo loop's samples, the reference's within P, Q and the programmed feed,
+// from FROM to TO mm of the path (--speed-window), by default over the 40 mm where cncd
+// takes the most time over the reference.
 //
 // A benchmark: it prints figures and never fails on them.
 #include <sys/wait.h>
@@ -43,6 +50,7 @@
 #include "path_floor.hpp"
 #include "path_reference.hpp"
 #include "planner_programs.hpp"
+#include "speed_svg.hpp"
 
 namespace {
 
@@ -105,12 +113,19 @@ struct Bench {
   bool linuxcnc = false;
   std::string run_sh;
   fs::path lcnc_ini;
+  fs::path speed_svg;                               // --speed-svg, empty: none
+  std::optional<cncd::bench::Window> speed_window;  // --speed-window
+  mutable bool pictured = false;
 
   cncd::pipeline::PlanSimResult simulate(
       const fs::path& program, std::vector<cncd::motion::Segment>* path_moves = nullptr,
-      int first_line = 0, int last_line = 0,
-      std::vector<cncd::motion::Segment>* segments = nullptr) const {
+      int first_line = 0, int last_line = 0, std::vector<cncd::motion::Segment>* segments = nullptr,
+      std::vector<cncd::motion::AxisPose>* samples = nullptr) const {
     cncd::pipeline::PlanSimOptions options;
+    if (samples != nullptr)
+      options.on_sample = [samples](double, const cncd::motion::AxisPose& at, double) {
+        samples->push_back(at);
+      };
     options.interp = cncd::pipeline::interpreter_options(machine);
     options.start_machine = cncd::interp::Pose{};
     if (segments != nullptr)
@@ -190,6 +205,8 @@ struct Bench {
     within.tolerance = program.tolerance;
     cncd::bench::ReferenceOptions merged = within;
     merged.merge_tolerance = program.merge_tolerance;
+    const bool picture = program.diagnose && !speed_svg.empty() && !pictured;
+    merged.profile = picture;
     const auto started = std::chrono::steady_clock::now();
     const auto ref_exact = cncd::bench::time_optimal(machine, moves, exact);
     const auto ref_within = cncd::bench::time_optimal(machine, moves, within);
@@ -225,7 +242,8 @@ struct Bench {
       return;
     }
     std::vector<cncd::motion::Segment> segments;
-    const auto a = simulate(alone, nullptr, 0, 0, &segments);
+    std::vector<cncd::motion::AxisPose> samples;
+    const auto a = simulate(alone, nullptr, 0, 0, &segments, picture ? &samples : nullptr);
     if (!a.complete()) {
       std::printf("    cncd alone: %s\n",
                   (a.error ? a.error->to_string() : a.stopped->to_string()).c_str());
@@ -244,11 +262,29 @@ struct Bench {
           cncd::bench::planned_optimal(machine, segments, moves.size()),
           cncd::bench::planned_optimal(machine, segments, moves.size(), true));
     }
+    if (picture) picture_speed(program, moves, ref, samples);
     if (const auto l = linuxcnc_run(alone)) {
       ratios("LinuxCNC", "alone (moving)", l->moving_s);
       std::printf("    cncd/LinuxCNC alone %.4f (LinuxCNC run, cycle start to idle, %.3f s)\n",
                   a.cycle_time_s / l->moving_s, l->run_s);
     }
+  }
+
+  // --speed-svg: cncd's speed from its samples (XYZ, per servo period), the reference's, the
+  // feed of the move the reference's point counts in.
+  void picture_speed(const cncd::bench::BenchProgram& program,
+                     const std::vector<cncd::motion::Segment>& moves,
+                     const cncd::bench::PathReference& ref,
+                     const std::vector<cncd::motion::AxisPose>& samples) const {
+    pictured = true;
+    const auto picture = cncd::bench::write_speed_picture(
+        speed_svg, program.name, static_cast<double>(machine.servo_period_ns) * 1e-9, moves,
+        ref.profile, samples, speed_window);
+    std::printf(
+        "    speed picture: %s (s %.1f .. %.1f mm of %.1f mm; cncd's samples end at %.1f mm): "
+        "cncd %.3f s, reference %.3f s there\n",
+        speed_svg.c_str(), picture.window.from, picture.window.to, picture.reference_length,
+        picture.cncd_length, picture.cncd_s, picture.reference_s);
   }
 };
 
@@ -260,6 +296,9 @@ int main(int argc, char** argv) {
   double jerk = 0;
   std::string only;
   std::string run_sh = default_run_sh();
+  fs::path speed_svg;
+  std::optional<cncd::bench::Window> speed_window;
+  cncd::bench::Window window;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--no-linuxcnc") {
@@ -268,6 +307,13 @@ int main(int argc, char** argv) {
       keep = true;
     } else if (arg == "--only" && i + 1 < argc) {
       only = argv[++i];
+    } else if (arg == "--speed-svg" && i + 1 < argc) {
+      speed_svg = argv[++i];
+    } else if (arg == "--speed-window" && i + 1 < argc &&
+               std::sscanf(argv[i + 1], "%lf,%lf", &window.from, &window.to) == 2 &&
+               window.to > window.from) {
+      speed_window = window;
+      ++i;
     } else if (arg == "--run-sh" && i + 1 < argc) {
       run_sh = argv[++i];
     } else if (arg == "--jerk" && i + 1 < argc && std::atof(argv[i + 1]) >= 1) {
@@ -276,7 +322,10 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] "
-                   "[--jerk J (>= 1 mm/s^3)] [--only TEXT]\n");
+                   "[--jerk J (>= 1 mm/s^3)] [--only TEXT]\n"
+                   "       [--speed-svg FILE [--speed-window FROM,TO (mm of path length)]]\n"
+                   "  --speed-svg: SVG picture of the path speed along the first diagnosed path "
+                   "(3D_Chips): cncd, the time-optimal reference within P, Q, the feed\n");
       return 64;
     }
   }
@@ -326,7 +375,7 @@ int main(int argc, char** argv) {
                 .c_str()
           : "trapezoidal profiles",
       build, dir.c_str());
-  const Bench bench{machine, dir, linuxcnc, run_sh, lcnc_ini};
+  const Bench bench{machine, dir, linuxcnc, run_sh, lcnc_ini, speed_svg, speed_window};
   for (const auto& program : programs) {
     if (program.name.find(only) == std::string::npos) continue;
     std::printf("%s  (%s)\n", program.name.c_str(), program.path.filename().c_str());

@@ -114,10 +114,35 @@ class Grid {
 
   // The passes; adds each step's time to its move's.
   std::size_t solve(std::vector<double>& move_s) const {
+    const std::vector<double> x = speeds();
+    for (std::size_t k = 0; k < steps_.size(); ++k)
+      move_s[steps_[k].move] += time(steps_[k], x[k], x[k + 1]);
+    return steps_.size();
+  }
+
+  // The speed along the path after the passes: a point at every node, and on a line's ramps
+  // enough points between that the speed reads straight between them.
+  std::vector<SpeedPoint> profile() const {
+    const std::vector<double> x = speeds();
+    std::vector<SpeedPoint> out;
+    double s = 0;
+    if (!steps_.empty()) out.push_back({0, 0, steps_.front().move});
+    for (std::size_t k = 0; k < steps_.size(); ++k) {
+      const Step& step = steps_[k];
+      if (!step.curved && step.accel < kInf) ramps(step, s, x[k], x[k + 1], out);
+      s += step.length;
+      out.push_back({s, std::sqrt(x[k + 1]), step.move});
+    }
+    return out;
+  }
+
+ private:
+  // Speed squared at every node: at rest at both ends, within the caps and the limits, then
+  // the backward and forward passes.
+  std::vector<double> speeds() const {
     const std::size_t n = steps_.size();
-    if (n == 0) return 0;
-    // At rest at both ends; within both neighbouring steps' caps in between.
     std::vector<double> x;
+    if (n == 0) return x;
     x.reserve(n + 1);
     x.push_back(0);
     for (std::size_t k = 1; k < n; ++k)
@@ -129,12 +154,28 @@ class Grid {
       x[k] = std::min(x[k], backward(steps_[k], x[k + 1]));
     for (std::size_t k = 0; k < n; ++k)
       x[k + 1] = std::min(x[k + 1], forward(steps_[k], x[k]));
-    for (std::size_t k = 0; k < n; ++k)
-      move_s[steps_[k].move] += time(steps_[k], x[k], x[k + 1]);
-    return n;
+    return x;
   }
 
- private:
+  // The inside of a line's step from s0 (speeds squared x0, x1 at its ends): up at its
+  // acceleration to the peak, at the peak, down to x1 (x linear in s on the ramps).
+  static void ramps(const Step& step, double s0, double x0, double x1,
+                    std::vector<SpeedPoint>& out) {
+    constexpr int kPoints = 8;  // a ramp's
+    const double a = step.accel;
+    const double peak = std::max({std::min(step.cap, 0.5 * (x0 + x1) + a * step.length), x0, x1});
+    const double up = (peak - x0) / (2 * a), down = (peak - x1) / (2 * a);
+    for (int k = 1; k <= kPoints && up > 0; ++k) {
+      const double d = up * k / kPoints;
+      out.push_back({s0 + d, std::sqrt(x0 + 2 * a * d), step.move});
+    }
+    const double from = s0 + step.length - down;
+    for (int k = 0; k < kPoints && down > 0; ++k) {
+      const double d = down * k / kPoints;
+      out.push_back({from + d, std::sqrt(peak - 2 * a * d), step.move});
+    }
+  }
+
   double a(int i) const { return a_[static_cast<std::size_t>(i)]; }
 
   // Highest speed squared at a point of tangent t and curvature c: the feed, the axes'
