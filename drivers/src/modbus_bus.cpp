@@ -152,7 +152,8 @@ void ModbusBus::fail(std::size_t index, const char* what, int first, int count, 
     }
     FaultText current;
     reason_.copy(current.text.data(), current.text.size());
-    if (current.text[0] == '\0') reason_.set(text);
+    if (current.text[0] == '\0' || reason_outdated_) reason_.set(text);
+    reason_outdated_ = false;
   }
   s.latched = true;
   // A reply that is an exception or a fault bit leaves the link usable; anything else
@@ -376,7 +377,7 @@ void ModbusBus::loop() {
         // fails again, not the last.
         if (setpoint.reset_request != reason_reset_) {
           reason_reset_ = setpoint.reset_request;
-          reason_.clear();
+          reason_outdated_ = true;
         }
       }
       if (!connected) {
@@ -392,6 +393,12 @@ void ModbusBus::loop() {
       s.last.reset_ack = s.reset_ack;
       s.last.fault = s.latched;
       readbacks_[i].store(s.last);
+    }
+    // No drive failed since the reset: the reason from before it is history.
+    if (reason_outdated_ &&
+        std::none_of(state_.begin(), state_.end(), [](const DriveState& d) { return d.latched; })) {
+      reason_.clear();
+      reason_outdated_ = false;
     }
     if (!io_.empty()) exchange_io(connected);
     cycles_.fetch_add(1, std::memory_order_relaxed);

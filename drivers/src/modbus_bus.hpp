@@ -227,7 +227,11 @@ class ModbusBus {
   std::int64_t request_ns_ = 0;
   std::int64_t response_ns_ = 0;
   std::uint32_t reason_reset_ = 0;  // the reset request that last cleared reason_
-  void* ctx_ = nullptr;             // modbus_t*, I/O thread only once started
+  // A reset was asked for since reason_ was written: the next failure replaces it, and an
+  // update with none clears it. Never emptied in between, so that the servo thread, reading it
+  // on the stale feedback that follows the reset, still finds why.
+  bool reason_outdated_ = false;
+  void* ctx_ = nullptr;  // modbus_t*, I/O thread only once started
   bool link_failed_ = false;
   std::atomic<std::uint64_t> cycles_{0};
   std::atomic<std::uint64_t> errors_{0};
