@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iterator>
 
+#include "cncd/config/enum_name.hpp"
 #include "cncd/config/machine_config.hpp"
 
 namespace cncd::motion {
@@ -185,8 +186,7 @@ const char* event_code_name(RtEvent::Code code) noexcept {
                                            "sync_jump",
                                            "sync_not_at_rest"};
   static_assert(std::size(kNames) == static_cast<std::size_t>(RtEvent::Code::sync_not_at_rest) + 1);
-  const auto index = static_cast<std::size_t>(code);
-  return index < std::size(kNames) ? kNames[index] : "";
+  return config::enum_name(code, kNames);
 }
 
 std::string format_event(const RtEvent& event) {
