@@ -136,9 +136,12 @@ std::optional<ProgramRunner::Outcome> ProgramRunner::skip_block(bool program_end
   // Under G41/G42 the interpreter holds each move back until it has read the next: the move
   // the line starts from (the one before it, ending at the compensated corner) comes out with
   // a later block. The lines before keep being skipped until a move of the line or a later one
-  // is out; the way then leads to where the compensated path left off.
+  // is out; the way then leads to where the compensated path left off. A stop or wait of the
+  // line or a later one (M0, M1, M60, M66) has put out every move before it: the way leads
+  // there, and the machine stops or waits as the program says.
   if (!skip_feed_) skip_feed_ = feeder_.feed_in_force();
-  if (interp_.state().gcodes[4] > 400 && !program_ended && !feeder_.moves_from(skip_to_)) {
+  if (interp_.state().gcodes[4] > 400 && !program_ended && !feeder_.moves_from(skip_to_) &&
+      !feeder_.waits_seen()) {
     if (feeder_.drop_pending_before(skip_to_, skip_end_)) skip_moved_ = true;
     return std::nullopt;
   }

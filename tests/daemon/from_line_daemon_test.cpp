@@ -119,5 +119,31 @@ TEST_F(FromLineTest, RunFromALineUnderCutterCompensationStartsAtTheCompensatedPo
       });
 }
 
+// An M0 on the line a run starts from under cutter compensation stops the machine there, as in
+// the whole run: the M0 puts out line 5's move (ending at X9 Y10, the next move not yet read),
+// the way leads there, and the machine waits for the operator before line 7.
+TEST_F(MachineTest, AnM0OnTheStartLineUnderCutterCompensationStops) {
+  ready_machine();
+  const auto program = dir_.write("m0.ngc",
+                                  "G21 G90 F600\nG0 X0 Y0 Z5\nG1 Z-1\nG41.1 D2 G1 X10 Y0\n"
+                                  "G1 X10 Y10\nM0\nG1 X0 Y10\nG1 X0 Y0\nG40 G1 X-5 Y-5\n"
+                                  "G0 Z5\nM2\n");
+  result_of(call("program.open", {{"path", program.string()}}));
+  for (const json& params : {json::object(), json{{"from_line", 6}}}) {
+    result_of(call("program.run", params));
+    json s = wait_until([](const json& st) { return st["exec"] != "running"; });
+    ASSERT_EQ(s["exec"], "paused") << params.dump() << ": " << s.dump();
+    EXPECT_EQ(s["motion"], "idle");
+    EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 9.0, 1e-9);
+    EXPECT_NEAR(s["position"]["commanded"]["y"].get<double>(), 10.0, 1e-9);
+    EXPECT_NEAR(s["position"]["commanded"]["z"].get<double>(), -1.0, 1e-9);
+    result_of(call("program.resume"));
+    s = wait_until([](const json& st) { return st["exec"] == "idle"; });
+    EXPECT_EQ(s["program"]["result"], "done") << s.dump();
+    EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), -5.0, 1e-9);
+    EXPECT_NEAR(s["position"]["commanded"]["z"].get<double>(), 5.0, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace cncd::test

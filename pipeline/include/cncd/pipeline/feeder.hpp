@@ -127,6 +127,8 @@ class ProgramFeeder final : public interp::CanonSink {
   bool take_stop() { return std::exchange(stop_seen_, false); }
   bool take_input_wait() { return std::exchange(input_wait_seen_, false); }
   bool take_probe() { return std::exchange(probe_seen_, false); }
+  // Whether any of the three is waiting to be taken.
+  bool waits_seen() const { return stop_seen_ || input_wait_seen_ || probe_seen_; }
   // Something in the stream this machine cannot run (spindle-synchronized motion): its line and
   // why. The program stops there.
   struct Unsupported {
