@@ -33,6 +33,7 @@ void Interpreter::Impl::execute_block() {
     check_numeryx_block();
   } else {
     check_block();
+    halve_diameter_word();
   }
   do_comment();
   do_spindle_mode();
@@ -57,6 +58,22 @@ void Interpreter::Impl::execute_block() {
     }
   }
   do_stop();
+}
+
+// Under G7 (in force or given on the line) every X word is a diameter: the position, G92, G10
+// and G28/G30's X alike are half of it. I and R stay radii.
+void Interpreter::Impl::halve_diameter_word() {
+  const int code = block_.g_code(GGroup::lathe_diameter);
+  const bool diameter = code < 0 ? modal_.diameter_mode : code == 70;
+  if (diameter && block_.has('x')) block_.value[static_cast<std::size_t>('x' - 'a')] /= 2;
+}
+
+// G7 or G8: LinuxCNC notes a change of mode, not a repeat.
+void Interpreter::Impl::set_diameter_mode(bool diameter) {
+  if (diameter == modal_.diameter_mode) return;
+  modal_.diameter_mode = diameter;
+  emit_comment(diameter ? "interpreter: Lathe diameter mode changed to diameter"
+                        : "interpreter: Lathe diameter mode changed to radius");
 }
 
 // G96 D.. S.. (constant surface speed, D the highest rpm) and G97, before the feed mode and
@@ -265,6 +282,8 @@ void Interpreter::Impl::do_modes() {
   }
   const int units = block_.g_code(GGroup::units);
   if (units >= 0) change_units(units == 200 ? Units::inches : Units::mm);
+  const int lathe = block_.g_code(GGroup::lathe_diameter);
+  if (lathe >= 0) set_diameter_mode(lathe == 70);
   const int comp = block_.g_code(GGroup::cutter_comp);
   if (comp >= 0) Comp::comp_mode(*this, comp);
   const int length = block_.g_code(GGroup::tool_length);

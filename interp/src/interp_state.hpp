@@ -58,6 +58,7 @@ struct ModalState {
   bool adaptive_feed = false;
   bool feed_hold = true;
   int tool_length_code = 490;  // 430, 431 or 490
+  bool diameter_mode = false;  // G7: X words are diameters; G8: radii
 };
 
 // Values canned cycles remember between blocks while the cycle stays the motion mode.
@@ -69,10 +70,7 @@ struct CycleState {
   double i = 0;
   double j = 0;
   double k = 0;
-  bool has_r = false;
-  bool has_z = false;
-  bool has_p = false;
-  bool has_q = false;
+  bool has_r = false, has_z = false, has_p = false, has_q = false;
   // LinuxCNC's "old Z": the drilling-axis position when a run of canned cycles starts, kept
   // (unconverted, whatever the plane) while the motion mode stays a canned cycle.
   double initial_level = 0;
@@ -174,15 +172,14 @@ OScan scan_o_word(const std::string& line, std::string& name, OKind& kind);
 
 // Where one canned cycle works: the plane axes, the drilling axis and its heights.
 struct CycleGeometry {
-  std::size_t a = 0;  // first plane axis
-  std::size_t b = 1;  // second plane axis
-  std::size_t c = 2;  // drilling axis
-  double r = 0;       // R plane
-  double bottom = 0;  // hole bottom
-  double clear = 0;   // retract height at the end of each repeat
-  double k = 0;       // G87 back-bore height
-  double i = 0;       // G87 offsets across the plane
-  double j = 0;
+  std::size_t a = 0;    // first plane axis
+  std::size_t b = 1;    // second plane axis
+  std::size_t c = 2;    // drilling axis
+  double r = 0;         // R plane
+  double bottom = 0;    // hole bottom
+  double clear = 0;     // retract height at the end of each repeat
+  double k = 0;         // G87 back-bore height
+  double i = 0, j = 0;  // G87 offsets across the plane
   // Numeryx: the cycle has positioned itself (no move across at the current height first), and
   // the top pecks are measured from (R, below the R1 the tool feeds from); a dwell at the bottom
   // for every cycle (D), instead of LinuxCNC's P for the cycles that take one.
@@ -227,6 +224,8 @@ struct Interpreter::Impl {
   void check_spindle_words(int motion) const;
   int motion_to_be() const;
   void do_comment();
+  void halve_diameter_word();
+  void set_diameter_mode(bool diameter);
   void do_spindle_mode();
   std::string substitute_parameters(const std::string& text) const;
   std::optional<double> predefined_parameter(std::string_view name) const;

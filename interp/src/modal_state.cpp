@@ -144,6 +144,7 @@ void Interpreter::Impl::restore_modes(const SavedModalState& saved) {
     modal_.plane = m.plane;
     emit(SelectPlane{m.plane});
   }
+  set_diameter_mode(m.diameter_mode);
   if (saved.comp_side != comp_.side) {
     // As rs274 does it: G40, or G41/G42 with the tool in the spindle's radius.
     Comp::comp_mode(*this, saved.comp_side == CompSide::off    ? 400

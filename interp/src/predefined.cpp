@@ -180,8 +180,10 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
       return flag(modal_.css);
     case Name::ijk_absolute_mode:
       return flag(!modal_.arc_incremental);
+    case Name::lathe_diameter_mode:
+      return flag(modal_.diameter_mode);
     case Name::lathe_radius_mode:
-      return 1.0;
+      return flag(!modal_.diameter_mode);
     case Name::spindle_on:
       return flag(modal_.spindle != SpindleDir::stopped);
     case Name::spindle_cw:

@@ -48,7 +48,7 @@ InterpState Interpreter::state() const {
   g[11] = path_control_code(m.control);
   g[13] = m.css ? 960 : 970;
   g[14] = m.arc_incremental ? 911 : 901;
-  g[15] = 80;  // lathe diameter mode (G7) is not supported
+  g[15] = m.diameter_mode ? 70 : 80;
   if (s.parameters_.get(5210) == 1.0) g[16] = 923;
 
   auto& mc = out.mcodes;
