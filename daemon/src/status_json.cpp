@@ -195,6 +195,7 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config, std::
       {"work_position",
        {{"commanded", axes_object(config, s.work_commanded)},
         {"actual", axes_object(config, s.work_actual)}}},
+      {"diameter_mode", s.diameter_mode},
       {"velocity", s.velocity},
       {"distance_to_go", s.distance_to_go},
       {"axes_to_go", axes_object(config, s.axes_to_go)},

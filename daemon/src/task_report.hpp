@@ -168,8 +168,9 @@ struct TaskStatus {
   motion::AxisPose actual{};
   // "clean", "unclean" or "none": where the joints started (Task::load_files).
   std::string position_restored;
-  motion::AxisPose work_commanded{};  // work coordinates
+  motion::AxisPose work_commanded{};  // work coordinates; X a diameter under G7
   motion::AxisPose work_actual{};
+  bool diameter_mode = false;  // G7 in force
   double velocity = 0;
   double distance_to_go = 0;
   motion::AxisPose axes_to_go{};  // per axis, of the segment being executed

@@ -239,6 +239,12 @@ TaskStatus Task::status() const {
   const interp::InterpState st = interp_->state();
   out.work_commanded = work_pose(s.commanded, st);
   out.work_actual = work_pose(s.actual, st);
+  // Under G7 the DRO shows X as the program writes it: a diameter.
+  out.diameter_mode = st.gcodes[15] == 70;
+  if (out.diameter_mode) {
+    out.work_commanded[0] *= 2;
+    out.work_actual[0] *= 2;
+  }
   out.tool.number = st.tool_in_spindle;
   out.tool.prepared = st.tool_prepared;
   out.tool.length_offset = st.tool_offset;

@@ -1,5 +1,6 @@
 // status.get's program.dialect: the open program's dialect (its first line, else the
-// machine's [RS274NGC] DIALECT), the machine's with no program open, and the program run in it.
+// machine's [RS274NGC] DIALECT), the machine's with no program open, and the program run in it;
+// and the DRO under G7 (lathe diameter mode).
 #include <string>
 
 #include "machine_fixture.hpp"
@@ -46,6 +47,28 @@ TEST_F(MachineTest, ProgramDialectIsTheFirstLinesElseTheMachines) {
   EXPECT_EQ(s["program"]["result"], "done") << s["program"].dump();
   EXPECT_EQ(dialect_of(s), "linuxcnc");
   EXPECT_NEAR(s["position"]["commanded"]["z"].get<double>(), 2.0, 1e-9);
+}
+
+// G7 G0 X20 puts the tool at radius 10; the DRO (work_position) shows the diameter 20 and the
+// status names the mode; G8 shows the radius again.
+TEST_F(MachineTest, UnderG7XGoesToTheRadiusAndTheDroShowsTheDiameter) {
+  ready_machine();
+  EXPECT_EQ(status()["diameter_mode"], false);
+  mdi("G21 G90 G18 G7 G0 X20");
+  json s = wait_until([](const json& st) { return st["motion"] == "idle"; });
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 20.0, 1e-9);
+  EXPECT_EQ(s["diameter_mode"], true);
+  EXPECT_NE(s["gcodes"].dump().find("\"G7\""), std::string::npos) << s["gcodes"].dump();
+  mdi("G91 G0 X-4");  // 4 of diameter: 2 of radius
+  s = wait_until([](const json& st) { return st["motion"] == "idle"; });
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 8.0, 1e-9);
+  EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 16.0, 1e-9);
+  mdi("G90 G8");
+  s = status();
+  EXPECT_EQ(s["diameter_mode"], false);
+  EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 8.0, 1e-9);
+  EXPECT_NE(s["gcodes"].dump().find("\"G8\""), std::string::npos) << s["gcodes"].dump();
 }
 
 // A machine whose [RS274NGC] DIALECT is numeryx: programs without a first line naming

@@ -38,6 +38,11 @@ function showDro(ctx, status) {
   for (const letter of ctx.droAxes) {
     const a = letter.toLowerCase();
     setText($(`#dro-${a}`), fmt(work[a], digits));
+    if (a === 'x') {
+      const th = $('#dro-rows .dro-row[data-axis="x"] .dro-axis');
+      if (th) setText(th, status.diameter_mode ? 'X \u2300' : letter);
+      $('#dro-x')?.setAttribute('title', status.diameter_mode ? 'X as a diameter (G7)' : '');
+    }
     setText($(`#dro-mach-${a}`), fmt(mach[a], digits));
     setText($(`#dro-dtg-${a}`), fmt(toGo[a], digits));
   }
