@@ -41,6 +41,30 @@ std::string fixed(double value) {
   return text;
 }
 
+// Text as SVG character data: a program's name may hold <, & or quotes.
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<double> nice_ticks(double lo, double hi, int most) {
@@ -103,7 +127,7 @@ std::string speed_svg(const std::vector<SpeedCurve>& curves, Window window,
          fixed(left) + "\" y=\"" + fixed(top) + "\" width=\"" + fixed(w) + "\" height=\"" +
          fixed(h) + "\"/></clipPath>\n";
   out += "<text x=\"" + fixed(left + w / 2) +
-         "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" + title + "</text>\n";
+         "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" + escaped(title) + "</text>\n";
   for (double s : nice_ticks(window.from, window.to, 11)) {
     out += "<line x1=\"" + fixed(x(s)) + "\" y1=\"" + fixed(top) + "\" x2=\"" + fixed(x(s)) +
            "\" y2=\"" + fixed(top + h + 5) + "\" stroke=\"#ddd\"/>\n";
@@ -147,8 +171,8 @@ std::string speed_svg(const std::vector<SpeedCurve>& curves, Window window,
            fixed(lx + 40) + "\" y2=\"" + fixed(yy - 4) + "\" stroke=\"" + curves[k].colour +
            "\" stroke-width=\"" + number(curves[k].width + 0.5) + "\"" +
            (curves[k].dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
-    out += "<text x=\"" + fixed(lx + 48) + "\" y=\"" + fixed(yy) + "\">" + curves[k].label +
-           "</text>\n";
+    out += "<text x=\"" + fixed(lx + 48) + "\" y=\"" + fixed(yy) + "\">" +
+           escaped(curves[k].label) + "</text>\n";
   }
   out += "</svg>\n";
   return out;

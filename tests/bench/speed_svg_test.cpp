@@ -48,6 +48,14 @@ TEST(SpeedSvg, CurveOffTheScaleLeavesTheSpeedAxisToTheOthers) {
   EXPECT_EQ(polylines, 2u);
 }
 
+TEST(SpeedSvg, TitleAndLabelsAreEscaped) {
+  const SpeedCurve speed{"a<b & \"c\"", "red", 1, false, {0, 10, 20}, {0, 140, 0}, true};
+  const std::string svg = speed_svg({speed}, {0, 20}, "<part>.ngc & co");
+  EXPECT_NE(svg.find(">&lt;part&gt;.ngc &amp; co</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">a&lt;b &amp; &quot;c&quot;</text>"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find("<part>"), std::string::npos);
+}
+
 TEST(SpeedSvg, ReferenceProfileRampsAtTheAccelerationLimit) {
   motion::Segment line;
   line.kind = motion::Segment::Kind::line;
