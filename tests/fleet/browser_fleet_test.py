@@ -31,7 +31,7 @@ from web_fixture import Machine, Rpc, StatusWatcher, free_port, skip, wait_until
 
 MOSQUITTO = "/usr/sbin/mosquitto"
 # About a minute at F100 on the sim mill: it is still running when the page is read.
-LONG_PROGRAM = "G21 G90 F100\nG1 X20\nG1 Y20\nG1 X0\nG1 Y0\nG1 X20 Y20\nM30\n"
+LONG_PROGRAM = "G21 G90 F20\nG1 X20\nG1 Y20\nG1 X0\nG1 Y0\nG1 X20 Y20\nM30\n"
 HOSTILE = '<img src=x onerror="window.fleetXss=1">'
 
 
