@@ -221,8 +221,9 @@ class WebPanelTest : public WebWsTest {
 };
 
 TEST_F(WebPanelTest, ControlIsNotTakenFromTheWebWhileThePanelsMpgJogs) {
-  // The example's rapid knob stands at 0 V: turned up, or the MPG does not move.
-  ASSERT_NO_FATAL_FAILURE(sim_set("rapid_override_analog", 10.0));
+  // The example's rapid knob stands at 0 V: turned up, or the MPG does not move. A quarter
+  // turn keeps the jog below going for seconds, however slow a loaded machine is to look.
+  ASSERT_NO_FATAL_FAILURE(sim_set("rapid_override_analog", 2.5));
   for (const char* method : {"machine.reset", "machine.on", "machine.home"}) {
     const auto answer = client_.call(method, nullptr, 30000);
     ASSERT_TRUE(has_result(answer)) << method << ": " << answer.dump();
@@ -234,12 +235,12 @@ TEST_F(WebPanelTest, ControlIsNotTakenFromTheWebWhileThePanelsMpgJogs) {
   wait_until([](const json& s) {
     const auto& in = s["panel"]["inputs"];
     return in["MPG_ENABLE"] == true && in["MPG_AXIS_X"] == true && in["MPG_STEP_100"] == true &&
-           s["overrides"]["rapid"] == 1.0;
+           s["overrides"]["rapid"] == 0.25;
   });
-  // 2500 detents of 0.1 mm: 250 mm of X, more than a second.
+  auto otto = ws("otto");  // logged in before: a login hashes a password
+  // 2500 detents of 0.1 mm: 250 mm of X at a quarter of the rapid speed, about five seconds.
   ASSERT_NO_FATAL_FAILURE(sim_set("mpg_counts", 250000));
   wait_until([](const json& s) { return s["panel"]["mpg"]["jogging"] == true; });
-  auto otto = ws("otto");
   const json seen = otto->call("status.get")["result"]["manual_holder"];
   EXPECT_EQ(seen, json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}}));
   // cncd-web hears of it within its status interval.
