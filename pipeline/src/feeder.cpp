@@ -8,6 +8,18 @@
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
+namespace {
+
+// The motion's probe mode of a G38 kind, in interp::ProbeKind's order (G38.2 .. G38.5).
+motion::ProbeMode probe_mode(interp::ProbeKind kind) {
+  constexpr motion::ProbeMode kModes[] = {
+      motion::ProbeMode::toward_or_error, motion::ProbeMode::toward,
+      motion::ProbeMode::away_or_error, motion::ProbeMode::away};
+  return kModes[static_cast<std::size_t>(kind)];
+}
+
+}  // namespace
+
 void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   pending_.clear();
   moves_queued_ = actions_queued_ = 0;
@@ -194,20 +206,7 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             move.kind = motion::Move::Kind::feed;
             std::copy(c.end.begin(), c.end.end(), move.end.begin());
             move.feed = feed_per_second();
-            switch (c.kind) {
-              case in::ProbeKind::toward_or_error:
-                move.probe = motion::ProbeMode::toward_or_error;
-                break;
-              case in::ProbeKind::toward:
-                move.probe = motion::ProbeMode::toward;
-                break;
-              case in::ProbeKind::away_or_error:
-                move.probe = motion::ProbeMode::away_or_error;
-                break;
-              case in::ProbeKind::away:
-                move.probe = motion::ProbeMode::away;
-                break;
-            }
+            move.probe = probe_mode(c.kind);
             moving(move);
             probe_seen_ = true;
             return true;
