@@ -1,75 +1,51 @@
 #include "cncd/web/roles.hpp"
 
+#include <algorithm>
 #include <array>
+#include <span>
 
 namespace cncd::web {
 namespace {
 
-struct MethodRule {
-  std::string_view method;  // a trailing ".*" covers every method of that prefix
-  Role role;                // the least role that may call it
-  bool lease = false;       // moves the machine: only for the lease's holder
-};
-
+// The methods each role gains over the one before, in the order methods() lists them.
 // Stopping is open to everyone logged in (machine.estop is an observer's; pause, abort,
 // jog.stop need no lease), so a second person at the machine can always stop it.
-constexpr std::array kRules{
-    MethodRule{"status.get", Role::observer},
-    MethodRule{"status.subscribe", Role::observer},
-    MethodRule{"status.unsubscribe", Role::observer},
-    MethodRule{"errors.list", Role::observer},
-    MethodRule{"system.info", Role::observer},
-    MethodRule{"tool.list", Role::observer},
-    MethodRule{"offsets.get", Role::observer},
-    MethodRule{"jobs.history", Role::observer},
-    MethodRule{"jobs.stats", Role::observer},
-    MethodRule{"program.preview", Role::observer},
-    MethodRule{"web.session", Role::observer},
-    MethodRule{"lease.get", Role::observer},
-    MethodRule{"files.list", Role::observer},
-    MethodRule{"machine.estop", Role::observer},
-    MethodRule{"machine.reset", Role::operator_},
-    MethodRule{"machine.on", Role::operator_},
-    MethodRule{"machine.off", Role::operator_},
-    MethodRule{"machine.home", Role::operator_, true},
-    MethodRule{"jog.start", Role::operator_, true},
-    MethodRule{"jog.stop", Role::operator_},
-    MethodRule{"jog.increment", Role::operator_, true},
-    MethodRule{"jog.heartbeat", Role::operator_},
-    MethodRule{"program.open", Role::operator_},
-    MethodRule{"files.open", Role::operator_},
-    MethodRule{"program.run", Role::operator_, true},
-    MethodRule{"program.step", Role::operator_, true},
-    MethodRule{"program.pause", Role::operator_},
-    MethodRule{"program.resume", Role::operator_},
-    MethodRule{"program.abort", Role::operator_},
-    MethodRule{"mdi.execute", Role::operator_, true},
-    MethodRule{"override.feed", Role::operator_},
-    MethodRule{"override.rapid", Role::operator_},
-    MethodRule{"override.spindle", Role::operator_},
-    MethodRule{"tool.change_done", Role::operator_},
-    MethodRule{"wait.done", Role::operator_},
-    MethodRule{"lease.take", Role::operator_},
-    MethodRule{"lease.release", Role::operator_},
-    MethodRule{"tool.set", Role::setter},
-    MethodRule{"offsets.set", Role::setter},
-    MethodRule{"files.rename", Role::setter},
-    MethodRule{"files.delete", Role::setter},
-    MethodRule{kUploadMethod, Role::setter},
-    MethodRule{"users.list", Role::admin},
-    MethodRule{"users.add", Role::admin},
-    MethodRule{"users.delete", Role::admin},
-    MethodRule{"users.passwd", Role::admin},
+constexpr std::string_view kObserverMethods[] = {
+    "status.get",  "status.subscribe", "status.unsubscribe", "errors.list",  "system.info",
+    "tool.list",   "offsets.get",      "jobs.history",       "jobs.stats",   "program.preview",
+    "web.session", "lease.get",        "files.list",         "machine.estop"};
+constexpr std::string_view kOperatorMethods[] = {
+    "machine.reset", "machine.on",    "machine.off",    "machine.home",     "jog.start",
+    "jog.stop",      "jog.increment", "jog.heartbeat",  "program.open",     "files.open",
+    "program.run",   "program.step",  "program.pause",  "program.resume",   "program.abort",
+    "mdi.execute",   "override.feed", "override.rapid", "override.spindle", "tool.change_done",
+    "wait.done",     "lease.take",    "lease.release"};
+constexpr std::string_view kSetterMethods[] = {"tool.set", "offsets.set", "files.rename",
+                                               "files.delete", kUploadMethod};
+constexpr std::string_view kAdminMethods[] = {"users.list", "users.add", "users.delete",
+                                              "users.passwd"};
+
+struct RoleMethods {
+  Role role;
+  std::span<const std::string_view> methods;
 };
+constexpr RoleMethods kByRole[] = {{Role::observer, kObserverMethods},
+                                   {Role::operator_, kOperatorMethods},
+                                   {Role::setter, kSetterMethods},
+                                   {Role::admin, kAdminMethods}};
+
+// The operator's methods that move the machine: only for the lease's holder.
+constexpr std::string_view kLeaseMethods[] = {"machine.home", "jog.start",    "jog.increment",
+                                              "program.run",  "program.step", "mdi.execute"};
 
 constexpr std::array<std::string_view, 4> kRoleNames{"observer", "operator", "setter", "admin"};
 
-const MethodRule* rule(std::string_view method) {
-  for (const auto& r : kRules) {
-    if (r.method == method) return &r;
-  }
-  return nullptr;
+constexpr bool listed(std::span<const std::string_view> list, std::string_view method) {
+  return std::ranges::find(list, method) != list.end();
 }
+static_assert(std::ranges::all_of(kLeaseMethods, [](std::string_view method) {
+  return listed(kOperatorMethods, method);
+}));
 
 }  // namespace
 
@@ -94,25 +70,25 @@ std::string role_names() {
 }
 
 bool allowed(Role role, std::string_view method) {
-  const MethodRule* r = rule(method);
-  return r != nullptr && role >= r->role;
+  const auto needed = required_role(method);
+  return needed && role >= *needed;
 }
 
 std::optional<Role> required_role(std::string_view method) {
-  const MethodRule* r = rule(method);
-  if (r == nullptr) return std::nullopt;
-  return r->role;
+  for (const auto& [role, list] : kByRole) {
+    if (listed(list, method)) return role;
+  }
+  return std::nullopt;
 }
 
 bool needs_lease(std::string_view method) {
-  const MethodRule* r = rule(method);
-  return r != nullptr && r->lease;
+  return listed(kLeaseMethods, method);
 }
 
 std::vector<std::string> methods(Role role) {
   std::vector<std::string> out;
-  for (const auto& r : kRules) {
-    if (role >= r.role) out.emplace_back(r.method);
+  for (const auto& [least, list] : kByRole) {
+    if (role >= least) out.insert(out.end(), list.begin(), list.end());
   }
   return out;
 }

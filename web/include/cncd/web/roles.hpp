@@ -1,5 +1,5 @@
 // Who may call what through cncd-web: the four roles, each including the one before, and the
-// methods that also need the control lease. One table (roles.cpp) answers every question, so
+// methods that also need the control lease. The lists of roles.cpp answer every question, so
 // the checks, the error messages and `web.session`'s method list cannot disagree.
 #pragma once
 
