@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -16,21 +17,9 @@ namespace {
 // As LinuxCNC's messages name the planes: the XYZ ones in lower case in most of them, the UVW
 // ones always in upper case.
 const char* plane_name(Plane plane) {
-  switch (plane) {
-    case Plane::xz:
-      return "xz";
-    case Plane::yz:
-      return "yz";
-    case Plane::uv:
-      return "UV";
-    case Plane::vw:
-      return "VW";
-    case Plane::uw:
-      return "UW";
-    case Plane::xy:
-      break;
-  }
-  return "xy";
+  constexpr const char* kNames[] = {"xy", "yz", "xz", "UV", "VW", "UW"};  // from Plane::xy = 1
+  const std::size_t index = static_cast<std::size_t>(plane) - 1;
+  return index < std::size(kNames) ? kNames[index] : kNames[0];
 }
 
 bool is_uvw_plane(Plane plane) {

@@ -1,6 +1,7 @@
 #include "cncd/interp/rs274_printer.hpp"
 
 #include <cstdio>
+#include <iterator>
 #include <variant>
 
 #include "cncd/interp/fixed_text.hpp"
@@ -21,33 +22,19 @@ void append_pose(std::string& out, const Pose& pose, int axes) {
   }
 }
 
+// As rs274 names them; it has no names for the UVW planes.
 const char* plane_name(Plane plane) {
-  switch (plane) {
-    case Plane::yz:
-      return "CANON_PLANE_YZ";
-    case Plane::xz:
-      return "CANON_PLANE_XZ";
-    // rs274's printer has no names for the UVW planes.
-    case Plane::uv:
-    case Plane::vw:
-    case Plane::uw:
-      return "CANON_PLANE_UNKNOWN";
-    case Plane::xy:
-    default:
-      return "CANON_PLANE_XY";
-  }
+  constexpr const char* kNames[] = {"CANON_PLANE_XY",      "CANON_PLANE_YZ",
+                                    "CANON_PLANE_XZ",      "CANON_PLANE_UNKNOWN",
+                                    "CANON_PLANE_UNKNOWN", "CANON_PLANE_UNKNOWN"};
+  const std::size_t index = static_cast<std::size_t>(plane) - 1;  // from Plane::xy = 1
+  return index < std::size(kNames) ? kNames[index] : kNames[0];
 }
 
 const char* units_name(Units units) {
-  switch (units) {
-    case Units::inches:
-      return "CANON_UNITS_INCHES";
-    case Units::cm:
-      return "CANON_UNITS_CM";
-    case Units::mm:
-    default:
-      return "CANON_UNITS_MM";
-  }
+  constexpr const char* kNames[] = {"CANON_UNITS_INCHES", "CANON_UNITS_MM", "CANON_UNITS_CM"};
+  const std::size_t index = static_cast<std::size_t>(units) - 1;  // from Units::inches = 1
+  return index < std::size(kNames) ? kNames[index] : "CANON_UNITS_MM";
 }
 
 // Offsets in the tool table's layout: X Y Z, A B C and U V W in groups of three.
