@@ -229,29 +229,21 @@ void Interpreter::Impl::do_coolant_and_overrides() {
     fail(on ? "Cannot enable overrides with cutter radius compensation on"
             : "Cannot disable overrides with cutter radius compensation on");
   }
-  switch (code) {
-    case 48:
-    case 49:
-      modal_.feed_override = modal_.speed_override = on;
-      emit(SetFeedOverrideEnable{on});
-      emit(SetSpindleOverrideEnable{on});
-      break;
-    case 50:
-      modal_.feed_override = on;
-      emit(SetFeedOverrideEnable{on});
-      break;
-    case 51:
-      modal_.speed_override = on;
-      emit(SetSpindleOverrideEnable{on});
-      break;
-    case 52:
-      modal_.adaptive_feed = on;
-      emit(SetAdaptiveFeedEnable{on});
-      break;
-    default:
-      modal_.feed_hold = on;
-      emit(SetFeedHoldEnable{on});
-      break;
+  if (code == 48 || code == 49 || code == 50) {
+    modal_.feed_override = on;
+    emit(SetFeedOverrideEnable{on});
+  }
+  if (code == 48 || code == 49 || code == 51) {
+    modal_.speed_override = on;
+    emit(SetSpindleOverrideEnable{on});
+  }
+  if (code == 52) {
+    modal_.adaptive_feed = on;
+    emit(SetAdaptiveFeedEnable{on});
+  }
+  if (code == 53) {
+    modal_.feed_hold = on;
+    emit(SetFeedHoldEnable{on});
   }
 }
 
@@ -367,14 +359,14 @@ void Interpreter::Impl::do_non_modal() {
     case 281:
     case 300:
     case 301:
-      do_home(block_.g_code(GGroup::non_modal));
+      do_home(code);
       break;
     case 520:
     case 920:
     case 921:
     case 922:
     case 923:
-      do_g92(block_.g_code(GGroup::non_modal));
+      do_g92(code);
       break;
     default:
       break;
