@@ -230,19 +230,19 @@ void Interpreter::Impl::do_coolant_and_overrides() {
             : "Cannot disable overrides with cutter radius compensation on");
   }
   if (code == 48 || code == 49 || code == 50) {
-    modal_.feed_override = on;
+    modal_.overrides.feed = on;
     emit(SetFeedOverrideEnable{on});
   }
   if (code == 48 || code == 49 || code == 51) {
-    modal_.speed_override = on;
+    modal_.overrides.speed = on;
     emit(SetSpindleOverrideEnable{on});
   }
   if (code == 52) {
-    modal_.adaptive_feed = on;
+    modal_.overrides.adaptive_feed = on;
     emit(SetAdaptiveFeedEnable{on});
   }
   if (code == 53) {
-    modal_.feed_hold = on;
+    modal_.overrides.feed_hold = on;
     emit(SetFeedHoldEnable{on});
   }
 }
@@ -417,9 +417,9 @@ void Interpreter::Impl::program_end_reset() {
   emit(SetFeedMode{FeedRateMode::per_minute});
   modal_.feed_rate = 0;
   emit(SetFeedRate{0.0});
-  if (!modal_.feed_override) {
+  if (!modal_.overrides.feed) {
     // LinuxCNC re-enables only the feed override here; the speed override stays as it was.
-    modal_.feed_override = true;
+    modal_.overrides.feed = true;
     emit(SetFeedOverrideEnable{true});
   }
   modal_.spindle = SpindleDir::stopped;

@@ -17,6 +17,7 @@
 #include "cncd/interp/interpreter.hpp"
 #include "comp_state.hpp"
 #include "failure.hpp"
+#include "modal.hpp"
 #include "parameters.hpp"
 #include "parser.hpp"
 #include "source.hpp"
@@ -29,37 +30,7 @@ namespace cncd::interp {
 enum Axis : int { kX = 0, kY, kZ, kA, kB, kC, kU, kV, kW };
 inline constexpr char kAxisLetters[kAxes + 1] = "xyzabcuvw";
 
-enum class FeedMode : int { units_per_minute = 0, inverse_time = 1, units_per_rev = 2 };
-enum class SpindleDir : int { stopped = 0, clockwise = 1, counterclockwise = -1 };
 enum class StraightKind : bool { traverse, feed };
-
-// Modal state LinuxCNC keeps between blocks.
-struct ModalState {
-  int motion = -1;  // motion G code * 10, -1 before any motion code (LinuxCNC starts without one)
-  Plane plane = Plane::xy;
-  bool incremental = false;
-  bool arc_incremental = true;  // G91.1 is LinuxCNC's default
-  FeedMode feed_mode = FeedMode::units_per_minute;
-  Units units = Units::mm;
-  bool retract_r_plane = true;  // G99 is LinuxCNC's start-up retract mode
-  int coord_system = 1;         // 1..9 = G54..G59.3
-  MotionMode control = MotionMode::continuous;
-  double tolerance = 0;        // G64 P
-  double naive_tolerance = 0;  // G64 Q
-  double feed_rate = 0;
-  double speed = 0;
-  SpindleDir spindle = SpindleDir::stopped;
-  bool css = false;        // G96: S is a surface speed (units per minute), G97: rpm
-  double css_max_rpm = 0;  // G96 D (absent: LinuxCNC's 1e30)
-  bool mist = false;
-  bool flood = false;
-  bool feed_override = true;
-  bool speed_override = true;
-  bool adaptive_feed = false;
-  bool feed_hold = true;
-  int tool_length_code = 490;  // 430, 431 or 490
-  bool diameter_mode = false;  // G7: X words are diameters; G8: radii
-};
 
 // Values canned cycles remember between blocks while the cycle stays the motion mode.
 struct CycleState {

@@ -107,9 +107,7 @@ void Interpreter::Impl::restore_modal_state(const SavedModalState& saved) {
     }
   }
   const bool coolant_changed = m.mist != modal_.mist || m.flood != modal_.flood;
-  const bool overrides_changed =
-      m.feed_override != modal_.feed_override || m.speed_override != modal_.speed_override ||
-      m.adaptive_feed != modal_.adaptive_feed || m.feed_hold != modal_.feed_hold;
+  const bool overrides_changed = m.overrides != modal_.overrides;
   const bool coolant_later = coolant_changed && spindle_changed;
   const bool overrides_later = overrides_changed && (spindle_changed || coolant_changed);
   if (!coolant_later) restore_coolant(m);
@@ -208,10 +206,10 @@ void Interpreter::Impl::restore_overrides(const ModalState& m) {
     op.on = saved;
     emit(op);
   };
-  restore(modal_.feed_override, m.feed_override, SetFeedOverrideEnable{});
-  restore(modal_.speed_override, m.speed_override, SetSpindleOverrideEnable{});
-  restore(modal_.adaptive_feed, m.adaptive_feed, SetAdaptiveFeedEnable{});
-  restore(modal_.feed_hold, m.feed_hold, SetFeedHoldEnable{});
+  restore(modal_.overrides.feed, m.overrides.feed, SetFeedOverrideEnable{});
+  restore(modal_.overrides.speed, m.overrides.speed, SetSpindleOverrideEnable{});
+  restore(modal_.overrides.adaptive_feed, m.overrides.adaptive_feed, SetAdaptiveFeedEnable{});
+  restore(modal_.overrides.feed_hold, m.overrides.feed_hold, SetFeedHoldEnable{});
 }
 
 }  // namespace cncd::interp

@@ -195,13 +195,13 @@ std::optional<double> Interpreter::Impl::predefined_parameter(std::string_view n
     case Name::flood:
       return flag(modal_.flood);
     case Name::speed_override:
-      return flag(modal_.speed_override);
+      return flag(modal_.overrides.speed);
     case Name::feed_override:
-      return flag(modal_.feed_override);
+      return flag(modal_.overrides.feed);
     case Name::adaptive_feed:
-      return flag(modal_.adaptive_feed);
+      return flag(modal_.overrides.adaptive_feed);
     case Name::feed_hold:
-      return flag(modal_.feed_hold);
+      return flag(modal_.overrides.feed_hold);
     case Name::feed:
       return modal_.feed_rate;
     case Name::rpm:

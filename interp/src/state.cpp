@@ -59,9 +59,10 @@ InterpState Interpreter::state() const {
   mc[3] = s.block_.m_code(MGroup::tool_change);
   mc[4] = m.mist ? 7 : m.flood ? -1 : 9;
   mc[5] = m.flood ? 8 : -1;
-  mc[6] = m.feed_override ? (m.speed_override ? 48 : 50) : (m.speed_override ? 51 : 49);
-  mc[7] = m.adaptive_feed ? 52 : -1;
-  mc[8] = m.feed_hold ? 53 : -1;
+  const OverrideSwitches& o = m.overrides;
+  mc[6] = o.feed ? (o.speed ? 48 : 50) : (o.speed ? 51 : 49);
+  mc[7] = o.adaptive_feed ? 52 : -1;
+  mc[8] = o.feed_hold ? 53 : -1;
 
   out.coord_system = m.coord_system;
   out.rotation_deg = s.rotation_deg_;
