@@ -55,6 +55,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     return std::chrono::seconds(app_.limits.body_idle_seconds);
   }
 
+  // A read's completion handler: keeps the session alive and hands `next` the error code.
+  auto then(void (HttpSession::*next)(beast::error_code)) {
+    return [self = this->shared_from_this(), next](beast::error_code ec, std::size_t) {
+      (*self.*next)(ec);
+    };
+  }
+
   void read_header() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(app_.limits.header_bytes));
@@ -62,10 +69,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     // header says which, not the parser's default 1 MiB checked against Content-Length here.
     parser_->body_limit(boost::none);
     beast::get_lowest_layer(stream_).expires_after(header_time());
-    http::async_read_header(stream_, buffer_, *parser_,
-                            [self = this->shared_from_this()](beast::error_code ec, std::size_t) {
-                              self->on_header(ec);
-                            });
+    http::async_read_header(stream_, buffer_, *parser_, then(&HttpSession::on_header));
   }
 
   void on_header(beast::error_code ec) {
@@ -93,10 +97,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     body_parser_.emplace(std::move(*parser_));
     body_parser_->body_limit(app_.limits.body_bytes);
     beast::get_lowest_layer(stream_).expires_after(body_time());
-    http::async_read(stream_, buffer_, *body_parser_,
-                     [self = this->shared_from_this()](beast::error_code read_ec, std::size_t) {
-                       self->on_body(read_ec);
-                     });
+    http::async_read(stream_, buffer_, *body_parser_, then(&HttpSession::on_body));
   }
 
   void on_body(beast::error_code ec) {
@@ -151,10 +152,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     body.data = chunk_.data();
     body.size = chunk_.size();
     beast::get_lowest_layer(stream_).expires_after(body_time());
-    http::async_read_some(stream_, buffer_, *upload_parser_,
-                          [self = this->shared_from_this()](beast::error_code ec, std::size_t) {
-                            self->on_chunk(ec);
-                          });
+    http::async_read_some(stream_, buffer_, *upload_parser_, then(&HttpSession::on_chunk));
   }
 
   void on_chunk(beast::error_code ec) {
