@@ -17,6 +17,11 @@ constexpr KeySpec button(std::string_view key, std::string_view help) {
   return signal_key(kPanel, key, help);
 }
 
+// A detent's distance while an MPG_STEP_n switch is on; the default depends on the units.
+constexpr KeySpec step_distance(std::string_view key, std::string_view help) {
+  return positive_key(kPanel, key, "", "units", help);
+}
+
 // The seven keys of an override knob, NAME_OVERRIDE_*: an encoder or an analog input.
 constexpr std::array<KeySpec, 7> knob_keys(std::string_view a, std::string_view b,
                                            std::string_view counts, std::string_view scale,
@@ -73,13 +78,13 @@ constexpr std::array kGeneral{
                "MPG_A/MPG_B"),
     integer_key(kPanel, "MPG_COUNTS_PER_DETENT", "4", 1, 10000, "counts",
                 "MPG counts of one detent (one step of the wheel)"),
-    positive_key(kPanel, "MPG_STEP_1_DISTANCE", "", "units",
-                 "Distance of a detent with MPG_STEP_1 (or no step input) on; default 0.001 mm, "
-                 "0.0001 in"),
-    positive_key(kPanel, "MPG_STEP_10_DISTANCE", "", "units",
-                 "Distance of a detent with MPG_STEP_10 on; default 0.01 mm, 0.001 in"),
-    positive_key(kPanel, "MPG_STEP_100_DISTANCE", "", "units",
-                 "Distance of a detent with MPG_STEP_100 on; default 0.1 mm, 0.01 in"),
+    step_distance("MPG_STEP_1_DISTANCE",
+                  "Distance of a detent with MPG_STEP_1 (or no step input) on; default 0.001 mm, "
+                  "0.0001 in"),
+    step_distance("MPG_STEP_10_DISTANCE",
+                  "Distance of a detent with MPG_STEP_10 on; default 0.01 mm, 0.001 in"),
+    step_distance("MPG_STEP_100_DISTANCE",
+                  "Distance of a detent with MPG_STEP_100 on; default 0.1 mm, 0.01 in"),
     choice_key(kPanel, "MPG_MODE", "position", "position|velocity",
                "position: every detent moves its distance exactly; velocity: the wheel's speed "
                "is the jog speed, and the axis stops when the wheel does"),
