@@ -6,6 +6,11 @@ namespace cncd::daemon {
 
 using nlohmann::json;
 
+// The program object of status.get but its two optional numbers.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ProgramReport, path, opening, line, total_lines, dialect,
+                                   progress, stepping, moves, elapsed_s, motion_s, remaining_reason,
+                                   result, error)
+
 namespace {
 
 const char* motion_state_name(motion::MotionState state) {
@@ -92,21 +97,10 @@ json wait_object(const WaitReport& w) {
 }
 
 json program_object(const ProgramReport& p) {
-  return {{"path", p.path},
-          {"opening", p.opening},
-          {"line", p.line},
-          {"total_lines", p.total_lines},
-          {"dialect", p.dialect},
-          {"progress", p.progress},
-          {"stepping", p.stepping},
-          {"moves", p.moves},
-          {"elapsed_s", p.elapsed_s},
-          {"motion_s", p.motion_s},
-          {"estimated_s", optional_number(p.estimated_s)},
-          {"remaining_s", optional_number(p.remaining_s)},
-          {"remaining_reason", p.remaining_reason},
-          {"result", p.result},
-          {"error", p.error}};
+  json out = p;
+  out["estimated_s"] = optional_number(p.estimated_s);
+  out["remaining_s"] = optional_number(p.remaining_s);
+  return out;
 }
 
 json rt_object(const motion::RtStats& rt) {
