@@ -305,11 +305,13 @@ void Planner::kink(Segment& prev, bool prev_reserved, Segment& next) {
   // limit) for it; each kink may use half of that, so two kinks close together still fit.
   const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
   double v = 1e300;
-  for (int i = 0; i < kAxes; ++i) {
-    const double jump = std::abs(next.start_direction[i] - prev.end_direction[i]);
+  AxisPose turn{};
+  for (int i = 0; i < kAxes; ++i)
+    turn[i] = next.start_direction[i] - prev.end_direction[i];
+  for (const RateLimit& limit : kins_->rate_limits()) {
+    const double jump = std::abs(limit.dot(turn));
     if (jump <= 1e-15) continue;
-    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
-    v = std::min(v, 0.5 * kKinkReserve * axis.max_acceleration * dt / jump);
+    v = std::min(v, 0.5 * kKinkReserve * limit.max_acceleration * dt / jump);
   }
   // Kinks at least a period apart: at most two fall in any estimate of the acceleration.
   v = std::min({v, prev.length / dt, next.length / dt});
@@ -339,8 +341,11 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed) const {
   double v = 1e300;
   double plane_a = 1e300;   // orthogonal bound: the plane's acceleration limit
   double normal_a = 1e300;  // the centripetal acceleration every axis allows alone
-  std::array<double, kAxes> max_t{}, max_n{};
+  const auto rates = kins_->rate_limits();
+  std::array<double, kMaxRateLimits> max_t{}, max_n{};
   bool linear = false;
+  for (int i = 0; i < 3; ++i)
+    linear = linear || std::hypot(blend.blend_u[i], blend.blend_v[i]) > 1e-12;
   const double sweep = std::abs(blend.sweep);
   // Largest |cos| over [x, x + sweep].
   auto max_cos = [sweep](double x) {
@@ -349,18 +354,19 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed) const {
     if (first_peak <= x + sweep) return 1.0;
     return std::max(std::abs(std::cos(x)), std::abs(std::cos(x + sweep)));
   };
-  for (int i = 0; i < kAxes; ++i) {
-    const double w = std::hypot(blend.blend_u[i], blend.blend_v[i]);
+  // A bound (an axis, or a joint of several axes) is one more such share: its coefficients
+  // against u and v.
+  for (std::size_t k = 0; k < rates.size(); ++k) {
+    const double u = rates[k].dot(blend.blend_u);
+    const double u_across = rates[k].dot(blend.blend_v);
+    const double w = std::hypot(u, u_across);
     if (w <= 1e-12) continue;
-    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
-    const double alpha = std::atan2(blend.blend_u[i], blend.blend_v[i]);
-    const auto k = static_cast<std::size_t>(i);
+    const double alpha = std::atan2(u, u_across);
     max_t[k] = w * max_cos(alpha);
     max_n[k] = w * max_cos(alpha - std::numbers::pi / 2);
-    if (max_t[k] > 1e-12) v = std::min(v, axis.max_velocity / max_t[k]);
-    if (max_n[k] > 1e-12) normal_a = std::min(normal_a, axis.max_acceleration / max_n[k]);
-    plane_a = std::min(plane_a, axis.max_acceleration / w);
-    linear = linear || i < 3;
+    if (max_t[k] > 1e-12) v = std::min(v, rates[k].max_velocity / max_t[k]);
+    if (max_n[k] > 1e-12) normal_a = std::min(normal_a, rates[k].max_acceleration / max_n[k]);
+    plane_a = std::min(plane_a, rates[k].max_acceleration / w);
   }
   if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
   // The speed limit and the tangential acceleration limit of the arc when its centripetal
@@ -375,9 +381,9 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed) const {
     if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
     const double v_sum = std::min(v, std::sqrt(centripetal * blend.radius));
     double a_sum = 1e300;
-    for (std::size_t k = 0; k < kAxes; ++k) {
+    for (std::size_t k = 0; k < rates.size(); ++k) {
       if (max_t[k] <= 1e-12) continue;
-      const double left = config_.axes[k].max_acceleration - centripetal * max_n[k];
+      const double left = rates[k].max_acceleration - centripetal * max_n[k];
       a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
     }
     // Only where it allows both as much speed and more acceleration: a blend left with little

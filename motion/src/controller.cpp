@@ -54,9 +54,10 @@ void prefault_stack() {
 }  // namespace
 
 struct MotionController::Impl {
-  explicit Impl(const config::MachineConfig& c) : config(c), planner(c) {}
+  explicit Impl(const config::MachineConfig& c) : config(c), kins(make_kinematics(c)), planner(c) {}
 
   const config::MachineConfig& config;
+  std::unique_ptr<const Kinematics> kins;
   Planner planner;
   std::vector<drivers::DriverInstance> drivers;
   std::unique_ptr<ServoLoop> loop;
@@ -380,8 +381,8 @@ std::string MotionController::jog_start(int axis, double velocity_per_s) {
   if (!impl_->loop) return "motion is not started";
   if (!std::isfinite(velocity_per_s) || velocity_per_s == 0)
     return "the jog velocity must not be 0";
-  if (auto problem =
-          jog_problem(impl_->config, impl_->loop->status(), axis, velocity_per_s > 0 ? 1.0 : -1.0);
+  if (auto problem = jog_problem(impl_->config, *impl_->kins, impl_->loop->status(), axis,
+                                 velocity_per_s > 0 ? 1.0 : -1.0);
       !problem.empty())
     return problem;
   Command command;
@@ -397,7 +398,8 @@ std::string MotionController::jog_increment(int axis, double distance, double sp
   if (!std::isfinite(distance) || distance == 0) return "the jog distance must not be 0";
   if (!std::isfinite(speed_per_s) || speed_per_s <= 0) return "the jog speed must be above 0";
   const Status status = impl_->loop->status();
-  if (auto problem = jog_problem(impl_->config, status, axis, distance > 0 ? 1.0 : -1.0);
+  if (auto problem =
+          jog_problem(impl_->config, *impl_->kins, status, axis, distance > 0 ? 1.0 : -1.0);
       !problem.empty())
     return problem;
   if (status.motion == MotionState::jogging) return "the machine is jogging";

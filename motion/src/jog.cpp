@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cncd/motion/kinematics.hpp"
 #include "profile.hpp"
 
 namespace cncd::motion {
@@ -24,7 +25,28 @@ const char* jog_refusal(const config::MachineConfig& config, int axis, double po
   return nullptr;
 }
 
-Jog::Jog(const config::MachineConfig& config) : config_(config) {}
+Jog::Jog(const config::MachineConfig& config) : config_(config) {
+  const auto kins = make_kinematics(config);
+  coupled_ = kins->coupled_axes();
+  for (int axis = 0; axis < kAxes; ++axis) {
+    const auto k = static_cast<std::size_t>(axis);
+    max_velocity_[k] = config.axes[k].max_velocity;
+    max_acceleration_[k] = config.axes[k].max_acceleration;
+    for (const RateLimit& limit : kins->rate_limits()) {
+      const double share = std::abs(limit.coefficient(axis));
+      if (share <= 0) continue;
+      max_velocity_[k] = std::min(max_velocity_[k], limit.max_velocity / share);
+      max_acceleration_[k] = std::min(max_acceleration_[k], limit.max_acceleration / share);
+    }
+  }
+}
+
+const char* Jog::coupling_refusal(int axis) const noexcept {
+  const std::uint32_t others = active_mask() & ~(1u << axis);
+  if ((coupled_ & (1u << axis)) != 0 && (coupled_ & others) != 0)
+    return "the axis shares a motor with a jogging axis: jog them one at a time";
+  return nullptr;
+}
 
 void Jog::begin(int axis, double position, double target, double speed) noexcept {
   auto& j = axes_[static_cast<std::size_t>(axis)];
@@ -44,8 +66,9 @@ void Jog::begin(int axis, double position, double target, double speed) noexcept
 const char* Jog::start(int axis, double position, double velocity, bool homed) noexcept {
   const double direction = velocity > 0 ? 1.0 : -1.0;
   if (const char* refusal = jog_refusal(config_, axis, position, direction, homed)) return refusal;
+  if (const char* refusal = coupling_refusal(axis)) return refusal;
   const auto& limits = config_.axes[static_cast<std::size_t>(axis)];
-  const double speed = std::min(std::abs(velocity), limits.max_velocity);
+  const double speed = std::min(std::abs(velocity), max_velocity_[static_cast<std::size_t>(axis)]);
   if (!std::isfinite(speed) || speed <= 0) return "the jog speed must be above 0";
   auto& j = axes_[static_cast<std::size_t>(axis)];
   if (j.active && j.direction != direction && j.v > 0) {
@@ -67,8 +90,9 @@ const char* Jog::increment(int axis, double position, double distance, double sp
   const double direction = distance > 0 ? 1.0 : -1.0;
   if (const char* refusal = jog_refusal(config_, axis, position, direction, homed)) return refusal;
   if (axes_[static_cast<std::size_t>(axis)].active) return "the axis is jogging";
+  if (const char* refusal = coupling_refusal(axis)) return refusal;
   const auto& limits = config_.axes[static_cast<std::size_t>(axis)];
-  const double capped = std::min(std::abs(speed), limits.max_velocity);
+  const double capped = std::min(std::abs(speed), max_velocity_[static_cast<std::size_t>(axis)]);
   if (!std::isfinite(capped) || capped <= 0) return "the jog speed must be above 0";
   if (!std::isfinite(distance) || distance == 0) return "the jog distance must not be 0";
   double target = position + distance;
@@ -80,13 +104,13 @@ const char* Jog::increment(int axis, double position, double distance, double sp
 void Jog::follow(int axis, double position, double target, double speed) noexcept {
   if (axis < 0 || axis >= kAxes) return;
   auto& j = axes_[static_cast<std::size_t>(axis)];
-  const double capped = std::min(speed, config_.axes[static_cast<std::size_t>(axis)].max_velocity);
+  const double capped = std::min(speed, max_velocity_[static_cast<std::size_t>(axis)]);
   if (!j.active) {
     if (target != position && capped > 0) begin(axis, position, target, capped);
     return;
   }
   j.pending = false;
-  const double a = config_.axes[static_cast<std::size_t>(axis)].max_acceleration;
+  const double a = max_acceleration_[static_cast<std::size_t>(axis)];
   const double ahead = j.direction * (target - j.origin);
   if (ahead >= j.s + j.v * j.v / (2.0 * a)) {
     j.length = ahead;
@@ -102,7 +126,7 @@ void Jog::stop(int axis) noexcept {
   auto& j = axes_[static_cast<std::size_t>(axis)];
   j.pending = false;
   if (!j.active) return;
-  const double a = config_.axes[static_cast<std::size_t>(axis)].max_acceleration;
+  const double a = max_acceleration_[static_cast<std::size_t>(axis)];
   // The shortest stop the acceleration allows, unless the target comes first.
   const double stop_length = j.s + j.v * j.v / (2.0 * a);
   if (stop_length < j.length) {
@@ -134,7 +158,7 @@ void Jog::update(AxisPose& pose, double dt) noexcept {
     auto& j = axes_[static_cast<std::size_t>(axis)];
     if (!j.active) continue;
     double left = dt;
-    const double a = config_.axes[static_cast<std::size_t>(axis)].max_acceleration;
+    const double a = max_acceleration_[static_cast<std::size_t>(axis)];
     const bool done = advance_profile(j.s, j.v, j.length, j.v_max, a, left);
     // At the end exactly on the target (the soft limit, when it is one), not a rounding off.
     pose[static_cast<std::size_t>(axis)] = done ? j.target : j.origin + j.direction * j.s;

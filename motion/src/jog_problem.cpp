@@ -5,16 +5,17 @@
 namespace cncd::motion {
 
 // Why a jog cannot start now (checked before the servo thread sees it), or "".
-std::string jog_problem(const config::MachineConfig& config, const Status& status, int axis,
-                        double direction) {
+std::string jog_problem(const config::MachineConfig& config, const Kinematics& kins,
+                        const Status& status, int axis, double direction) {
   if (status.machine != MachineState::on) return "machine is not on";
   if (status.motion != MotionState::idle && status.motion != MotionState::jogging)
     return "the machine is moving";
   if (status.queued != 0) return "the machine is moving";
   if (status.panel.mpg_jogging) return "the panel's MPG is jogging";
+  const std::uint32_t joints = kins.joints_of_axis(axis);
   bool homed = false;
   for (int j = 0; j < status.joint_count; ++j) {
-    if (config::axis_index(config.joints[static_cast<std::size_t>(j)].axis) != axis) continue;
+    if ((joints & (1u << j)) == 0) continue;
     homed = status.homed[static_cast<std::size_t>(j)];
     if (!homed) break;
   }

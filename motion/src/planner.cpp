@@ -81,7 +81,8 @@ AxisPose Segment::point_at(double s) const noexcept {
   return p;
 }
 
-Planner::Planner(const config::MachineConfig& config) : config_(config) {}
+Planner::Planner(const config::MachineConfig& config)
+    : config_(config), kins_(make_kinematics(config)) {}
 
 void Planner::set_directions(Segment& seg) {
   AxisPose start{}, end{};
@@ -351,13 +352,30 @@ void Planner::set_limits(Segment& seg) const {
     const bool in_plane = arc && (i == seg.first_axis || i == seg.second_axis);
     direction[i] = (in_plane ? arc_length : std::abs(seg.end[i] - seg.start[i])) / seg.length;
   }
+  // Each bound's rate along the path the same way: its share of the plane (the length of
+  // its coefficients there) times the in-plane share, plus its part along the other axes.
+  const double in_plane = arc ? direction[seg.first_axis] : 0.0;  // cos b, b the helix angle
+  std::array<double, kMaxRateLimits> plane_share{};
+  std::array<double, kMaxRateLimits> other_share{};
+  AxisPose other{};
+  for (int i = 0; i < kAxes; ++i) {
+    const bool in_the_plane = arc && (i == seg.first_axis || i == seg.second_axis);
+    other[i] = in_the_plane ? 0.0 : seg.end[i] - seg.start[i];
+  }
+  const auto limits = kins_->rate_limits();
+  for (std::size_t r = 0; r < limits.size(); ++r) {
+    if (arc)
+      plane_share[r] =
+          std::hypot(limits[r].coefficient(seg.first_axis), limits[r].coefficient(seg.second_axis));
+    other_share[r] = std::abs(limits[r].dot(other)) / seg.length;
+  }
   double v = 1e300;
   double a = 1e300;
-  for (int i = 0; i < kAxes; ++i) {
-    if (direction[i] <= kTiny) continue;
-    const auto& axis = config_.axes[static_cast<std::size_t>(i)];
-    v = std::min(v, axis.max_velocity / direction[i]);
-    a = std::min(a, axis.max_acceleration / direction[i]);
+  for (std::size_t r = 0; r < limits.size(); ++r) {
+    const double rate = plane_share[r] * in_plane + other_share[r];
+    if (rate <= kTiny) continue;
+    v = std::min(v, limits[r].max_velocity / rate);
+    a = std::min(a, limits[r].max_acceleration / rate);
   }
   const bool linear_motion = direction[0] + direction[1] + direction[2] > kTiny;
   if (linear_motion && config_.max_linear_velocity > 0)
@@ -365,10 +383,14 @@ void Planner::set_limits(Segment& seg) const {
   if (arc) {
     // In the plane the acceleration is the tangential part (path acceleration x cos b, b the
     // helix angle) plus the centripetal part (in-plane speed^2 / r) at right angles to it.
-    double plane_a =
-        std::min(config_.axes[static_cast<std::size_t>(seg.first_axis)].max_acceleration,
-                 config_.axes[static_cast<std::size_t>(seg.second_axis)].max_acceleration);
-    const double in_plane = direction[seg.first_axis];  // cos b
+    // A bound with a share of the plane takes that share of the in-plane acceleration, and
+    // of the tangential part (at most the in-plane acceleration / cos b) its other share.
+    double plane_a = 1e300;
+    for (std::size_t r = 0; r < limits.size(); ++r) {
+      if (plane_share[r] <= kTiny) continue;
+      plane_a = std::min(plane_a,
+                         limits[r].max_acceleration / (plane_share[r] + other_share[r] / in_plane));
+    }
     const double fastest = seg.feed > 0 ? std::min(v, seg.feed * config_.max_feed_override) : v;
     double v_plane = v * in_plane;
     double a_plane = 0;

@@ -4,13 +4,11 @@
 namespace cncd::motion {
 
 bool ServoLoop::axis_homed(int axis) const noexcept {
-  bool any = false;
+  const std::uint32_t joints = kins_->joints_of_axis(axis);
   for (int j = 0; j < joint_count_; ++j) {
-    if (joint_axis_[static_cast<std::size_t>(j)] != axis) continue;
-    if (!joints_.homed[static_cast<std::size_t>(j)]) return false;
-    any = true;
+    if ((joints & (1u << j)) != 0 && !joints_.homed[static_cast<std::size_t>(j)]) return false;
   }
-  return any;
+  return joints != 0;
 }
 
 void ServoLoop::apply_jog(const Command& command) noexcept {
@@ -49,11 +47,7 @@ void ServoLoop::advance_jog() noexcept {
   // The axes that move this period (including the one that comes to rest in it).
   const std::uint32_t moving = jog_.active_mask();
   jog_.update(axis_pose_, period_s_);
-  for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis >= 0 && (moving & (1u << axis)) != 0)
-      joints_.command[static_cast<std::size_t>(j)] = axis_pose_[static_cast<std::size_t>(axis)];
-  }
+  kins_->inverse(axis_pose_, moving, joints_.command);
   status_.velocity = jog_.speed();
   status_.motion = jog_.active() ? MotionState::jogging : MotionState::idle;
 }

@@ -49,6 +49,7 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       drivers_(std::move(drivers)),
       period_s_(static_cast<double>(config.servo_period_ns) * 1e-9),
       joint_count_(static_cast<int>(std::min<std::size_t>(config.joints.size(), kJoints))),
+      kins_(make_kinematics(config)),
       io_(config, period_s_),
       path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
@@ -59,11 +60,6 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
   path_.set_gate(&io_);
   // The MPG's speed in velocity mode: its counts over about 50 ms.
   mpg_.window = std::clamp(static_cast<int>(std::lround(0.05 / period_s_)), 1, Mpg::kWindowMax);
-  joint_axis_.fill(-1);
-  for (int j = 0; j < joint_count_; ++j) {
-    joint_axis_[static_cast<std::size_t>(j)] =
-        config::axis_index(config.joints[static_cast<std::size_t>(j)].axis);
-  }
   for (const auto& binding : drivers_) {
     for (int j : binding.joints) {
       if (j < 0 || j >= kJoints) continue;
@@ -279,17 +275,16 @@ void ServoLoop::advance_homing() noexcept {
       status_.motion = homing_.stopping() ? MotionState::stopping : MotionState::homing;
       break;
   }
-  // Axes follow their joints while homing (trivkins: the first joint of an axis leads).
+  // Axes follow their joints while homing (a gantry's first joint leads its axis).
   sync_axes_from_joints();
 }
 
 int ServoLoop::joint_apart() const noexcept {
+  JointArray placed = joints_.command;
+  kins_->inverse(axis_pose_, kAllAxes, placed);
   for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis < 0) continue;
-    if (std::abs(joints_.command[static_cast<std::size_t>(j)] -
-                 axis_pose_[static_cast<std::size_t>(axis)]) > 1e-6)
-      return j;
+    const auto k = static_cast<std::size_t>(j);
+    if (std::abs(joints_.command[k] - placed[k]) > 1e-6) return j;
   }
   return -1;
 }
@@ -309,7 +304,7 @@ void ServoLoop::advance_path() noexcept {
     RtEvent fault;
     fault.code = RtEvent::Code::joints_apart;
     fault.joint = static_cast<std::int8_t>(apart);
-    fault.axis = static_cast<std::int8_t>(joint_axis_[static_cast<std::size_t>(apart)]);
+    fault.axis = static_cast<std::int8_t>(kins_->axis_of_joint(apart));
     latch_fault(fault);
   } else if (result.fault == PathExecutor::Fault::off_path) {
     latch_fault(RtEvent::Code::off_path);
@@ -317,11 +312,7 @@ void ServoLoop::advance_path() noexcept {
   // Joints follow the path only while it moves: at rest they keep what homing left (a gantry
   // joint homed apart is caught, not jumped, when the next move starts).
   if (!result.moved) return;
-  for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis >= 0)
-      joints_.command[static_cast<std::size_t>(j)] = axis_pose_[static_cast<std::size_t>(axis)];
-  }
+  kins_->inverse(axis_pose_, kAllAxes, joints_.command);
 }
 
 void ServoLoop::advance_io() noexcept {
@@ -350,13 +341,7 @@ void ServoLoop::advance_io() noexcept {
 }
 
 void ServoLoop::sync_axes_from_joints() noexcept {
-  std::array<bool, kAxes> seen{};
-  for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis < 0 || seen[static_cast<std::size_t>(axis)]) continue;
-    seen[static_cast<std::size_t>(axis)] = true;
-    axis_pose_[static_cast<std::size_t>(axis)] = joints_.command[static_cast<std::size_t>(j)];
-  }
+  kins_->forward(joints_.command, axis_pose_);
 }
 
 void ServoLoop::update_stats(std::int64_t wake_error_ns) noexcept {

@@ -20,12 +20,7 @@ void ServoLoop::watch_probe() noexcept {
   // The input was read with this period's feedback: the machine was where the feedback says.
   probe_tripped_ = true;
   probe_position_ = status_.commanded;
-  for (int j = 0; j < joint_count_; ++j) {
-    const int axis = joint_axis_[static_cast<std::size_t>(j)];
-    if (axis >= 0)
-      probe_position_[static_cast<std::size_t>(axis)] =
-          joints_.feedback[static_cast<std::size_t>(j)];
-  }
+  kins_->forward(joints_.feedback, probe_position_);
   path_.abort();
 }
 

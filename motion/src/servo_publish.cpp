@@ -21,16 +21,11 @@ void ServoLoop::publish() noexcept {
   status_.sync = io_.sync();
   status_.input_result = io_.input_result();
   status_.input_waits = io_.input_waits();
-  std::array<bool, kAxes> seen{};
+  kins_->forward(joints_.feedback, status_.actual);
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     status_.joint_commanded[k] = joints_.command[k];
     status_.joint_actual[k] = joints_.feedback[k];
-    const int axis = joint_axis_[k];
-    if (axis >= 0 && !seen[static_cast<std::size_t>(axis)]) {
-      seen[static_cast<std::size_t>(axis)] = true;
-      status_.actual[static_cast<std::size_t>(axis)] = joints_.feedback[k];
-    }
     const auto& fb = feedback_[k];
     const auto& joint = config_.joints[k];
     JointStatus& out = status_.joints[k];

@@ -112,12 +112,12 @@ class Simulation final : motion::MoveQueue {
     }
     interp_.set_machine_position(start);
     std::vector<int> joints;
-    motion::JointArray joint_start{};
-    for (std::size_t j = 0; j < machine_.joints.size() && j < joint_start.size(); ++j) {
+    for (std::size_t j = 0; j < machine_.joints.size() && j < motion::kJoints; ++j)
       joints.push_back(static_cast<int>(j));
-      const int axis = config::axis_index(machine_.joints[j].axis);
-      if (axis >= 0) joint_start[j] = start[static_cast<std::size_t>(axis)];
-    }
+    motion::AxisPose start_axes{};
+    std::copy_n(start.begin(), start_axes.size(), start_axes.begin());
+    motion::JointArray joint_start{};
+    motion::make_kinematics(machine_)->inverse(start_axes, motion::kAllAxes, joint_start);
     if (auto problem = drive_.configure(machine_, joints); !problem.empty()) {
       result_.error = CheckProblem{program_, 0, "simulated drives: " + problem};
       return false;

@@ -1,5 +1,6 @@
 // Jogging: continuous and incremental moves of single axes, each a trapezoid within the axis's
-// MAX_VELOCITY and MAX_ACCELERATION that ends at the soft limit on a homed axis.
+// MAX_VELOCITY and MAX_ACCELERATION, and those of the joints it moves, that ends at the soft
+// limit on a homed axis. Axes that share a joint (corexy's X and Y) jog one at a time.
 #pragma once
 
 #include <array>
@@ -63,8 +64,15 @@ class Jog {
     bool pending_homed = false;
   };
   CNCD_RT void begin(int axis, double position, double target, double speed) noexcept;
+  // Why `axis` may not start now while others jog, or nullptr.
+  CNCD_RT const char* coupling_refusal(int axis) const noexcept;
 
   const config::MachineConfig& config_;
+  std::uint32_t coupled_ = 0;  // Kinematics::coupled_axes()
+  // Per axis: the speed and acceleration its jogs keep within, the tightest of the axis's own
+  // and those of the joints it moves.
+  std::array<double, kAxes> max_velocity_{};
+  std::array<double, kAxes> max_acceleration_{};
   std::array<AxisJog, kAxes> axes_{};
 };
 

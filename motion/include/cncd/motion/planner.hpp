@@ -1,7 +1,8 @@
 // Turns programmed moves into segments whose every axis stays within its MAX_VELOCITY and
 // MAX_ACCELERATION: the path limits are the tightest the axes allow along the move's direction
 // (on arcs and blend arcs with the centripetal acceleration included), and [TRAJ]
-// MAX_LINEAR_VELOCITY. Non-RT: called on the task thread.
+// MAX_LINEAR_VELOCITY. Where a joint is no axis of its own (corexy's motors) its limits are
+// kept the same way (Kinematics::rate_limits()). Non-RT: called on the task thread.
 //
 // The stateful side (push/flush) looks one move ahead: it holds back the newest move until the
 // next one shows how the two join. Tangent junctions are marked for the servo loop to cross
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/motion/kinematics.hpp"
 #include "cncd/motion/segment.hpp"
 #include "cncd/motion/types.hpp"
 
@@ -128,6 +130,7 @@ class Planner {
   bool fillet(Held& held, Segment& next);
 
   const config::MachineConfig& config_;
+  std::shared_ptr<const Kinematics> kins_;
   AxisPose end_{};
   std::optional<Merge> merge_;
   std::optional<Held> held_;

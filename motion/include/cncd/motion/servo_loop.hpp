@@ -14,6 +14,7 @@
 #include "cncd/motion/feedback_checks.hpp"
 #include "cncd/motion/homing.hpp"
 #include "cncd/motion/jog.hpp"
+#include "cncd/motion/kinematics.hpp"
 #include "cncd/motion/machine_io.hpp"
 #include "cncd/motion/panel.hpp"
 #include "cncd/motion/path_executor.hpp"
@@ -138,7 +139,7 @@ class ServoLoop {
   CNCD_RT void probe_error(RtEvent::Code code) noexcept;
   // An abort or a stop ends a probing move without an outcome.
   CNCD_RT void disarm_probe() noexcept;
-  // The first joint whose command stands apart from its axis's position, or -1.
+  // The first joint whose command stands apart from where the axes put it, or -1.
   CNCD_RT int joint_apart() const noexcept;
   CNCD_RT void advance_homing() noexcept;
   CNCD_RT void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
@@ -178,7 +179,7 @@ class ServoLoop {
   std::vector<DriverBinding> drivers_;
   double period_s_;
   int joint_count_;
-  std::array<int, kJoints> joint_axis_{};  // axis index a joint follows, -1 = none
+  std::unique_ptr<const Kinematics> kins_;  // joints to axes and back
 
   CommandRing commands_;
   EventRing events_;
