@@ -72,7 +72,8 @@ constexpr std::array kMachineKeys{
              "File that keeps joint positions across restarts; empty: start at zero"),
     bool_key("TRAJ", "NO_FORCE_HOMING", "0", "Allow programs and MDI before the machine is homed"),
     text_key("KINS", "KINEMATICS", "",
-             "Kinematics module and its arguments; only trivkins, e.g. trivkins coordinates=XYYZ"),
+             "Kinematics module and its arguments: trivkins (e.g. trivkins coordinates=XYYZ, a "
+             "gantry) or corexykins (joint 0 = X + Y, joint 1 = X - Y); docs/kinematics.md"),
     integer_key("KINS", "JOINTS", "", 1, 16, "", "Number of joints (motors)"),
     real_key("DISPLAY", "MAX_FEED_OVERRIDE", "1.0", 0, 10, "ratio",
              "Highest feed override an operator may set; 1.2 = 120 %"),

@@ -263,8 +263,11 @@ std::string describe(const MachineConfig& c) {
     const JointConfig& j = c.joints[i];
     const bool angular = j.type == JointType::angular;
     const std::string u = angular ? au : lu;
-    const std::string axis =
-        j.axis == '\0' ? std::string("none (extra joint)") : std::string(1, j.axis);
+    const bool motor = c.kinematics == "corexykins" && i < 2 &&
+                       static_cast<int>(i) < c.joint_count - c.extra_joints;
+    const std::string axis = motor            ? std::string(i == 0 ? "X + Y" : "X - Y") + " (motor)"
+                             : j.axis == '\0' ? std::string("none (extra joint)")
+                                              : std::string(1, j.axis);
     std::string home = "home " + num(j.home) + " " + u + ", ";
     if (j.home_search_vel == 0) {
       home += "homes where it stands";

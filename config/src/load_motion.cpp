@@ -3,6 +3,7 @@
 #include <sstream>
 #include <vector>
 
+#include "kins_map.hpp"
 #include "loader.hpp"
 #include "text.hpp"
 
@@ -17,130 +18,6 @@ std::string joint_section(int joint) {
 }
 bool is_linear_axis(char letter) {
   return std::string_view("XYZUVW").find(letter) != std::string_view::npos;
-}
-
-struct Kinematics {
-  bool ok = false;
-  std::string module;
-  std::string args;
-  std::string coordinates;  // trivkins coordinates= letters, upper case; empty: not given
-};
-
-Kinematics load_kinematics(TypedReader& r) {
-  Kinematics k;
-  const auto written = r.text("KINS", "KINEMATICS");
-  if (!written) {
-    r.problem("KINS", "KINEMATICS", "missing; write KINEMATICS = trivkins");
-    return k;
-  }
-  std::istringstream words{std::string(strip_trailing_comment(*written))};
-  words >> k.module;
-  if (k.module != "trivkins") {
-    r.problem("KINS", "KINEMATICS",
-              "kinematics '" + printable(k.module) + "' is not supported; cncd supports trivkins");
-    return k;
-  }
-  k.ok = true;
-  std::string word;
-  while (words >> word) {
-    k.args += (k.args.empty() ? "" : " ") + word;
-    const std::size_t equal = word.find('=');
-    const std::string name = to_lower(word.substr(0, equal));
-    const std::string value = equal == std::string::npos ? "" : word.substr(equal + 1);
-    if (name == "coordinates") {
-      for (const char ch : value) {
-        if (axis_index(ch) < 0) {
-          r.problem("KINS", "KINEMATICS",
-                    "coordinates=" + printable(value) + ": '" + printable(std::string(1, ch)) +
-                        "' is not an axis letter");
-          k.ok = false;
-          return k;
-        }
-      }
-      k.coordinates = to_upper(value);
-    } else if (name != "kinstype") {
-      r.warning("KINS", "KINEMATICS",
-                "unknown trivkins argument '" + printable(word) + "' ignored");
-    }
-  }
-  return k;
-}
-
-// "Y is" or "X and Y are": the letters written more than once.
-std::string repeated_letters(const std::string& letters) {
-  std::string found;
-  for (const char letter : kAxisLetters) {
-    if (std::count(letters.begin(), letters.end(), letter) > 1) found += letter;
-  }
-  std::string text;
-  for (std::size_t i = 0; i < found.size(); ++i) {
-    text += (i == 0 ? "" : i + 1 == found.size() ? " and " : ", ") + std::string(1, found[i]);
-  }
-  return text + (found.size() == 1 ? " is" : " are");
-}
-
-// With coordinates= the joints are trivkins', and [TRAJ] COORDINATES only names the axes: a
-// letter it repeats more often than trivkins gives that axis joints is no gantry.
-void check_repeats_match_kinematics(TypedReader& r, const Kinematics& k,
-                                    const std::string& coordinates) {
-  for (const char letter : kAxisLetters) {
-    const auto written = std::count(coordinates.begin(), coordinates.end(), letter);
-    const auto joints = std::count(k.coordinates.begin(), k.coordinates.end(), letter);
-    if (written < 2 || joints >= written) continue;
-    r.problem("TRAJ", "COORDINATES",
-              std::string(1, letter) + " is written " + std::to_string(written) +
-                  " times, but trivkins coordinates=" + k.coordinates + " drives it with " +
-                  std::to_string(joints) + " joint" + (joints == 1 ? "" : "s") +
-                  "; a gantry repeats the letter in both");
-  }
-}
-
-// Which axis each joint drives, as trivkins assigns them: the letters of coordinates= in
-// joint order; without it joint n drives the n-th of XYZABCUVW. A gantry written only in
-// [TRAJ] COORDINATES (XYYZ) is taken as that joint list, since identity cannot mean it.
-std::string joint_map(TypedReader& r, const Kinematics& k, MachineConfig& c) {
-  const std::string jstr = "JOINTS = " + std::to_string(c.joint_count);
-  const int kinematic_joints = c.joint_count - c.extra_joints;
-  std::set<char> distinct(c.coordinates.begin(), c.coordinates.end());
-  std::string map;
-  if (!k.coordinates.empty()) {
-    map = k.coordinates;
-    if (static_cast<int>(map.size()) > kinematic_joints) {
-      r.problem("KINS", "JOINTS",
-                jstr + " is too few: trivkins coordinates=" + map + " needs " +
-                    std::to_string(map.size() + c.extra_joints) + " joints");
-    }
-    check_repeats_match_kinematics(r, k, c.coordinates);
-  } else if (distinct.size() != c.coordinates.size()) {
-    map = c.coordinates;
-    if (static_cast<int>(distinct.size()) == kinematic_joints) {
-      // One joint an axis: the repeat cannot be a gantry, it is a slip.
-      r.problem("TRAJ", "COORDINATES",
-                repeated_letters(c.coordinates) + " repeated, but a repeated letter is a " +
-                    "gantry, one joint a letter (" + std::to_string(map.size()) + "), and " + jstr +
-                    " gives each axis one joint; write each letter once, or JOINTS = " +
-                    std::to_string(map.size() + c.extra_joints) + " for a gantry");
-    } else if (static_cast<int>(map.size()) != kinematic_joints) {
-      r.problem("KINS", "JOINTS",
-                jstr + " does not match COORDINATES " + c.coordinates + ", which names " +
-                    std::to_string(map.size()) + " joints");
-    }
-  } else {
-    map = std::string(kAxisLetters);
-    if (static_cast<int>(distinct.size()) > kinematic_joints) {
-      r.problem("KINS", "JOINTS",
-                jstr + " is too few for the " + std::to_string(distinct.size()) +
-                    " axes of COORDINATES " + c.coordinates);
-    }
-  }
-  if (static_cast<int>(map.size()) > kinematic_joints) map.resize(std::max(0, kinematic_joints));
-  for (const char letter : distinct) {
-    if (map.find(letter) == std::string::npos) {
-      r.warning("KINS", "KINEMATICS",
-                std::string("axis ") + letter + " in [TRAJ] COORDINATES is driven by no joint");
-    }
-  }
-  return map;
 }
 
 void load_axis(TypedReader& r, MachineConfig& c, char letter) {
@@ -283,8 +160,36 @@ void derive_traj_limits(TypedReader& r, MachineConfig& c) {
 
 }  // namespace
 
+// A corexy motor's soft limits: the range it covers while X and Y stay within theirs (joint 0 =
+// X + Y, joint 1 = X - Y) when its [JOINT_n] gives none, and never narrower, since moves are
+// checked against the axes' limits (as a trivkins joint's must include its axis's).
+void corexy_motor_limits(TypedReader& r, const MachineConfig& c, int index, JointConfig& j) {
+  const AxisConfig& x = c.axis('X');
+  const AxisConfig& y = c.axis('Y');
+  const std::string s = joint_section(index);
+  const double low = index == 0 ? x.min_limit + y.min_limit : x.min_limit - y.max_limit;
+  const double high = index == 0 ? x.max_limit + y.max_limit : x.max_limit - y.min_limit;
+  const std::string motor = index == 0 ? "X + Y" : "X - Y";
+  if (!r.given(s, "MIN_LIMIT")) {
+    j.min_limit = low;
+  } else if (j.min_limit > low && !r.failed(s, "MIN_LIMIT")) {
+    r.problem(s, "MIN_LIMIT",
+              format_number(j.min_limit) + " is narrower than the " + format_number(low) +
+                  " that this motor (" + motor +
+                  ") reaches within the X and Y limits; joint limits must include the axis limits");
+  }
+  if (!r.given(s, "MAX_LIMIT")) {
+    j.max_limit = high;
+  } else if (j.max_limit < high && !r.failed(s, "MAX_LIMIT")) {
+    r.problem(s, "MAX_LIMIT",
+              format_number(j.max_limit) + " is narrower than the " + format_number(high) +
+                  " that this motor (" + motor +
+                  ") reaches within the X and Y limits; joint limits must include the axis limits");
+  }
+}
+
 void load_motion(TypedReader& r, MachineConfig& c) {
-  const Kinematics k = load_kinematics(r);
+  const KinsChoice k = load_kinematics(r);
   c.kinematics = k.module.empty() ? c.kinematics : k.module;
   c.kinematics_args = k.args;
   const auto joints = r.integer("KINS", "JOINTS");
@@ -316,14 +221,21 @@ void load_motion(TypedReader& r, MachineConfig& c) {
   for (int index = 0; index < c.joint_count; ++index) {
     const char letter =
         index < static_cast<int>(map.size()) ? map[static_cast<std::size_t>(index)] : '\0';
-    const bool drives_axis = letter != '\0' && c.coordinates.find(letter) != std::string::npos;
+    const bool motor = k.corexy && index < 2 && index < c.joint_count - c.extra_joints;
+    const bool drives_axis =
+        motor || (letter != '\0' && c.coordinates.find(letter) != std::string::npos);
     if (index > last_section && index < c.joint_count - c.extra_joints && !drives_axis) {
       // No section here nor after it: JOINTS counts joints the machine does not have.
       unconfigured.push_back(index);
       c.joints.push_back(load_joint(r, c, index, letter));
       continue;
     }
-    check_joint_section(r, c, index, letter);
+    check_joint_section(r, c, index, motor ? "XY"[index] : letter);
+    if (motor) {
+      c.joints.push_back(load_joint(r, c, index, letter));
+      corexy_motor_limits(r, c, index, c.joints.back());
+      continue;
+    }
     if (letter == '\0' && index < c.joint_count - c.extra_joints) {
       r.warning(joint_section(index), "", "joint is driven by no axis");
     } else if (letter != '\0' && c.coordinates.find(letter) == std::string::npos) {

@@ -8,8 +8,9 @@
 
 namespace cncd::motion {
 
-// trivkins (kins_trivial.cpp).
+// trivkins (kins_trivial.cpp) and corexykins (kins_corexy.cpp).
 std::unique_ptr<const Kinematics> make_trivkins(const config::MachineConfig& config);
+std::unique_ptr<const Kinematics> make_corexykins(const config::MachineConfig& config);
 
 // Every axis's own limits, one bound an axis in axis order (those the machine lacks too: no
 // move ever has a share along them).

@@ -163,10 +163,10 @@ TEST_F(ValidationTest, UnknownDriver) {
 
 TEST_F(ValidationTest, UnsupportedKinematics) {
   EXPECT_EQ(
-      problems_with(10, "KINEMATICS = corexykins"),
-      problem_at(
-          10,
-          "[KINS] KINEMATICS: kinematics 'corexykins' is not supported; cncd supports trivkins"));
+      problems_with(10, "KINEMATICS = xyzac-trt-kins"),
+      problem_at(10,
+                 "[KINS] KINEMATICS: kinematics 'xyzac-trt-kins' is not supported; cncd supports "
+                 "trivkins and corexykins"));
 }
 
 TEST_F(ValidationTest, DisplayOverrideLimitsAreRead) {

@@ -128,20 +128,41 @@ int VirtualMachine::run_until_idle(int max_cycles) {
   return max_cycles;
 }
 
+namespace {
+
+// Raises `p` to coordinate i's largest speed and acceleration over `points` (one a period of
+// `dt` seconds), as ratios to its limits.
+template <typename Points>
+void add_peaks(Peaks& p, const Points& points, std::size_t i, double dt, double max_velocity,
+               double max_acceleration) {
+  for (std::size_t k = 2; k < points.size(); ++k) {
+    const double v = (points[k][i] - points[k - 1][i]) / dt;
+    const double v0 = (points[k - 1][i] - points[k - 2][i]) / dt;
+    p.velocity = std::max(p.velocity, std::abs(v) / max_velocity);
+    p.acceleration = std::max(p.acceleration, std::abs(v - v0) / dt / max_acceleration);
+  }
+}
+
+}  // namespace
+
 Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start) {
   Peaks p;
-  const double dt = m.period_s();
   std::vector<motion::AxisPose> points{start, start};
   points.insert(points.end(), m.trajectory().begin(), m.trajectory().end());
   for (int axis = 0; axis < motion::kAxes; ++axis) {
     const auto& limits = m.config().axes[static_cast<std::size_t>(axis)];
     if (!limits.present) continue;
-    for (std::size_t k = 2; k < points.size(); ++k) {
-      const double v = (points[k][axis] - points[k - 1][axis]) / dt;
-      const double v0 = (points[k - 1][axis] - points[k - 2][axis]) / dt;
-      p.velocity = std::max(p.velocity, std::abs(v) / limits.max_velocity);
-      p.acceleration = std::max(p.acceleration, std::abs(v - v0) / dt / limits.max_acceleration);
-    }
+    add_peaks(p, points, static_cast<std::size_t>(axis), m.period_s(), limits.max_velocity,
+              limits.max_acceleration);
+  }
+  return p;
+}
+
+Peaks joint_peaks(const VirtualMachine& m) {
+  Peaks p;
+  for (std::size_t j = 0; j < m.config().joints.size(); ++j) {
+    const auto& joint = m.config().joints[j];
+    add_peaks(p, m.motor_trajectory(), j, m.period_s(), joint.max_velocity, joint.max_acceleration);
   }
   return p;
 }

@@ -135,6 +135,8 @@ struct Peaks {
   double acceleration = 0;
 };
 Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start);
+// The same for every joint against its [JOINT_n] limits, from the recorded motor commands.
+Peaks joint_peaks(const VirtualMachine& m);
 // Every axis stayed within its velocity and acceleration limits (and 0.1 % for rounding) on
 // the way from `start` through the recorded trajectory.
 void expect_within_limits(const VirtualMachine& m, const motion::AxisPose& start);

@@ -49,7 +49,8 @@ struct AxisConfig {
 struct JointConfig {
   JointType type = JointType::linear;
   // The axis this joint drives (trivkins joint map); '\0' for an extra joint that no axis
-  // drives (LinuxCNC's num_extrajoints, or joints beyond the trivkins coordinates= letters).
+  // drives (LinuxCNC's num_extrajoints, or joints beyond the trivkins coordinates= letters)
+  // and for corexykins' joints 0 and 1, the X + Y and X - Y motors.
   char axis = 'X';
   double min_limit = -1e99;  // joint units
   double max_limit = 1e99;
@@ -298,7 +299,7 @@ struct MachineConfig {
   std::filesystem::path position_file_seed;
   bool no_force_homing = false;
   // [KINS]
-  std::string kinematics = "trivkins";  // module name only, e.g. "trivkins"
+  std::string kinematics = "trivkins";  // module name only: "trivkins" or "corexykins"
   std::string kinematics_args;          // the rest, e.g. "coordinates=XYYZ kinstype=both"
   int joint_count = 0;
   int extra_joints = 0;  // [EMCMOT] EMCMOT = motmod num_extrajoints=N

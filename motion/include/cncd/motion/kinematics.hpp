@@ -5,7 +5,8 @@
 // nowhere else.
 //
 // trivkins: each joint drives one axis (coordinates= or [TRAJ] COORDINATES; a letter repeated
-// is a gantry, its first joint leads the axis).
+// is a gantry, its first joint leads the axis). corexykins: joint 0 = X + Y and joint 1 =
+// X - Y (the two belt motors), joint n = the n-th of XYZABCUVW from joint 2 on.
 #pragma once
 
 #include <array>
@@ -75,12 +76,12 @@ class Kinematics {
   // joint's where a joint is no axis of its own. trivkins gives the axes' alone, as LinuxCNC
   // plans in world coordinates.
   virtual std::span<const RateLimit> rate_limits() const noexcept = 0;
-  // Bit i set: axis i shares a joint with another axis.
+  // Bit i set: axis i shares a joint with another axis (corexy's X and Y).
   virtual std::uint32_t coupled_axes() const noexcept = 0;
 };
 
 // Non-RT. The kinematics [KINS] KINEMATICS names (config::MachineConfig::kinematics, which the
-// config loader has checked): trivkins with its joint map (JointConfig::axis).
+// config loader has checked): trivkins with its joint map (JointConfig::axis), or corexykins.
 std::unique_ptr<const Kinematics> make_kinematics(const config::MachineConfig& config);
 
 }  // namespace cncd::motion
