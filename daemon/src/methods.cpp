@@ -98,6 +98,7 @@ void register_methods(RpcDispatcher& dispatcher, Task& task, const config::Machi
                   {"units", config.linear_units == config::LinearUnits::inch ? "inch" : "mm"},
                   {"axes", axes},
                   {"joints", config.joints.size()},
+                  {"kinematics", config.kinematics},
                   {"drivers", drivers},
                   {"servo_period_ns", config.servo_period_ns},
                   {"soft_limits", limits},

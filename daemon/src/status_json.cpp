@@ -53,7 +53,9 @@ json joints_array(const std::vector<JointReport>& joints) {
                    {"driver", std::string(joint.io.driver)},
                    {"enabled", joint.io.enabled},
                    {"drive_fault", joint.io.drive_fault},
-                   {"stale", joint.io.stale}});
+                   {"stale", joint.io.stale},
+                   {"commanded", joint.commanded},
+                   {"actual", joint.actual}});
   }
   return out;
 }

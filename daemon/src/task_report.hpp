@@ -34,6 +34,8 @@ struct JointReport {
   bool homed = false;
   bool fault = false;
   motion::JointStatus io;  // switches and drive, as the servo thread read them last
+  double commanded = 0;    // joint position, joint units (a corexy motor: X + Y or X - Y)
+  double actual = 0;
 };
 
 struct ProgramReport {

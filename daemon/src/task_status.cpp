@@ -165,7 +165,8 @@ TaskStatus Task::status() const {
   out.motion = s.motion;
   for (int j = 0; j < s.joint_count; ++j) {
     const auto k = static_cast<std::size_t>(j);
-    out.joints.push_back({s.homed[k], s.joint_fault[k], s.joints[k]});
+    out.joints.push_back(
+        {s.homed[k], s.joint_fault[k], s.joints[k], s.joint_commanded[k], s.joint_actual[k]});
   }
   out.fault = s.fault_reason;
   out.manual_holder = manual_holder(s);

@@ -50,10 +50,12 @@ inline CommandResult run_cncctl(const std::string& socket, const std::vector<std
 class MachineTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ini_ = copy_example_machine(dir_.path());
+    ini_ = copy_example_machine(dir_.path(), example());
     ASSERT_EQ(daemon_.start(dir_.path(), {"--ini", ini_.string()}), "");
     ASSERT_EQ(client_.connect(daemon_.socket()), "");
   }
+  // The example machine (config/examples/NAME.ini) the daemon runs.
+  virtual std::string example() const { return "sim_mm"; }
 
   nlohmann::json call(const std::string& method, const nlohmann::json& params = nullptr) {
     return client_.call(method, params, 30000);
