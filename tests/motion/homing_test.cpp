@@ -15,6 +15,7 @@ namespace {
 using motion::Command;
 using motion::MachineState;
 using motion::MotionState;
+using motion::Move;
 
 void start_homing(VirtualMachine& m, std::uint32_t mask) {
   m.command(Command::Kind::reset_estop);
@@ -206,6 +207,25 @@ TEST(Homing, SynchronisedSequenceStartsItsFinalMovesTogether) {
     EXPECT_NEAR(m.motor_position(1), 20 - 20, 4e-3);
     EXPECT_NEAR(m.motor_position(2), 35 - 20, 4e-3);
   }
+}
+
+TEST(Homing, ARackedGantryHomesSquareThenMovesAsOne) {
+  VirtualMachine m(gantry(true));
+  m.sim().set_home_switch(2, 35, 1);  // racked: the second motor's switch is 15 further out
+  start_homing(m, 1u << 1);
+  m.run_until_idle(200'000);
+  ASSERT_EQ(m.status().machine, MachineState::on) << m.status().fault_reason;
+  const double first = m.motor_position(1);
+  const double second = m.motor_position(2);
+  EXPECT_NEAR(second - first, 15, 4e-3);  // each joint HOME - HOME_OFFSET from its switch
+  // Both joints now stand at Y 0: a move of Y turns both motors by the same distance.
+  m.queue(line_to(Move::Kind::feed, 0, 30, 0, 600));
+  m.run_until_idle();
+  const auto s = m.status();
+  EXPECT_EQ(s.joint_commanded[1], 30);
+  EXPECT_EQ(s.joint_commanded[2], 30);
+  EXPECT_NEAR(m.motor_position(1) - first, 30, 1e-9);
+  EXPECT_NEAR(m.motor_position(2) - second, 30, 1e-9);
 }
 
 TEST(Homing, SequencesRunInOrder) {
