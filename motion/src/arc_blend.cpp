@@ -320,7 +320,7 @@ bool Planner::fillet(Held& held, Segment& next) {
     next.length -= f.trim_out;
   }
   prev.continuous = true;
-  emit_corner(prev, blend, next);
+  emit_corner(prev, held.entry_speed, blend, next);
   return true;
 }
 

@@ -39,6 +39,7 @@ void Planner::reset(const AxisPose& start) {
   end_ = start;
   merge_.reset();
   held_.reset();
+  pending_blend_.reset();
   output_.clear();
   pending_sync_ = {};
 }
@@ -136,11 +137,12 @@ void Planner::take(Segment seg, const Move& move) {
   }
   const double full_length = seg.length;
   next_reserved_ = false;
-  next_entry_speed_ = 1e300;
+  // With nothing held, the path is at rest where the segment starts.
+  next_entry_speed_ = 0.0;
   if (held_) join(seg, move);
   if (seg.kind == Segment::Kind::dwell || move.path_mode == Move::PathMode::exact_stop) {
     seg.continuous = false;
-    output_.push_back(seg);
+    emit_held(seg, next_entry_speed_, 0.0);
     return;
   }
   held_ = Held{seg,
@@ -156,7 +158,7 @@ void Planner::flush() {
   release_merge();
   if (held_) {
     held_->segment.continuous = false;
-    output_.push_back(held_->segment);
+    emit_held(held_->segment, held_->entry_speed, 0.0);
     held_.reset();
   }
   if (pending_sync_.any()) {
@@ -198,14 +200,14 @@ void Planner::join(Segment& next, const Move& move) {
   // and left as exact path even from and into G64 moves.
   const Move::PathMode mode = std::min(held.mode, move.path_mode);
   if (!moving || mode == Move::PathMode::exact_stop) {
-    output_.push_back(prev);
+    emit_held(prev, held.entry_speed, 0.0);
     return;
   }
   if (c > kTangentCos) {
     // Exact path (canned cycles) stops where a traverse meets a feed move, as LinuxCNC does.
     const bool same_kind = held.traverse == (move.kind == Move::Kind::traverse);
     prev.continuous = mode == Move::PathMode::blend || same_kind;
-    output_.push_back(prev);
+    emit_held(prev, held.entry_speed, next.axis_velocity);
     return;
   }
   if (mode != Move::PathMode::blend || prev.kind != Segment::Kind::line ||
@@ -213,7 +215,7 @@ void Planner::join(Segment& next, const Move& move) {
     // fillet() emits the trimmed held segment and the fillet arc itself.
     if (mode == Move::PathMode::blend && fillet(held, next)) return;
     if (mode == Move::PathMode::blend) kink(prev, held.reserved, next);
-    output_.push_back(prev);
+    emit_held(prev, held.entry_speed, next.axis_velocity);
     return;
   }
   // A tangent arc of radius R into a corner that turns by `turn` touches both lines at
@@ -229,7 +231,7 @@ void Planner::join(Segment& next, const Move& move) {
   reach = std::min(reach, prev.length);
   const double radius = reach / std::tan(half);
   if (!(radius >= kMinBlendRadius) || !std::isfinite(radius)) {
-    output_.push_back(prev);
+    emit_held(prev, held.entry_speed, 0.0);
     return;
   }
   const AxisPose corner = prev.end;
@@ -267,35 +269,59 @@ void Planner::join(Segment& next, const Move& move) {
   } else {
     blend.feed = std::max(prev.feed, next.feed);  // a traverse has none
   }
-  // The fastest the line before the arc can be left: from the speed bound at its start,
-  // accelerating all along what the arc leaves of it (and two servo periods' margin).
-  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
-  const double line_left = prev.length - reach;
-  const double entry = std::min(prev.axis_velocity,
-                                std::sqrt(held.entry_speed * held.entry_speed +
-                                          2.0 * prev.max_acceleration * std::max(0.0, line_left))) +
-                       2.0 * prev.max_acceleration * dt;
-  set_blend_limits(blend, entry);
-  next_entry_speed_ = blend.axis_velocity;
-
   prev.end = blend.start;
   prev.length -= reach;
   prev.continuous = true;
   next.start = blend.end;
   next.length -= reach;
-  emit_corner(prev, blend, next);
+  // Sized for now from the speed bound at the line's start (the speed limit of the blend arc
+  // before it as that stands), accelerating all along what the arc leaves of it; emit_corner
+  // lowers the bound once that arc's own limits are final.
+  set_blend_limits(blend, reach_speed(prev, held.entry_speed));
+  emit_corner(prev, held.entry_speed, blend, next);
 }
 
-void Planner::emit_corner(Segment& prev, Segment& blend, Segment& next) {
+double Planner::reach_speed(const Segment& seg, double bound) const {
+  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
+  return std::min(seg.axis_velocity,
+                  std::sqrt(bound * bound + 2.0 * seg.max_acceleration * seg.length)) +
+         2.0 * seg.max_acceleration * dt;
+}
+
+void Planner::emit_corner(Segment& prev, double start_speed, Segment& blend, Segment& next) {
   blend.sync = next.sync;
   next.sync = {};
-  if (prev.length > 1e-12) {
-    output_.push_back(prev);
-  } else {
+  const bool used_up = !(prev.length > 1e-12);
+  if (used_up) {
     blend.moves += prev.moves;  // the blend took all that was left of it
     add_sync(blend.sync, prev.sync);
   }
-  output_.push_back(blend);
+  emit_held(prev, start_speed, blend.axis_velocity, !used_up);
+  // The bound on the blend's entry speed, now that the limits before prev are final.
+  const double entry = next_entry_speed_;
+  Segment sized = blend;
+  set_blend_limits(sized, entry);
+  if (sized.axis_velocity <= blend.axis_velocity) blend = sized;
+  pending_blend_ = PendingBlend{blend, entry};
+  next_entry_speed_ = blend.axis_velocity;
+}
+
+void Planner::emit_held(const Segment& prev, double start_speed, double limit_after, bool push) {
+  const double end = prev.continuous ? std::min(prev.junction_velocity, limit_after) : 0.0;
+  if (pending_blend_) {
+    // The blend before prev cannot be left faster than prev lets the path slow down to `end`
+    // (reach_speed backwards).
+    Segment& blend = pending_blend_->segment;
+    Segment sized = blend;
+    set_blend_limits(sized, pending_blend_->entry_speed, reach_speed(prev, end));
+    // The segments after it were planned with its earlier speed limit: never above that.
+    if (sized.axis_velocity <= blend.axis_velocity) blend = sized;
+    start_speed = std::min(start_speed, blend.axis_velocity);
+    output_.push_back(blend);
+    pending_blend_.reset();
+  }
+  if (push) output_.push_back(prev);
+  next_entry_speed_ = std::min(end, reach_speed(prev, start_speed));
 }
 
 void Planner::kink(Segment& prev, bool prev_reserved, Segment& next) {
@@ -328,111 +354,6 @@ void Planner::reserve_for_kink(Segment& seg) {
   seg.max_acceleration *= 1.0 - kKinkReserve;
   if (seg.kind == Segment::Kind::arc) seg.axis_velocity *= std::sqrt(1.0 - kKinkReserve);
   seg.max_velocity = std::min(seg.max_velocity, seg.axis_velocity);
-}
-
-void Planner::set_blend_limits(Segment& blend, double entry_speed) const {
-  // Along the arc, axis i's share of the unit tangent is T_i = w cos(phi + alpha) and of the
-  // unit normal (towards the centre) N_i = -w sin(phi + alpha), w = |(u_i, v_i)| its share of
-  // the plane. Two bounds hold for its acceleration a_t T_i + a_n N_i: the orthogonal one,
-  // sqrt(a_t^2 + a_n^2) w, and the sum of the parts' largest sizes over the sweep,
-  // a_t max|T_i| + a_n max|N_i|, which on a short arc is far below the first when the
-  // tangent and the normal lie along different axes (a slope's blend: the tangent along X,
-  // the normal along Z). The sum bound is taken where it is the better of the two.
-  double v = 1e300;
-  double plane_a = 1e300;   // orthogonal bound: the plane's acceleration limit
-  double normal_a = 1e300;  // the centripetal acceleration every axis allows alone
-  const auto rates = kins_->rate_limits();
-  std::array<double, kMaxRateLimits> max_t{}, max_n{};
-  bool linear = false;
-  for (int i = 0; i < 3; ++i)
-    linear = linear || std::hypot(blend.blend_u[i], blend.blend_v[i]) > 1e-12;
-  const double sweep = std::abs(blend.sweep);
-  // Largest |cos| over [x, x + sweep].
-  auto max_cos = [sweep](double x) {
-    const double pi = std::numbers::pi;
-    const double first_peak = std::ceil(x / pi) * pi;  // the first multiple of pi from x on
-    if (first_peak <= x + sweep) return 1.0;
-    return std::max(std::abs(std::cos(x)), std::abs(std::cos(x + sweep)));
-  };
-  // A bound (an axis, or a joint of several axes) is one more such share: its coefficients
-  // against u and v.
-  for (std::size_t k = 0; k < rates.size(); ++k) {
-    const double u = rates[k].dot(blend.blend_u);
-    const double u_across = rates[k].dot(blend.blend_v);
-    const double w = std::hypot(u, u_across);
-    if (w <= 1e-12) continue;
-    const double alpha = std::atan2(u, u_across);
-    max_t[k] = w * max_cos(alpha);
-    max_n[k] = w * max_cos(alpha - std::numbers::pi / 2);
-    if (max_t[k] > 1e-12) v = std::min(v, rates[k].max_velocity / max_t[k]);
-    if (max_n[k] > 1e-12) normal_a = std::min(normal_a, rates[k].max_acceleration / max_n[k]);
-    plane_a = std::min(plane_a, rates[k].max_acceleration / w);
-  }
-  if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
-  // The speed limit and the tangential acceleration limit of the arc when its centripetal
-  // part is sized for `fastest`.
-  auto limits = [&](double fastest, double& cap, double& accel) {
-    double v_orthogonal = v;
-    double a_orthogonal = 0;
-    curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v_orthogonal, a_orthogonal);
-    // The sum bound: the centripetal part takes what the fastest speed needs (at most the
-    // share of what every axis allows), the tangential part what each axis has left.
-    double centripetal = fastest * fastest / blend.radius;
-    if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
-    const double v_sum = std::min(v, std::sqrt(centripetal * blend.radius));
-    double a_sum = 1e300;
-    for (std::size_t k = 0; k < rates.size(); ++k) {
-      if (max_t[k] <= 1e-12) continue;
-      const double left = rates[k].max_acceleration - centripetal * max_n[k];
-      a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
-    }
-    // Only where it allows both as much speed and more acceleration: a blend left with little
-    // tangential acceleration would slow everything that has to brake through it.
-    const bool sum_better = v_sum >= v_orthogonal * (1 - 1e-12) && a_sum > a_orthogonal;
-    cap = sum_better ? v_sum : v_orthogonal;
-    accel = sum_better ? a_sum : a_orthogonal;
-  };
-  const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
-  limits(fastest, blend.axis_velocity, blend.max_acceleration);
-  auto set_feed_limit = [&blend] {
-    blend.max_velocity =
-        blend.feed > 0 ? std::min(blend.axis_velocity, blend.feed) : blend.axis_velocity;
-  };
-  set_feed_limit();
-  // No profile within the limits before the arc enters it faster than `entry_speed`, nor
-  // leaves it faster than sqrt(entry^2 + 2 a_t length) (with a margin of two servo periods'
-  // acceleration each for the servo loop's steps). Sizing the centripetal part for the lowest
-  // speed limit that still lets every such profile through leaves the rest of the
-  // acceleration to the tangential part: every profile that fitted the old limits fits the
-  // new ones, and the arc may speed up and slow down faster.
-  if (!(entry_speed < blend.axis_velocity)) return;
-  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
-  auto lets_through = [&](double cap, double accel) {
-    const double peak = std::sqrt(entry_speed * entry_speed + 2.0 * accel * blend.length);
-    return cap >= peak + 2.0 * accel * dt;
-  };
-  if (!lets_through(blend.axis_velocity, blend.max_acceleration)) return;
-  double lo = 0;
-  double hi = fastest;
-  double hi_cap = blend.axis_velocity;
-  double hi_accel = blend.max_acceleration;
-  for (int step = 0; step < 24; ++step) {
-    const double mid = 0.5 * (lo + hi);
-    double cap = 0;
-    double accel = 0;
-    limits(mid, cap, accel);
-    if (lets_through(cap, accel)) {
-      hi = mid;
-      hi_cap = cap;
-      hi_accel = accel;
-    } else {
-      lo = mid;
-    }
-  }
-  if (hi_accel <= blend.max_acceleration) return;
-  blend.axis_velocity = hi_cap;
-  blend.max_acceleration = hi_accel;
-  set_feed_limit();
 }
 
 }  // namespace cncd::motion

@@ -1,6 +1,7 @@
-// Blend arcs sized for the speed they can actually be entered at: below its curvature's speed
-// limit an arc leaves more of the acceleration to speeding up and slowing down, and at every
-// point of every arc each axis stays within its velocity and acceleration limits.
+// Blend arcs sized for the speeds they can actually be entered and left at: below its
+// curvature's speed limit an arc leaves more of the acceleration to speeding up and slowing
+// down, and at every point of every arc each axis stays within its velocity and acceleration
+// limits.
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -54,49 +55,80 @@ double worst_load(const config::MachineConfig& config, const Segment& arc) {
   return worst;
 }
 
+// `length` on from `from` in XY at `degrees` from X.
+AxisPose step(const AxisPose& from, double degrees, double length) {
+  const double heading = degrees * std::numbers::pi / 180;
+  return AxisPose{from[0] + length * std::cos(heading), from[1] + length * std::sin(heading), 0};
+}
+
+// Two corners joined by a short line, planned: their blend arcs and the line between them.
+struct TwoCorners {
+  Segment first, second, between;
+};
+TwoCorners two_corners(const config::MachineConfig& config, const std::vector<AxisPose>& points) {
+  std::vector<Segment> arcs;
+  std::vector<Segment> lines;
+  for (const auto& seg : plan_path(config, AxisPose{}, points, 0.1))
+    (seg.kind == Segment::Kind::blend ? arcs : lines).push_back(seg);
+  EXPECT_EQ(arcs.size(), 2u);
+  EXPECT_EQ(lines.size(), 3u);
+  if (arcs.size() != 2 || lines.size() != 3) return {};
+  return {arcs[0], arcs[1], lines[1]};
+}
+
+// The last blend arc of a path from `start` through `points`.
+Segment last_arc(const config::MachineConfig& config, const AxisPose& start,
+                 const std::vector<AxisPose>& points) {
+  Segment arc;
+  for (const auto& seg : plan_path(config, start, points, 0.1))
+    if (seg.kind == Segment::Kind::blend) arc = seg;
+  return arc;
+}
+
+// `soft`, a gentle corner's arc with a sharp corner's slow arc `sharp` at the other end of the
+// short line `between`, against `top`, the same corner sized for its top speed.
+void expect_sized_for_neighbour(const config::MachineConfig& config, const Segment& soft,
+                                const Segment& top, const Segment& sharp, const Segment& between) {
+  EXPECT_NEAR(top.radius, soft.radius, 1e-9);
+  // At its top speed the centripetal part takes 0.95 of the plane's 2000: 0.31 is left.
+  EXPECT_NEAR(top.axis_velocity, std::sqrt(0.95 * 2000 * top.radius), 1e-9);
+  EXPECT_LE(top.max_acceleration, std::sqrt(1 - 0.95 * 0.95) * 2000 * (1 + 1e-9));
+  // Between the sharp corner and the arc the speed changes by at most sqrt(v_sharp^2 + 2 a L):
+  // the arc keeps a speed limit at least that high (plus its own speeding up or slowing down)
+  // and gets much more of the acceleration along the path.
+  const double reach = std::sqrt(sharp.axis_velocity * sharp.axis_velocity +
+                                 2 * between.max_acceleration * between.length);
+  EXPECT_LT(soft.axis_velocity, top.axis_velocity);
+  EXPECT_GE(soft.axis_velocity, std::sqrt(reach * reach + 2 * soft.max_acceleration * soft.length));
+  EXPECT_GT(soft.max_acceleration, 1.5 * top.max_acceleration);
+  EXPECT_LE(worst_load(config, soft), 1 + 1e-9);
+  EXPECT_LE(worst_load(config, top), 1 + 1e-9);
+}
+
 // A sharp corner (slow, tight blend), a short line, then a gentle corner whose curvature alone
 // would allow far more speed than the short line can reach from the sharp corner.
 TEST(BlendLoad, AnArcEnteredBelowItsTopSpeedGetsMoreTangentialAcceleration) {
   const auto config = small_mill();
-  const double h1 = 2 * std::numbers::pi / 3;          // 120 degrees at a
-  const double h2 = h1 + 20 * std::numbers::pi / 180;  // then 20 degrees at b
   const AxisPose a{10, 0, 0};
-  auto step = [](const AxisPose& from, double heading, double length) {
-    return AxisPose{from[0] + length * std::cos(heading), from[1] + length * std::sin(heading), 0};
-  };
-  const AxisPose b = step(a, h1, 2);
-  const AxisPose c = step(b, h2, 10);
-  const auto out = plan_path(config, AxisPose{}, {a, b, c}, 0.1);
-  std::vector<Segment> arcs;
-  std::vector<Segment> lines;
-  for (const auto& seg : out)
-    (seg.kind == Segment::Kind::blend ? arcs : lines).push_back(seg);
-  ASSERT_EQ(arcs.size(), 2u);
-  ASSERT_EQ(lines.size(), 3u);
-  const Segment& sharp = arcs[0];
-  const Segment& soft = arcs[1];
-  const Segment& between = lines[1];
+  const AxisPose b = step(a, 120, 2);  // 120 degrees at a, then 20 at b
+  const auto corners = two_corners(config, {a, b, step(b, 140, 10)});
   // The same gentle corner at the end of the same 2 mm line, entered straight on from further
   // back (no corner before it): the arc sized for its top speed.
-  const auto reference = plan_path(config, step(b, h1, -4), {step(b, h1, -2), b, c}, 0.1);
-  const Segment* top = nullptr;
-  for (const auto& seg : reference)
-    if (seg.kind == Segment::Kind::blend) top = &seg;
-  ASSERT_NE(top, nullptr);
-  EXPECT_NEAR(top->radius, soft.radius, 1e-9);
-  // At its top speed the centripetal part takes 0.95 of the plane's 2000: 0.31 is left.
-  EXPECT_NEAR(top->axis_velocity, std::sqrt(0.95 * 2000 * top->radius), 1e-9);
-  EXPECT_LE(top->max_acceleration, std::sqrt(1 - 0.95 * 0.95) * 2000 * (1 + 1e-9));
-  // Entered from the sharp corner over the short line, the arc can be reached no faster than
-  // sqrt(v_sharp^2 + 2 a L): it keeps a speed limit at least that high (plus the arc's own
-  // speeding up) and gets much more of the acceleration along the path.
-  const double reach = std::sqrt(sharp.axis_velocity * sharp.axis_velocity +
-                                 2 * between.max_acceleration * between.length);
-  EXPECT_LT(soft.axis_velocity, top->axis_velocity);
-  EXPECT_GE(soft.axis_velocity, std::sqrt(reach * reach + 2 * soft.max_acceleration * soft.length));
-  EXPECT_GT(soft.max_acceleration, 1.5 * top->max_acceleration);
-  EXPECT_LE(worst_load(config, soft), 1 + 1e-9);
-  EXPECT_LE(worst_load(config, *top), 1 + 1e-9);
+  const Segment top = last_arc(config, step(b, 120, -40), {step(b, 120, -2), b, step(b, 140, 10)});
+  expect_sized_for_neighbour(config, corners.second, top, corners.first, corners.between);
+}
+
+// A gentle corner, a short line, then a sharp corner: the gentle corner's arc can be left no
+// faster than the short line lets the path slow down to the sharp one's speed, far below what
+// its curvature alone would allow.
+TEST(BlendLoad, AnArcLeftBelowItsTopSpeedGetsMoreTangentialAcceleration) {
+  const auto config = small_mill();
+  const AxisPose b{50, 0, 0};
+  const AxisPose c = step(b, 20, 2.3);  // 20 degrees at b, then 120 at c
+  const auto corners = two_corners(config, {b, c, step(c, 140, 10)});
+  // The same gentle corner followed by a long straight line: sized for its top speed.
+  const Segment top = last_arc(config, AxisPose{}, {b, step(b, 20, 50)});
+  expect_sized_for_neighbour(config, corners.first, top, corners.second, corners.between);
 }
 
 // Random dense 3D paths of short lines with small and large turns, random feeds and

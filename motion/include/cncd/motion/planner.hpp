@@ -5,11 +5,12 @@
 // kept the same way (Kinematics::rate_limits()). Non-RT: called on the task thread.
 //
 // The stateful side (push/flush) looks one move ahead: it holds back the newest move until the
-// next one shows how the two join. Tangent junctions are marked for the servo loop to cross
-// at speed; under G64 a line-line corner gets a tangent blend arc within the P tolerance, and
-// a corner where a programmed arc meets a line or another arc in its plane a tangent fillet
-// arc; every other junction stops, or is crossed slowly when it is a small kink
-// (docs/motion.md).
+// next one shows how the two join, and a blend arc until the junction after the move it leads
+// into is known (its limits depend on how fast the path can leave it). Tangent junctions are marked
+// for the servo loop to cross at speed; under G64 a line-line corner gets a tangent blend arc
+// within the P tolerance, and a corner where a programmed arc meets a line or another arc in its
+// plane a tangent fillet arc; every other junction stops, or is crossed slowly when it is a small
+// kink (docs/motion.md).
 #pragma once
 
 #include <deque>
@@ -50,7 +51,9 @@ class Planner {
   // interpreter has to give now).
   void flush();
   // Whether a move is held back.
-  bool holding() const { return held_.has_value() || merge_.has_value(); }
+  bool holding() const {
+    return held_.has_value() || merge_.has_value() || pending_blend_.has_value();
+  }
   // Where the last pushed move ends.
   const AxisPose& end() const { return end_; }
   // Final segments, oldest first, for the caller to take from the front.
@@ -77,10 +80,12 @@ class Planner {
   void set_limits(Segment& seg) const;
   static void set_directions(Segment& seg);
   // Path speed and acceleration limits of a blend arc (blend_u, blend_v and radius set).
-  // `entry_speed`: a bound on the speed at which any profile within the limits of the
-  // segments before it can enter the arc; below the arc's speed limit, the centripetal part
-  // is sized for the fastest such profile and the tangential part gets the rest.
-  void set_blend_limits(Segment& blend, double entry_speed = 1e300) const;
+  // `entry_speed`, `exit_speed`: bounds on the speeds at which any profile within the limits
+  // of the segments before and after it can enter and leave the arc; where they keep it
+  // below the arc's speed limit, the centripetal part is sized for the fastest such profile
+  // and the tangential part gets the rest.
+  void set_blend_limits(Segment& blend, double entry_speed = 1e300,
+                        double exit_speed = 1e300) const;
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
   // a blend arc (trimming both lines), or leaves a stop. Emits the held segment.
   void join(Segment& next, const Move& move);
@@ -107,9 +112,10 @@ class Planner {
     double full_length = 0;  // before any blend trimmed it
     bool traverse = false;
     bool reserved = false;  // its acceleration is already reduced for a kink
-    // A bound on the speed at its start: the speed limit of the blend arc before it (no
-    // bound after any other junction).
-    double entry_speed = 1e300;
+    // A bound on the speed at its start: 0 after a stop, the speed limit of the blend arc
+    // before it (as it stands while that arc is held back), or what the segments before it
+    // allow across a tangent junction or a kink.
+    double entry_speed = 0;
   };
 
   // Consecutive G1 lines of the same feed whose points all lie within Q of the line from the
@@ -134,16 +140,34 @@ class Planner {
   AxisPose end_{};
   std::optional<Merge> merge_;
   std::optional<Held> held_;
-  bool next_reserved_ = false;       // join() reduced the next segment's limits for a kink
-  double next_entry_speed_ = 1e300;  // join() ended the held segment in a blend arc this fast
+  bool next_reserved_ = false;   // join() reduced the next segment's limits for a kink
+  double next_entry_speed_ = 0;  // a bound on the speed where the segment join() joins starts
   // Outputs of moves that went nowhere, for the next segment to set (SyncOutputs).
   SyncOutputs pending_sync_{};
   // Adds the `earlier` settings of outputs to `into`, whose own settings win.
   static void add_sync(SyncOutputs& into, const SyncOutputs& earlier);
-  // Emits `prev` and the blend arc or fillet that rounds its corner into `next`. The blend
-  // starts the next move, so next's outputs go with it; a prev the blend used up entirely is
-  // dropped, its move count and outputs passing to the blend.
-  void emit_corner(Segment& prev, Segment& blend, Segment& next);
+  // Emits `prev` (`start_speed`: the bound on the speed at its start) and holds back the blend
+  // arc or fillet that rounds its corner into `next`, its entry speed bounded by what prev
+  // allows. The blend starts the next move, so next's outputs go with it; a prev the blend
+  // used up entirely is dropped, its move count and outputs passing to the blend.
+  void emit_corner(Segment& prev, double start_speed, Segment& blend, Segment& next);
+  // Emits the held segment `prev` once its end junction is settled (`start_speed` as above,
+  // `limit_after`: the speed limit of the segment after it) and sets next_entry_speed_ to the
+  // bound on the speed at its end. The blend held back before prev goes first, its limits set
+  // again now that what follows it is known: it cannot be left faster than prev lets the path
+  // slow down to its end junction. `push` false: the blend after prev used it up.
+  void emit_held(const Segment& prev, double start_speed, double limit_after, bool push = true);
+  // The fastest `seg` can be at one end when it is at most `bound` at the other: its speed
+  // limit, or bound^2 + 2 a length, with two servo periods' acceleration as a margin for the
+  // servo loop's steps.
+  double reach_speed(const Segment& seg, double bound) const;
+  // A blend arc or fillet, with the bound on its entry speed, held back until the corner at the
+  // end of the move after it is known.
+  struct PendingBlend {
+    Segment segment;
+    double entry_speed = 1e300;
+  };
+  std::optional<PendingBlend> pending_blend_;
   std::deque<Segment> output_;
 };
 
