@@ -1,6 +1,7 @@
-// Speed and acceleration limits of blend arcs and fillets: the centripetal and tangential
-// shares of the plane's acceleration, sized for the fastest speed the arc can be run at, and
-// lowered to what the segments around it let through once both of its neighbours are known.
+// Speed and acceleration limits of blend arcs and fillets: the centripetal and tangential parts
+// of the acceleration within every axis's limit at every point of the arc, sized for the
+// fastest speed the arc can be run at, and lowered to what the segments around it let through
+// once both of its neighbours are known.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,19 +11,61 @@
 
 namespace cncd::motion {
 
+namespace {
+
+// One axis's share of a blend arc: along the arc its share of the unit tangent is
+// T = w cos(psi) and of the unit normal (towards the centre) N = -w sin(psi), for psi over the
+// sweep (w = |(u_i, v_i)|, its share of the plane).
+struct AxisShare {
+  bool moves = false;
+  double limit = 0;            // the axis's acceleration limit over w
+  double end_cos[2] = {0, 0};  // |cos(psi)| and |sin(psi)| at the start and the end
+  double end_sin[2] = {0, 0};
+  double least_sin = 0;  // the range of |sin(psi)| over the sweep
+  double most_sin = 0;
+};
+
+// The most tangential acceleration a, of either sign, that leaves the axis within its limit
+// while the centripetal part is anywhere from 0 to `centripetal`: at every psi,
+// a |cos(psi)| + centripetal |sin(psi)| <= limit, that is a <= (limit - centripetal
+// |sin(psi)|) / |cos(psi)|. Within each quarter turn that bound falls to its least,
+// sqrt(limit^2 - centripetal^2), where |sin(psi)| = centripetal / limit, and rises on both
+// sides of it: the least over the sweep is there, if |sin(psi)| passes that value, or at one
+// of its ends. A centripetal part beyond the limit fits only where |sin(psi)| stays low.
+double tangential_limit(const AxisShare& axis, double centripetal) {
+  const double a = axis.limit;
+  double least = 1e300;
+  for (int end = 0; end < 2; ++end) {
+    if (axis.end_cos[end] > 1e-15)
+      least = std::min(least, (a - centripetal * axis.end_sin[end]) / axis.end_cos[end]);
+  }
+  const double turn = centripetal / a;
+  if (turn < 1) {
+    if (axis.least_sin <= turn && turn <= axis.most_sin)
+      least = std::min(least, std::sqrt(a * a - centripetal * centripetal));
+  } else if (axis.most_sin >= 1) {
+    return 0.0;  // the centripetal part alone is too much where the normal lies along the axis
+  }
+  return std::max(0.0, least);
+}
+
+}  // namespace
+
 void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_speed) const {
-  // Along the arc, axis i's share of the unit tangent is T_i = w cos(phi + alpha) and of the
-  // unit normal (towards the centre) N_i = -w sin(phi + alpha), w = |(u_i, v_i)| its share of
-  // the plane. Two bounds hold for its acceleration a_t T_i + a_n N_i: the orthogonal one,
-  // sqrt(a_t^2 + a_n^2) w, and the sum of the parts' largest sizes over the sweep,
-  // a_t max|T_i| + a_n max|N_i|, which on a short arc is far below the first when the
-  // tangent and the normal lie along different axes (a slope's blend: the tangent along X,
-  // the normal along Z). The sum bound is taken where it is the better of the two.
+  // Along the arc the acceleration on axis i is a_t T_i + a_n N_i, a_t the tangential part (of
+  // either sign, at most the arc's acceleration limit) and a_n = v^2 / r the centripetal part
+  // (from 0 up to what the arc's speed limit needs). Each axis stays within its limit at every
+  // point of the sweep when |a_t| |T_i| + a_n |N_i| does (tangential_limit): the exact bound,
+  // which on a short arc leaves far more than the plane's limit shared between the two parts
+  // when the tangent and the normal lie along different axes (a slope's blend: the tangent
+  // along Z, the normal along Y).
   double v = 1e300;
-  double plane_a = 1e300;   // orthogonal bound: the plane's acceleration limit
   double normal_a = 1e300;  // the centripetal acceleration every axis allows alone
+  double plane_a = 1e300;   // the smallest acceleration limit over the plane
+  // A bound (an axis, or a joint of several axes: corexy's motors) is one more such share,
+  // with its coefficients against u and v.
   const auto rates = kins_->rate_limits();
-  std::array<double, kMaxRateLimits> max_t{}, max_n{};
+  std::array<AxisShare, kMaxRateLimits> shares{};
   bool linear = false;
   for (int i = 0; i < 3; ++i)
     linear = linear || std::hypot(blend.blend_u[i], blend.blend_v[i]) > 1e-12;
@@ -34,43 +77,59 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
     if (first_peak <= x + sweep) return 1.0;
     return std::max(std::abs(std::cos(x)), std::abs(std::cos(x + sweep)));
   };
-  // A bound (an axis, or a joint of several axes) is one more such share: its coefficients
-  // against u and v.
   for (std::size_t k = 0; k < rates.size(); ++k) {
     const double u = rates[k].dot(blend.blend_u);
     const double u_across = rates[k].dot(blend.blend_v);
     const double w = std::hypot(u, u_across);
     if (w <= 1e-12) continue;
     const double alpha = std::atan2(u, u_across);
-    max_t[k] = w * max_cos(alpha);
-    max_n[k] = w * max_cos(alpha - std::numbers::pi / 2);
-    if (max_t[k] > 1e-12) v = std::min(v, rates[k].max_velocity / max_t[k]);
-    if (max_n[k] > 1e-12) normal_a = std::min(normal_a, rates[k].max_acceleration / max_n[k]);
+    const double max_t = w * max_cos(alpha);
+    const double max_n = w * max_cos(alpha - std::numbers::pi / 2);  // w max|sin(psi)|
+    if (max_t > 1e-12) v = std::min(v, rates[k].max_velocity / max_t);
+    if (max_n > 1e-12) normal_a = std::min(normal_a, rates[k].max_acceleration / max_n);
+    AxisShare& share = shares[k];
+    share.moves = true;
+    share.limit = rates[k].max_acceleration / w;
+    for (int end = 0; end < 2; ++end) {
+      const double psi = alpha + end * sweep;
+      share.end_cos[end] = std::abs(std::cos(psi));
+      share.end_sin[end] = std::abs(std::sin(psi));
+    }
+    share.most_sin = max_cos(alpha - std::numbers::pi / 2);
+    // |sin(psi)| is 0 at the multiples of pi.
+    share.least_sin = std::ceil(alpha / std::numbers::pi) * std::numbers::pi <= alpha + sweep
+                          ? 0.0
+                          : std::min(share.end_sin[0], share.end_sin[1]);
     plane_a = std::min(plane_a, rates[k].max_acceleration / w);
   }
   if (linear && config_.max_linear_velocity > 0) v = std::min(v, config_.max_linear_velocity);
-  // The speed limit and the tangential acceleration limit of the arc when its centripetal
-  // part is sized for `fastest`.
-  auto limits = [&](double fastest, double& cap, double& accel) {
-    double v_orthogonal = v;
-    double a_orthogonal = 0;
-    curve_limits(fastest, blend.radius, plane_a, kBlendNormalShare, v_orthogonal, a_orthogonal);
-    // The sum bound: the centripetal part takes what the fastest speed needs (at most the
-    // share of what every axis allows), the tangential part what each axis has left.
-    double centripetal = fastest * fastest / blend.radius;
-    if (centripetal >= kBlendNormalShare * normal_a) centripetal = kBlendNormalShare * normal_a;
-    const double v_sum = std::min(v, std::sqrt(centripetal * blend.radius));
-    double a_sum = 1e300;
-    for (std::size_t k = 0; k < rates.size(); ++k) {
-      if (max_t[k] <= 1e-12) continue;
-      const double left = rates[k].max_acceleration - centripetal * max_n[k];
-      a_sum = std::min(a_sum, std::max(0.0, left) / max_t[k]);
+  auto tangential = [&](double centripetal) {
+    double accel = 1e300;
+    for (const auto& share : shares) {
+      if (share.moves) accel = std::min(accel, tangential_limit(share, centripetal));
     }
-    // Only where it allows both as much speed and more acceleration: a blend left with little
-    // tangential acceleration would slow everything that has to brake through it.
-    const bool sum_better = v_sum >= v_orthogonal * (1 - 1e-12) && a_sum > a_orthogonal;
-    cap = sum_better ? v_sum : v_orthogonal;
-    accel = sum_better ? a_sum : a_orthogonal;
+    return accel;
+  };
+  // The most the centripetal part may take: kBlendNormalShare of what every axis allows, as
+  // long as the tangential part keeps kBlendTangentialFloor of the plane's smallest limit (a
+  // blend left with next to no tangential acceleration would slow everything that has to
+  // brake through it).
+  double most = kBlendNormalShare * normal_a;
+  const double keep = kBlendTangentialFloor * plane_a;
+  if (tangential(most) < keep) {
+    double lo = 0;
+    for (int step = 0; step < 40; ++step) {
+      const double mid = 0.5 * (lo + most);
+      (tangential(mid) >= keep ? lo : most) = mid;
+    }
+    most = lo;
+  }
+  // The speed limit and the tangential acceleration limit of the arc when its centripetal
+  // part is sized for `fastest`, the speed limited to what `most` allows beyond.
+  auto limits = [&](double fastest, double& cap, double& accel) {
+    const double centripetal = std::min(fastest * fastest / blend.radius, most);
+    cap = std::min(v, std::sqrt(centripetal * blend.radius));
+    accel = tangential(centripetal);
   };
   const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
   limits(fastest, blend.axis_velocity, blend.max_acceleration);

@@ -63,9 +63,13 @@ class Planner {
   // Largest share of a curve's in-plane acceleration limit for the centripetal part, the rest
   // (t = sqrt(1 - n^2)) being left for speeding up and slowing down. Programmed arcs are long
   // enough to change speed on; a blend arc is short and mostly run at the speed its curvature
-  // allows.
+  // allows: its share is of the centripetal acceleration every axis allows on its own share of
+  // the normal, and what is left along the path is found axis by axis (blend_limits.cpp).
   static constexpr double kArcNormalShare = 0.8;
   static constexpr double kBlendNormalShare = 0.95;
+  // A blend arc's centripetal part stops short of kBlendNormalShare where the tangential part
+  // would keep less than this share of the plane's smallest acceleration limit.
+  static constexpr double kBlendTangentialFloor = 0.1;
   // A curve of `radius` in a plane whose acceleration limit is `plane_a`, never faster than
   // `fastest` (in-plane speed, units/s): the centripetal part gets what `fastest` needs, at
   // most `max_normal` of the limit, and the tangential part what is left, at right angles, so
