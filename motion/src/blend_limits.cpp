@@ -113,8 +113,11 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
   // The most the centripetal part may take: kBlendNormalShare of what every axis allows, as
   // long as the tangential part keeps kBlendTangentialFloor of the plane's smallest limit (a
   // blend left with next to no tangential acceleration would slow everything that has to
-  // brake through it).
-  double most = kBlendNormalShare * normal_a;
+  // brake through it). Under S-curve profiles, where a segment of low acceleration ahead makes
+  // the path ease its acceleration off at the jerk limit, kBlendNormalShare of the plane's
+  // smallest limit, as if the two parts shared it: the tangential part keeps at least the
+  // sqrt(1 - share^2) of it that sharing would leave.
+  double most = kBlendNormalShare * (jerk_ > 0 ? plane_a : normal_a);
   const double keep = kBlendTangentialFloor * plane_a;
   if (tangential(most) < keep) {
     double lo = 0;
@@ -146,7 +149,11 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
   // Sizing the centripetal part for the lowest speed limit that still lets every such profile
   // through leaves the rest of the acceleration to the tangential part: every profile that
   // fitted the old limits fits the new ones, and the arc may speed up and slow down faster.
-  if (!(std::min(entry_speed, exit_speed) < blend.axis_velocity)) return;
+  //
+  // Under S-curve profiles a speed limit just above the speeds the path reaches still costs
+  // time (the acceleration eases off before it at the jerk limit): there the arc keeps the
+  // limits it has at its top speed.
+  if (jerk_ > 0 || !(std::min(entry_speed, exit_speed) < blend.axis_velocity)) return;
   const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
   const double entry_sq = entry_speed * entry_speed;
   const double exit_sq = exit_speed * exit_speed;

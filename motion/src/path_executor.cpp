@@ -9,18 +9,19 @@
 namespace cncd::motion {
 
 PathExecutor::PathExecutor(const config::MachineConfig& config, double period_s)
-    : period_s_(period_s) {
-  if (config.scurve) {
-    // The acceleration must take at least kMinRampPeriods servo periods to build up on every
-    // axis: steeper S-curves, which the period-by-period steps cannot follow within the axis
-    // limits, are planned as trapezoids (cncd --check-config says so).
-    double accel = 1e300;
-    for (const auto& axis : config.axes) {
-      if (axis.present && axis.max_acceleration > 0) accel = std::min(accel, axis.max_acceleration);
-    }
-    if (config.max_linear_jerk * period_s_ * kMinRampPeriods <= accel)
-      jerk_ = config.max_linear_jerk;
+    : period_s_(period_s), jerk_(jerk_limit(config, period_s)) {}
+
+double PathExecutor::jerk_limit(const config::MachineConfig& config, double period_s) {
+  if (!config.scurve) return 0.0;
+  // The acceleration must take at least kMinRampPeriods servo periods to build up on every
+  // axis: steeper S-curves, which the period-by-period steps cannot follow within the axis
+  // limits, are planned as trapezoids (cncd --check-config says so).
+  double accel = 1e300;
+  for (const auto& axis : config.axes) {
+    if (axis.present && axis.max_acceleration > 0) accel = std::min(accel, axis.max_acceleration);
   }
+  return config.max_linear_jerk * period_s * kMinRampPeriods <= accel ? config.max_linear_jerk
+                                                                      : 0.0;
 }
 
 void PathExecutor::flush() noexcept {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "cncd/motion/path_executor.hpp"
 #include "cncd/motion/soft_limits.hpp"
 
 namespace cncd::motion {
@@ -82,7 +83,9 @@ AxisPose Segment::point_at(double s) const noexcept {
 }
 
 Planner::Planner(const config::MachineConfig& config)
-    : config_(config), kins_(make_kinematics(config)) {}
+    : config_(config),
+      kins_(make_kinematics(config)),
+      jerk_(PathExecutor::jerk_limit(config, static_cast<double>(config.servo_period_ns) * 1e-9)) {}
 
 void Planner::set_directions(Segment& seg) {
   AxisPose start{}, end{};

@@ -146,6 +146,24 @@ TEST(BlendLoad, AnArcLeftBelowItsTopSpeedGetsMoreTangentialAcceleration) {
   expect_sized_for_neighbour(config, corners.first, top, corners.second, corners.between);
 }
 
+// Under S-curve profiles a speed limit just above the speeds the path reaches still costs time
+// (the acceleration eases off before it): the gentle corner's arc before the sharp one keeps its
+// top limits, and at its top the centripetal part takes 0.95 of the plane's smallest limit.
+TEST(BlendLoad, UnderAJerkLimitAnArcKeepsItsTopLimits) {
+  auto config = small_mill();
+  config.scurve = true;
+  config.max_linear_jerk = 40000;
+  const AxisPose b{50, 0, 0};
+  const AxisPose c = step(b, 20, 2.3);
+  const auto corners = two_corners(config, {b, c, step(c, 140, 10)});
+  const Segment top = last_arc(config, AxisPose{}, {b, step(b, 20, 50)});
+  EXPECT_DOUBLE_EQ(corners.first.axis_velocity, top.axis_velocity);
+  EXPECT_DOUBLE_EQ(corners.first.max_acceleration, top.max_acceleration);
+  EXPECT_NEAR(top.axis_velocity, std::sqrt(0.95 * 2000 * top.radius), 1e-9);
+  EXPECT_GE(top.max_acceleration, std::sqrt(1 - 0.95 * 0.95) * 2000 * (1 - 1e-12));
+  EXPECT_LE(worst_load(config, top), 1 + 1e-9);
+}
+
 // A corner in the YZ plane, the path climbing along Z and turning by 50 degrees about it: along
 // the arc the tangent lies mostly along Z (1000 mm/s^2) and the normal mostly along Y (2000).
 // Each axis is held to its limit at every point of the sweep, not the plane to its smallest:

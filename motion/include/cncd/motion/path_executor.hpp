@@ -35,6 +35,8 @@ class PathExecutor {
 
   // Non-RT. S-curve profiles when the config asks for a jerk limit the period can follow.
   PathExecutor(const config::MachineConfig& config, double period_s);
+  // The path's jerk limit that S-curve profiles follow on `config`, 0 for trapezoidal profiles.
+  static double jerk_limit(const config::MachineConfig& config, double period_s);
 
   // Producer: the planner (task thread). Consumer: the servo thread.
   SegmentRing& segments() noexcept { return segments_; }

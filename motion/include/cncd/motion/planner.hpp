@@ -141,6 +141,8 @@ class Planner {
 
   const config::MachineConfig& config_;
   std::shared_ptr<const Kinematics> kins_;
+  // The path's jerk limit under S-curve profiles, 0 for trapezoidal ones.
+  double jerk_ = 0;
   AxisPose end_{};
   std::optional<Merge> merge_;
   std::optional<Held> held_;
