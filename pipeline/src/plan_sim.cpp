@@ -75,6 +75,12 @@ class Simulation final : motion::MoveQueue {
         result_.error = CheckProblem{program_, s.line, s.fault_reason};
         break;
       }
+      if (s.path_errors != path_errors_base_) {
+        // The servo loop stopped the path (a spindle that did not reach its speed in time):
+        // the machine would end the program there.
+        result_.error = CheckProblem{program_, s.line, motion::format_event(s.path_error)};
+        break;
+      }
       const std::uint64_t done = s.segments_done - base_;
       // Move i starts when move i - 1 is complete: the daemon counts moves the same way.
       const std::uint64_t moves_done = s.moves_done - moves_base_;
@@ -138,6 +144,7 @@ class Simulation final : motion::MoveQueue {
     }
     base_ = status.segments_done;
     moves_base_ = status.moves_done;
+    path_errors_base_ = status.path_errors;
     programmed_end_ = status.commanded;
     planner_.reset(status.commanded);
     previous_ = status.commanded;
@@ -315,11 +322,12 @@ class Simulation final : motion::MoveQueue {
   PlanDrive drive_;
   std::unique_ptr<motion::ServoLoop> loop_;
   const Clock::time_point wall_start_ = Clock::now();
-  std::uint64_t cycle_ = 0;            // servo periods since the program started
-  std::uint64_t base_ = 0;             // segments done before the program
-  std::uint64_t moves_base_ = 0;       // moves done before the program
-  motion::AxisPose programmed_end_{};  // where the last programmed move ends
-  std::uint64_t pushed_ = 0;           // segments queued by the program
+  std::uint64_t cycle_ = 0;             // servo periods since the program started
+  std::uint64_t base_ = 0;              // segments done before the program
+  std::uint64_t moves_base_ = 0;        // moves done before the program
+  std::uint64_t path_errors_base_ = 0;  // path errors before the program
+  motion::AxisPose programmed_end_{};   // where the last programmed move ends
+  std::uint64_t pushed_ = 0;            // segments queued by the program
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};
   std::deque<motion::Segment> window_;  // queued segments from index window_first_ on
