@@ -26,11 +26,12 @@ std::string not_supported(char letter, int code) {
 
 }  // namespace
 
-// G10, G28, G30, G52 and G92 take the line's axis words for themselves; so does G43.1 when
+// G10, G28, G30, G52 and G92 take the line's axis words for themselves; so do G43.1 and G43.2 when
 // no motion code shares its line (with one, both use them).
 bool Interpreter::Impl::axes_belong_elsewhere() const {
-  return axes_belong_to_non_modal() ||
-         (block_.g_code(GGroup::tool_length) == 431 && block_.g_code(GGroup::motion) < 0);
+  return axes_belong_to_non_modal() || ((block_.g_code(GGroup::tool_length) == 431 ||
+                                         block_.g_code(GGroup::tool_length) == 432) &&
+                                        block_.g_code(GGroup::motion) < 0);
 }
 
 bool Interpreter::Impl::axes_belong_to_non_modal() const {
@@ -121,7 +122,8 @@ void Interpreter::Impl::check_word_users(int motion) const {
   require('d', css || b.g_code(GGroup::cutter_comp) > 400,
           "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
   require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
-  require('h', b.g_code(GGroup::tool_length) == 430, "H word with no G43 or G76 to use it");
+  require('h', b.g_code(GGroup::tool_length) == 430 || b.g_code(GGroup::tool_length) == 432,
+          "H word with no G43 or G76 to use it");
   require('i', arc || bezier || g10 || motion == 870 || motion == 331,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
   require('j', arc || bezier || g10 || motion == 870,

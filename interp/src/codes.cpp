@@ -32,7 +32,7 @@ constexpr std::array kGCodes{
     GEntry{400, GGroup::cutter_comp, true},   GEntry{410, GGroup::cutter_comp, true},
     GEntry{411, GGroup::cutter_comp, true},   GEntry{420, GGroup::cutter_comp, true},
     GEntry{421, GGroup::cutter_comp, true},   GEntry{430, GGroup::tool_length, true},
-    GEntry{431, GGroup::tool_length, true},   GEntry{432, GGroup::tool_length, false},
+    GEntry{431, GGroup::tool_length, true},   GEntry{432, GGroup::tool_length, true},
     GEntry{490, GGroup::tool_length, true},   GEntry{520, GGroup::non_modal, true},
     GEntry{530, GGroup::non_modal, true},     GEntry{540, GGroup::coord_system, true},
     GEntry{550, GGroup::coord_system, true},  GEntry{560, GGroup::coord_system, true},

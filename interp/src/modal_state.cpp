@@ -150,11 +150,11 @@ void Interpreter::Impl::restore_modes(const SavedModalState& saved) {
                                                                : 420);
   }
   if (modal_.tool_length_code != m.tool_length_code) {
-    if (m.tool_length_code != 431) {
+    if (m.tool_length_code == 430 || m.tool_length_code == 490) {
       apply_tool_length(m.tool_length_code);  // G43: the tool in the spindle, as rs274
     } else {
-      // rs274 restores G43.1 as G43 (the table's offset of the tool in the spindle); cncd
-      // restores the offsets G43.1 gave.
+      // rs274 restores G43.1 and G43.2 as G43 (the table's offset of the tool in the
+      // spindle); cncd restores the offsets they gave.
       for (std::size_t axis = 0; axis < kAxes; ++axis)
         pos_[axis] += tool_offset_[axis] - saved.tool_offset[axis];
       tool_offset_ = saved.tool_offset;
@@ -163,7 +163,7 @@ void Interpreter::Impl::restore_modes(const SavedModalState& saved) {
         tool_offset_machine_[a] =
             is_linear_axis(axis) ? to_machine_units(tool_offset_[a]) : tool_offset_[a];
       }
-      modal_.tool_length_code = 431;
+      modal_.tool_length_code = m.tool_length_code;
       emit(UseToolLengthOffset{tool_offset_});
     }
   }

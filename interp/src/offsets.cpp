@@ -149,6 +149,31 @@ void Interpreter::Impl::apply_tool_length(int code) {
       }
       if (entry != nullptr) offset = table_offset(*entry);
     }
+  } else if (code == 432) {
+    // G43.2 adds a table entry's offsets (a wear entry, T10000 + n as LinuxCNC's lathe
+    // configurations keep them) or the line's axis words to the offsets in force.
+    bool axes = false;
+    for (int axis = 0; axis < kAxes; ++axis)
+      axes = axes || block_.has(kAxisLetters[axis]);
+    if (block_.has('h') && axes) fail("G43.2: Can not have both H and axis words");
+    if (!block_.has('h') && !axes) fail("G43.2: No axes specified and H word missing");
+    offset = tool_offset_;
+    Pose more{};
+    if (axes) {
+      for (int axis = 0; axis < kAxes; ++axis) {
+        const char letter = kAxisLetters[axis];
+        if (block_.has(letter)) more[static_cast<std::size_t>(axis)] = block_.get(letter);
+      }
+    } else if (const int tool = to_int(block_.get('h')); tool != 0) {
+      const ToolEntry* entry = tools_.find(tool);
+      if (entry == nullptr && !options_.tool_table.empty()) {
+        fail("Requested tool " + std::to_string(tool) + " not found in the tool table",
+             block_.col('h'));
+      }
+      if (entry != nullptr) more = table_offset(*entry);
+    }
+    for (std::size_t axis = 0; axis < kAxes; ++axis)
+      offset[axis] += more[axis];
   } else if (code == 431) {
     // G43.1 replaces the offsets of the axes it names and keeps the others.
     offset = tool_offset_;

@@ -86,6 +86,25 @@ TEST(ModalState, G43Point1ComesBackWithItsOffsets) {
             "0.0000)\n");
 }
 
+// The same for G43.2: the offsets it added, not the tool's alone.
+TEST(ModalState, G43Point2ComesBackWithTheOffsetsItAdded) {
+  EXPECT_EQ(restored("G43.1 Z2\nG43.2 Z0.5 X0.25\nM70\nG49\nM72 (restore)\n(done)\nM2\n"),
+            "USE_TOOL_LENGTH_OFFSET(0.2500 0.0000 2.5000, 0.0000 0.0000 0.0000, 0.0000 0.0000 "
+            "0.0000)\n");
+}
+
+// G43.2 with axis words adds them to the offsets in force. The rs274 of Debian 12 (LinuxCNC
+// 2.9.0~pre1) refuses that form with "Requested tool -1 not found in the tool table", a defect
+// LinuxCNC fixed later in 2.9 (it reads the missing H word as tool -1).
+TEST(ModalState, G43Point2AddsTheLinesAxisWords) {
+  const Outcome out = run("G43.1 Z2\nG43.2 Z0.5 X0.25\nG43.2 Z-0.1\nG0 X1 Z1\nM2\n");
+  EXPECT_EQ(out.error, "");
+  EXPECT_NE(out.canon.find("USE_TOOL_LENGTH_OFFSET(0.2500 0.0000 2.4000, "), std::string::npos)
+      << out.canon;
+  EXPECT_NE(out.canon.find("STRAIGHT_TRAVERSE(1.0000, 0.0000, 1.0000, "), std::string::npos)
+      << out.canon;
+}
+
 // rs274 turns nothing off while some saved coolant was on: M7 saved, M8 then, both stay on.
 TEST(ModalState, CoolantThatWasOffIsTurnedOff) {
   EXPECT_EQ(restored("M7\nM70\nM8\nM72 (restore)\n(done)\nM2\n"),
