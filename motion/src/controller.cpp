@@ -387,7 +387,7 @@ std::string MotionController::jog_start(int axis, double velocity_per_s) {
     return problem;
   Command command;
   command.kind = Command::Kind::jog_start;
-  command.axis = axis;
+  set_jog_target(command, axis);
   command.velocity = velocity_per_s;
   impl_->send(command);
   return "";
@@ -405,7 +405,7 @@ std::string MotionController::jog_increment(int axis, double distance, double sp
   if (status.motion == MotionState::jogging) return "the machine is jogging";
   Command command;
   command.kind = Command::Kind::jog_increment;
-  command.axis = axis;
+  set_jog_target(command, axis);
   command.distance = distance;
   command.velocity = speed_per_s;
   impl_->send(command);
@@ -415,7 +415,7 @@ std::string MotionController::jog_increment(int axis, double distance, double sp
 void MotionController::jog_stop(int axis) {
   Command command;
   command.kind = Command::Kind::jog_stop;
-  command.axis = axis;
+  set_jog_target(command, axis);
   impl_->send(command);
 }
 

@@ -12,10 +12,11 @@ bool ServoLoop::axis_homed(int axis) const noexcept {
 }
 
 void ServoLoop::apply_jog(const Command& command) noexcept {
+  Jog& jog = command.joint ? joint_jog_ : jog_;
   if (command.kind == Command::Kind::jog_stop) {
-    jog_.stop(command.axis);
+    jog.stop(command.axis);
     // A stop holds the MPG too: its target is forgotten, not resumed next period.
-    if (command.axis == mpg_.axis) mpg_.drop = true;
+    if (!command.joint && command.axis == mpg_.axis) mpg_.drop = true;
     return;
   }
   const char* refusal = nullptr;
@@ -25,8 +26,14 @@ void ServoLoop::apply_jog(const Command& command) noexcept {
     refusal = "the machine is moving";
   } else if (status_.panel.mpg_jogging) {
     refusal = "the panel's MPG is jogging";
+  } else if (command.joint) {
+    refusal = joint_jog_refusal(command);
   } else if (command.axis < 0 || command.axis >= kAxes) {
     refusal = "the machine has no such axis";
+  } else if (joint_jog_.active()) {
+    refusal = "a joint is jogging: axes jog once it rests";
+  } else if (axis_joints_apart(command.axis)) {
+    refusal = kJointsApartForJog;
   } else {
     sync_axes_from_joints();  // a jog starts from where the axis's joints stand
     const bool homed = axis_homed(command.axis);
@@ -43,7 +50,34 @@ void ServoLoop::apply_jog(const Command& command) noexcept {
   status_.motion = MotionState::jogging;
 }
 
+bool ServoLoop::axis_joints_apart(int axis) const noexcept {
+  return joints_apart_from_axis(*kins_, joints_.command, joint_count_, axis);
+}
+
+const char* ServoLoop::joint_jog_refusal(const Command& command) noexcept {
+  const int joint = command.axis;
+  if (joint < 0 || joint >= joint_count_) return "the machine has no such joint";
+  if (jog_.active()) return "an axis is jogging: joints jog once it rests";
+  const auto k = static_cast<std::size_t>(joint);
+  const bool homed = joints_.homed[k];
+  // A homed joint moves with its axis: alone it would leave its axis (a gantry's other joint,
+  // corexy's other axis) where the axes' soft limits no longer hold.
+  if (homed && !homed_joint_may_jog(*kins_, joint)) return kHomedJointMovesWithAxis;
+  const double position = joints_.command[k];
+  return command.kind == Command::Kind::jog_start
+             ? joint_jog_.start(joint, position, command.velocity, homed)
+             : joint_jog_.increment(joint, position, command.distance, command.velocity, homed);
+}
+
 void ServoLoop::advance_jog() noexcept {
+  if (joint_jog_.active()) {
+    // Joint mode: the joints move, the axes are where the forward kinematics put them.
+    joint_jog_.update(joints_.command, period_s_);
+    sync_axes_from_joints();
+    status_.velocity = joint_jog_.speed();
+    status_.motion = joint_jog_.active() ? MotionState::jogging : MotionState::idle;
+    return;
+  }
   // The axes that move this period (including the one that comes to rest in it).
   const std::uint32_t moving = jog_.active_mask();
   jog_.update(axis_pose_, period_s_);

@@ -54,6 +54,7 @@ ServoLoop::ServoLoop(const config::MachineConfig& config, std::vector<DriverBind
       path_(config, period_s_),
       homing_(config, period_s_, home_switch_joints(drivers_)),
       jog_(config),
+      joint_jog_(config, Jog::Space::joints),
       panel_(config.panel, period_s_, axes_present(config)),
       checks_(config, joint_count_, joint_drivers(drivers_),
               history_depth(drivers_, config.servo_period_ns)) {
@@ -145,6 +146,7 @@ void ServoLoop::stop_now(MachineState next) noexcept {
   path_.flush();
   homing_.stop_now();
   jog_.halt();
+  joint_jog_.halt();
   // VOLATILE_HOME joints lose their home whenever the drives turn off.
   for (int j = 0; j < joint_count_; ++j) {
     if (config_.joints[static_cast<std::size_t>(j)].volatile_home)
@@ -192,6 +194,7 @@ void ServoLoop::apply(const Command& command) noexcept {
       path_.abort();
       homing_.abort();
       jog_.stop_all();
+      joint_jog_.stop_all();
       mpg_.drop = true;
       // The spindle, coolant and outputs stop at once, not when the path has come to rest.
       io_.stop_all();
@@ -248,7 +251,7 @@ void ServoLoop::apply(const Command& command) noexcept {
 void ServoLoop::start_homing(std::uint32_t mask) noexcept {
   if (status_.machine != MachineState::on) {
     warn(RtEvent::Code::home_ignored_not_on);
-  } else if (path_.pending() || homing_.active() || jog_.active()) {
+  } else if (path_.pending() || homing_.active() || jog_.active() || joint_jog_.active()) {
     warn(RtEvent::Code::home_ignored_moving);
   } else if (!homing_.start(mask, joints_)) {
     latch_fault(homing_.fault());
@@ -381,7 +384,7 @@ void ServoLoop::cycle(std::int64_t wake_error_ns) noexcept {
   if (status_.machine == MachineState::on) {
     if (homing_.active()) {
       advance_homing();
-    } else if (jog_.active()) {
+    } else if (jog_.active() || joint_jog_.active()) {
       advance_jog();
     } else {
       watch_probe();

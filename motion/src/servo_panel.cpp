@@ -23,7 +23,8 @@ void ServoLoop::advance_panel() noexcept {
   // takes the wheel again, from where the axis then stands.
   const bool allowed = status_.machine == MachineState::on && !homing_.active() &&
                        !path_.pending() && panel_.mpg_enabled() && axis >= 0 && !mpg_.drop &&
-                       (jog_.active_mask() & ~own) == 0 && (mpg_.axis < 0 || mpg_.axis == axis) &&
+                       !axis_joints_apart(axis) && (jog_.active_mask() & ~own) == 0 &&
+                       !joint_jog_.active() && (mpg_.axis < 0 || mpg_.axis == axis) &&
                        (mpg_.moving < 0 || mpg_.moving == mpg_.axis);
   mpg_.drop = false;
   if (!allowed) {

@@ -15,13 +15,7 @@ using motion::Command;
 using motion::MotionState;
 
 void jog(VirtualMachine& m, Command::Kind kind, int axis, double velocity, double distance = 0) {
-  Command c;
-  c.kind = kind;
-  c.axis = axis;
-  c.velocity = velocity;
-  c.distance = distance;
-  ASSERT_TRUE(m.loop().commands().push(c));
-  m.cycles(1);
+  send_jog(m, kind, axis, velocity, distance);
 }
 
 // Peak speed and acceleration of `axis` over the recorded trajectory.
@@ -36,14 +30,6 @@ void peaks(const VirtualMachine& m, int axis, double& v_peak, double& a_peak) {
     if (i >= 2)
       a_peak = std::max(a_peak, std::abs(t[i][k] - 2 * t[i - 1][k] + t[i - 2][k]) / (dt * dt));
   }
-}
-
-std::string drain_events(VirtualMachine& m) {
-  std::string text;
-  motion::Event e;
-  while (m.loop().events().pop(e))
-    text += std::string(e.text) + "\n";
-  return text;
 }
 
 TEST(Jog, ContinuousJogKeepsTheLimitsAndStopsUnderControl) {

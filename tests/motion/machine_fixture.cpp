@@ -158,6 +158,26 @@ Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start) {
   return p;
 }
 
+void send_jog(VirtualMachine& m, motion::Command::Kind kind, int index, double velocity,
+              double distance, bool joint) {
+  motion::Command c;
+  c.kind = kind;
+  c.joint = joint;
+  c.axis = index;
+  c.velocity = velocity;
+  c.distance = distance;
+  ASSERT_TRUE(m.loop().commands().push(c));
+  m.cycles(1);
+}
+
+std::string drain_events(VirtualMachine& m) {
+  std::string text;
+  motion::Event e;
+  while (m.loop().events().pop(e))
+    text += std::string(e.text) + "\n";
+  return text;
+}
+
 Peaks joint_peaks(const VirtualMachine& m) {
   Peaks p;
   for (std::size_t j = 0; j < m.config().joints.size(); ++j) {

@@ -2,6 +2,7 @@
 // recorded, for the motion tests.
 #pragma once
 
+#include <string>
 #include <memory>
 #include <vector>
 
@@ -137,6 +138,11 @@ struct Peaks {
 Peaks peaks(const VirtualMachine& m, const motion::AxisPose& start);
 // The same for every joint against its [JOINT_n] limits, from the recorded motor commands.
 Peaks joint_peaks(const VirtualMachine& m);
+// Sends a jog command (of joint `index` when `joint`) and runs one period.
+void send_jog(VirtualMachine& m, motion::Command::Kind kind, int index, double velocity,
+              double distance = 0, bool joint = false);
+// The servo loop's events since the last call, one line of words each.
+std::string drain_events(VirtualMachine& m);
 // Every axis stayed within its velocity and acceleration limits (and 0.1 % for rounding) on
 // the way from `start` through the recorded trajectory.
 void expect_within_limits(const VirtualMachine& m, const motion::AxisPose& start);

@@ -17,14 +17,6 @@ using motion::MotionState;
 
 constexpr auto kPosition = PanelConfig::MpgMode::position;
 
-std::string drain_events(VirtualMachine& m) {
-  std::string text;
-  motion::Event e;
-  while (m.loop().events().pop(e))
-    text += std::string(e.text) + "\n";
-  return text;
-}
-
 void send(VirtualMachine& m, Command::Kind kind, int axis = 0, double velocity = 0,
           std::uint32_t id = 0) {
   Command c;

@@ -95,9 +95,10 @@ class MotionController final : public MoveQueue {
 
   // Jogs of one axis (config::axis_index), run by the servo thread within the axis's
   // MAX_VELOCITY (speeds above it are capped) and MAX_ACCELERATION; on a homed axis up to its
-  // soft limit. Each returns "" once the servo thread has taken it, or why it is refused (the
-  // machine is not on, path motion or homing under way, no such axis, at the soft limit).
-  // Abort stops jogs under control; estop and off stop them at once.
+  // soft limit. `axis` kJointJogBase + n jogs joint n alone (joint mode) within its [JOINT_n]
+  // limits, refused on a homed joint that moves with an axis. Each returns "" once the servo thread
+  // has taken it, or why it is refused (the machine is not on, path motion or homing under way, no
+  // such axis, at the soft limit). Abort stops jogs under control; estop and off stop them at once.
   std::string jog_start(int axis, double velocity_per_s);  // sign = direction; until jog_stop
   std::string jog_increment(int axis, double distance, double speed_per_s);
   void jog_stop(int axis);  // controlled stop

@@ -1,6 +1,8 @@
 // Jogging: continuous and incremental moves of single axes, each a trapezoid within the axis's
 // MAX_VELOCITY and MAX_ACCELERATION, and those of the joints it moves, that ends at the soft
-// limit on a homed axis. Axes that share a joint (corexy's X and Y) jog one at a time.
+// limit on a homed axis. Axes that share a joint (corexy's X and Y) jog one at a time. The same
+// moves of single joints (joint mode, as LinuxCNC jogs a joint before homing): within the
+// joint's own [JOINT_n] limits, the axes following by the forward kinematics.
 #pragma once
 
 #include <array>
@@ -16,10 +18,39 @@ namespace cncd::motion {
 // A homed axis may not jog at or beyond its soft limit in that direction. Any thread.
 CNCD_RT const char* jog_refusal(const config::MachineConfig& config, int axis, double position,
                                 double direction, bool homed) noexcept;
+// The same for a jog of joint `joint` in joint mode, against its [JOINT_n] soft limits.
+CNCD_RT const char* joint_jog_refusal(const config::MachineConfig& config, int joint,
+                                      double position, double direction, bool homed) noexcept;
+
+class Kinematics;
+
+// Whether a joint-mode jog of homed joint `joint` keeps every axis within its soft limits: the
+// joint is its axis's only joint, or no axis moves with it (an extra joint). Any thread.
+CNCD_RT bool homed_joint_may_jog(const Kinematics& kins, int joint) noexcept;
+// Whether a joint of `axis` stands apart from where the axis, at the joints' forward position,
+// puts it (a gantry joint jogged alone): a jog of the axis would make it jump there at once.
+CNCD_RT bool joints_apart_from_axis(const Kinematics& kins, const JointArray& joints,
+                                    int joint_count, int axis) noexcept;
+// Why a homed joint may not jog alone.
+inline constexpr const char* kHomedJointMovesWithAxis =
+    "the joint is homed and moves with its axis: jog the axis";
+
+inline constexpr const char* kJointsApartForJog =
+    "a joint of the axis stands apart from it (jogged alone): home the axis, or jog that joint "
+    "back to its twin";
+
+// Jog targets as the controller and its clients number them: an axis index
+// (config::axis_index), or kJointJogBase + a joint's number for a joint-mode jog.
+inline constexpr int kJointJogBase = kAxes;
+inline constexpr int kJogTargets = kAxes + kJoints;
 
 class Jog {
  public:
-  explicit Jog(const config::MachineConfig& config);
+  // What the jogs move: the axes (indexes as config::axis_index) or the joints.
+  enum class Space : std::uint8_t { axes, joints };
+  static constexpr int kSlots = kJoints > kAxes ? kJoints : kAxes;
+
+  explicit Jog(const config::MachineConfig& config, Space space = Space::axes);
 
   // RT (servo thread, as every method). Continuous jog of `axis` from `position` at `velocity`
   // units/s (its sign is the direction, its size capped at MAX_VELOCITY), on a homed axis up
@@ -44,8 +75,12 @@ class Jog {
   CNCD_RT bool active() const noexcept { return active_mask() != 0; }
   // Bit i set: axis i is jogging.
   CNCD_RT std::uint32_t active_mask() const noexcept;
-  // RT. Advances every jogging axis by `dt` seconds and writes its position into `pose`.
-  CNCD_RT void update(AxisPose& pose, double dt) noexcept;
+  // RT. Advances every jogging axis (joint) by `dt` seconds and writes its position into
+  // `pose` (`joints`).
+  CNCD_RT void update(AxisPose& pose, double dt) noexcept { update(pose.data(), kAxes, dt); }
+  CNCD_RT void update(JointArray& joints, double dt) noexcept {
+    update(joints.data(), kJoints, dt);
+  }
   // Speed along the combined direction of the jogging axes, units/s.
   CNCD_RT double speed() const noexcept;
 
@@ -64,16 +99,24 @@ class Jog {
     bool pending_homed = false;
   };
   CNCD_RT void begin(int axis, double position, double target, double speed) noexcept;
+  CNCD_RT void update(double* positions, int count, double dt) noexcept;
+  CNCD_RT const char* refusal(int index, double position, double direction,
+                              bool homed) const noexcept;
+  // Soft limits of slot `index` (an axis's or a joint's).
+  CNCD_RT double min_limit(int index) const noexcept;
+  CNCD_RT double max_limit(int index) const noexcept;
   // Why `axis` may not start now while others jog, or nullptr.
   CNCD_RT const char* coupling_refusal(int axis) const noexcept;
 
   const config::MachineConfig& config_;
-  std::uint32_t coupled_ = 0;  // Kinematics::coupled_axes()
-  // Per axis: the speed and acceleration its jogs keep within, the tightest of the axis's own
-  // and those of the joints it moves.
-  std::array<double, kAxes> max_velocity_{};
-  std::array<double, kAxes> max_acceleration_{};
-  std::array<AxisJog, kAxes> axes_{};
+  Space space_;
+  int count_;                  // kAxes or the machine's joints
+  std::uint32_t coupled_ = 0;  // Kinematics::coupled_axes() (none among joints)
+  // Per slot: the speed and acceleration its jogs keep within; for an axis the tightest of the
+  // axis's own and those of the joints it moves.
+  std::array<double, kSlots> max_velocity_{};
+  std::array<double, kSlots> max_acceleration_{};
+  std::array<AxisJog, kSlots> axes_{};
 };
 
 }  // namespace cncd::motion

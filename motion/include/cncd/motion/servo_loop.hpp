@@ -50,11 +50,12 @@ struct Command {
   };
   Kind kind = Kind::estop;
   std::uint32_t joint_mask = 0;
-  int axis = 0;             // jogs: axis index
+  int axis = 0;             // jogs: axis index, or joint index when `joint`
   double velocity = 0;      // jog_start: units/s, signed; jog_increment: speed
   double distance = 0;      // jog_increment: units, signed
   std::uint32_t id = 0;     // release, end_wait, panel_lights, io_hold
   std::uint64_t since = 0;  // end_wait
+  bool joint = false;       // jogs: of a joint in joint mode
 };
 
 // Something the servo thread tells the non-RT side (which logs it), as that side reads it.
@@ -143,6 +144,11 @@ class ServoLoop {
   CNCD_RT int joint_apart() const noexcept;
   CNCD_RT void advance_homing() noexcept;
   CNCD_RT void apply_jog(const Command& command) noexcept;  // servo_jog.cpp
+  // Starts a joint-mode jog, or says why not.
+  CNCD_RT const char* joint_jog_refusal(const Command& command) noexcept;
+  // Whether a joint of `axis` stands apart from where the axis puts it (after joint jogs of
+  // one of a gantry's joints): the axis may not jog then.
+  CNCD_RT bool axis_joints_apart(int axis) const noexcept;
   CNCD_RT void advance_jog() noexcept;
   CNCD_RT bool axis_homed(int axis) const noexcept;
   // The panel (servo_panel.cpp): inputs read into status_.panel, then the MPG's counts turned
@@ -193,6 +199,7 @@ class ServoLoop {
   PathExecutor path_;
   Homing homing_;
   Jog jog_;
+  Jog joint_jog_;  // joint mode: single joints, the axes following them
   // Servo cycles counted from 1 (drivers::JointCommand::cycle).
   std::uint64_t cycle_ = 0;
   Panel panel_;
