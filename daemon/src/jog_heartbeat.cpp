@@ -4,6 +4,14 @@
 
 namespace cncd::daemon {
 
+std::string jog_target_name(int target) {
+  if (target >= motion::kJointJogBase)
+    return fmt::format("joint {}", target - motion::kJointJogBase);
+  if (target >= 0 && target < config::kMaxAxes)
+    return std::string(1, config::kAxisLetters[static_cast<std::size_t>(target)]);
+  return "?";
+}
+
 void JogHeartbeats::started(int axis, std::uint64_t connection, double heartbeat_s, std::string who,
                             Clock::time_point now) {
   Watch& watch = watches_.at(static_cast<std::size_t>(axis));
@@ -70,8 +78,7 @@ void JogHeartbeats::stop(int axis, const std::string& why) {
   task_.jog_stop(axis);
   if (jogging)
     events_.add("warning", "jog",
-                fmt::format("{} jog of {} stopped: {}",
-                            config::kAxisLetters[static_cast<std::size_t>(axis)], watch.who, why));
+                fmt::format("{} jog of {} stopped: {}", jog_target_name(axis), watch.who, why));
   watch = Watch{};
 }
 

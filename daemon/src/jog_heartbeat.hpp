@@ -1,7 +1,8 @@
 // Continuous jogs kept alive by their client: a jog.start with "heartbeat_s" runs only while
 // jog.heartbeat keeps coming from the connection that started it, and stops (as jog.stop does,
 // under control) when it stops coming or that connection closes. A front end whose page or
-// network dies mid-jog thus cannot leave an axis running. Loop thread only.
+// network dies mid-jog thus cannot leave an axis running. Loop thread only. Jogs are counted
+// by target: an axis index, or motion::kJointJogBase + a joint's number (joint mode).
 #pragma once
 
 #include <array>
@@ -11,10 +12,14 @@
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
+#include "cncd/motion/jog.hpp"
 #include "event_log.hpp"
 #include "task.hpp"
 
 namespace cncd::daemon {
+
+// A jog target as the operator reads it: "X", "joint 2".
+std::string jog_target_name(int target);
 
 class JogHeartbeats {
  public:
@@ -51,7 +56,7 @@ class JogHeartbeats {
 
   Task& task_;
   EventLog& events_;
-  std::array<Watch, config::kMaxAxes> watches_{};
+  std::array<Watch, motion::kJogTargets> watches_{};
 };
 
 }  // namespace cncd::daemon

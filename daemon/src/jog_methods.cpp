@@ -8,8 +8,24 @@ using nlohmann::json;
 
 namespace {
 
-// The "axis" parameter: one of the machine's axis letters.
-int axis_param(const json& params, const config::MachineConfig& config) {
+// The "axis" parameter: one of the machine's axis letters; or "joint", one of its joints
+// (motion::kJointJogBase + its number). `required`: one of the two must be there.
+int axis_param(const json& params, const config::MachineConfig& config, bool required = true) {
+  if (params.contains("joint")) {
+    if (params.contains("axis"))
+      throw RpcError(kInvalidParams, "give \"axis\" or \"joint\", not both");
+    const int joint = params["joint"].get<int>();
+    if (joint < 0 || static_cast<std::size_t>(joint) >= config.joints.size()) {
+      throw RpcError(kInvalidParams, "parameter \"joint\": the machine has no joint " +
+                                         std::to_string(joint) + " (it has " +
+                                         std::to_string(config.joints.size()) + ")");
+    }
+    return motion::kJointJogBase + joint;
+  }
+  if (!params.contains("axis")) {
+    if (!required) return -1;
+    throw RpcError(kInvalidParams, "parameter \"axis\" or \"joint\" is required");
+  }
   const auto& name = params["axis"].get_ref<const std::string&>();
   const int axis =
       name.size() == 1
@@ -50,19 +66,27 @@ void register_jog_methods(RpcDispatcher& dispatcher, Task& task,
     return ok();
   });
   dispatcher.add("jog.heartbeat", [&config, &heartbeats](const json& params, Session& session) {
-    const int axis = params.contains("axis") ? axis_param(params, config) : -1;
+    const int axis = axis_param(params, config, false);
     json axes = json::array();
-    for (const int kept : heartbeats.beat(session.connection, axis, JogHeartbeats::Clock::now()))
-      axes.push_back(std::string(1, config::kAxisLetters[static_cast<std::size_t>(kept)]));
-    return json{{"ok", true}, {"axes", axes}};
+    json joints = json::array();
+    for (const int kept : heartbeats.beat(session.connection, axis, JogHeartbeats::Clock::now())) {
+      if (kept >= motion::kJointJogBase)
+        joints.push_back(kept - motion::kJointJogBase);
+      else
+        axes.push_back(jog_target_name(kept));
+    }
+    return json{{"ok", true}, {"axes", axes}, {"joints", joints}};
   });
   dispatcher.add("jog.increment", [&task, &config, &heartbeats](const json& params) {
     const int axis = axis_param(params, config);
     const double distance = params["distance"].get<double>();
     if (distance == 0) throw RpcError(kInvalidParams, "parameter \"distance\" must not be 0");
-    // Without a velocity, the axis's MAX_VELOCITY.
-    const double velocity =
-        params.value("velocity", config.axes[static_cast<std::size_t>(axis)].max_velocity);
+    // Without a velocity, the axis's (joint's) MAX_VELOCITY.
+    const double velocity = params.value(
+        "velocity",
+        axis >= motion::kJointJogBase
+            ? config.joints[static_cast<std::size_t>(axis - motion::kJointJogBase)].max_velocity
+            : config.axes[static_cast<std::size_t>(axis)].max_velocity);
     if (velocity <= 0) throw RpcError(kInvalidParams, "parameter \"velocity\" must be above 0");
     task.jog_increment(axis, distance, velocity);
     heartbeats.forget(axis);

@@ -18,7 +18,12 @@ constexpr double kMaxTool = 99999;
 constexpr ParamSpec kFields{
     .name = "fields", .type = string_list, .note = "top-level status fields; all if empty"};
 constexpr ParamSpec kAxis{
-    .name = "axis", .type = string, .required = true, .note = "an axis letter such as \"X\""};
+    .name = "axis", .type = string, .note = "an axis letter such as \"X\"; or \"joint\" instead"};
+constexpr ParamSpec kJoint{.name = "joint",
+                           .type = integer,
+                           .min = 0,
+                           .max = kMaxJoint,
+                           .note = "a joint number: jogs that joint alone (joint mode)"};
 
 constexpr ParamSpec required(std::string_view name, ParamType type, std::string_view note) {
   return {.name = name, .type = type, .required = true, .note = note};
@@ -67,19 +72,21 @@ const std::vector<MethodSpec>& method_table() {
        {bounded("joints", integer_list, 0, kMaxJoint, "joint numbers")}},
       {"jog.start",
        Access::control,
-       {kAxis, required("velocity", number, "machine units per second, signed, not 0"),
+       {kAxis, kJoint, required("velocity", number, "machine units per second, signed, not 0"),
         bounded("heartbeat_s", number, 0.05, 5,
                 "seconds: the jog stops when no jog.heartbeat came for that long")}},
-      {"jog.stop", Access::control, {kAxis}},
+      {"jog.stop", Access::control, {kAxis, kJoint}},
       {"jog.heartbeat",
        Access::control,
        {{.name = "axis",
          .type = string,
-         .note = "an axis letter; all of this connection's jogs if left out"}},
+         .note = "an axis letter; all of this connection's jogs if left out"},
+        kJoint},
        /*recorded=*/false},
       {"jog.increment",
        Access::control,
        {kAxis,
+        kJoint,
         required("distance", number, "machine units, signed, not 0"),
         {.name = "velocity", .type = number, .note = "machine units per second, above 0"}}},
       {"program.open", Access::control, {required("path", string, "the program file")}},

@@ -132,7 +132,12 @@ json axis_letter(int axis) {
 
 json manual_holder_object(const std::optional<ManualHolder>& holder) {
   if (!holder) return nullptr;
-  return {{"by", holder->by}, {"panel", holder->panel}, {"axis", axis_letter(holder->axis)}};
+  // A joint-mode jog's target counts from config::kMaxAxes (motion::kJointJogBase).
+  const bool joint = holder->axis >= config::kMaxAxes;
+  return {{"by", holder->by},
+          {"panel", holder->panel},
+          {"axis", axis_letter(holder->axis)},
+          {"joint", joint ? json(holder->axis - config::kMaxAxes) : json(nullptr)}};
 }
 
 // {"KEY": true, ...} of the panel's inputs or lights.

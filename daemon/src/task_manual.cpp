@@ -53,7 +53,8 @@ void Task::client_may_jog() const {
   const auto holder = manual_holder(status);
   if (!holder) return;
   const std::string axis =
-      holder->axis >= 0 && holder->axis < config::kPanelAxes
+      holder->axis >= config::kMaxAxes ? " joint " + std::to_string(holder->axis - config::kMaxAxes)
+      : holder->axis >= 0
           ? " " + std::string(1, config::kAxisLetters[static_cast<std::size_t>(holder->axis)])
           : std::string();
   if (status.panel.mpg_jogging) {

@@ -91,7 +91,7 @@ TEST_F(PanelTest, AClientJogWhileTheMpgMovesIsRefusedNamingTheMpg) {
   const json moving =
       wait_until([](const json& st) { return st["panel"]["mpg"]["jogging"] == true; });
   EXPECT_EQ(moving["manual_holder"],
-            json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}}));
+            json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}, {"joint", nullptr}}));
   const json answer = call("jog.start", {{"axis", "Y"}, {"velocity", 5}});
   ASSERT_EQ(error_code(answer), 1004) << answer.dump();
   EXPECT_NE(answer["error"]["message"].get<std::string>().find("the panel's MPG"),
@@ -148,8 +148,10 @@ TEST_F(PanelTest, AJogButtonWhileAClientJogsIsRefusedNamingTheClient) {
   // And the other way round: the panel's button jogs, a client is refused naming it.
   ASSERT_NO_FATAL_FAILURE(level("JOG_X_PLUS", true));
   const json jogging = wait_until([](const json& st) { return st["motion"] == "jogging"; });
-  EXPECT_EQ(jogging["manual_holder"],
-            json({{"by", "the panel's JOG_X_PLUS button"}, {"panel", true}, {"axis", "X"}}));
+  EXPECT_EQ(jogging["manual_holder"], json({{"by", "the panel's JOG_X_PLUS button"},
+                                            {"panel", true},
+                                            {"axis", "X"},
+                                            {"joint", nullptr}}));
   const json answer = call("jog.start", {{"axis", "Y"}, {"velocity", 2}});
   ASSERT_EQ(error_code(answer), 1004) << answer.dump();
   EXPECT_NE(answer["error"]["message"].get<std::string>().find("the panel's JOG_X_PLUS"),

@@ -49,6 +49,8 @@ void usage(std::FILE* out) {
       "  jog AXIS --increment DIST [--velocity V]\n"
       "                      move AXIS by DIST and wait until it is there\n"
       "  jog AXIS stop       stop a jog under control and wait until at rest\n"
+      "                      (AXIS J0, J1, ...: that joint alone, as LinuxCNC's joint mode;\n"
+      "                      refused on a homed joint that moves with an axis)\n"
       "  override feed|rapid|spindle PERCENT\n"
       "                      set an override, e.g. 'override feed 80' (100 = as programmed)\n"
       "  tools               list the tool table\n"

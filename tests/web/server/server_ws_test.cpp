@@ -242,7 +242,8 @@ TEST_F(WebPanelTest, ControlIsNotTakenFromTheWebWhileThePanelsMpgJogs) {
   ASSERT_NO_FATAL_FAILURE(sim_set("mpg_counts", 250000));
   wait_until([](const json& s) { return s["panel"]["mpg"]["jogging"] == true; });
   const json seen = otto->call("status.get")["result"]["manual_holder"];
-  EXPECT_EQ(seen, json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}}));
+  EXPECT_EQ(seen,
+            json({{"by", "the panel's MPG"}, {"panel", true}, {"axis", "X"}, {"joint", nullptr}}));
   // cncd-web hears of it within its status interval.
   json refused;
   for (int i = 0; i < 100 && !refused.contains("error"); ++i) {

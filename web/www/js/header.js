@@ -77,7 +77,8 @@ export function setupHeader(ctx) {
     const hand = status.manual_holder;
     const handBox = $('#manual-holder');
     handBox.hidden = !hand || (!hand.panel && ctx.holdsLease());
-    if (hand) setText(handBox, `jogging: ${hand.by}${hand.axis ? ' ' + hand.axis : ''}`);
+    const what = hand?.axis ? ` ${hand.axis}` : hand?.joint != null ? ` joint ${hand.joint}` : '';
+    if (hand) setText(handBox, `jogging: ${hand.by}${what}`);
     const homed = status.homed ?? [];
     $('#home-all').classList.toggle('active', homed.length > 0 && homed.every(Boolean));
   });
