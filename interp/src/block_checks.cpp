@@ -12,9 +12,6 @@ namespace {
 
 // "G41.1 is not supported"; `code` is ten times the number.
 std::string not_supported(char letter, int code) {
-  if (letter == 'G' && code == 760) {
-    return "G76 is not supported: threading cycles are for lathe mode, which cncd does not have";
-  }
   char text[48];
   if (code % 10 != 0) {
     std::snprintf(text, sizeof text, "%c%d.%d is not supported", letter, code / 10, code % 10);
@@ -119,25 +116,28 @@ void Interpreter::Impl::check_word_users(int motion) const {
   const bool orient = b.m_code(MGroup::spindle) == 19;
   const bool bezier = motion == 50 || motion == 51;  // G5, G5.1
   const bool synced = motion == 330 || motion == 331;
+  const bool thread = motion == 760;
   require('d', css || b.g_code(GGroup::cutter_comp) > 400,
           "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
-  require('e', io >= 66, "E word with no G70, G76, M66, M67 or M68 to use it");
-  require('h', b.g_code(GGroup::tool_length) == 430 || b.g_code(GGroup::tool_length) == 432,
+  require('e', io >= 66 || thread, "E word with no G70, G76, M66, M67 or M68 to use it");
+  require('h',
+          b.g_code(GGroup::tool_length) == 430 || b.g_code(GGroup::tool_length) == 432 || thread,
           "H word with no G43 or G76 to use it");
-  require('i', arc || bezier || g10 || motion == 870 || motion == 331,
+  require('i', arc || bezier || g10 || motion == 870 || motion == 331 || thread,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
-  require('j', arc || bezier || g10 || motion == 870,
+  require('j', arc || bezier || g10 || motion == 870 || thread,
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
-  require('k', arc || motion == 870 || synced,
+  require('k', arc || motion == 870 || synced || thread,
           "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
-  require('l', g10 || cycle || io == 66 || b.g_code(GGroup::cutter_comp) > 400 || motion == 52,
+  require('l',
+          g10 || cycle || thread || io == 66 || b.g_code(GGroup::cutter_comp) > 400 || motion == 52,
           "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or "
           "NURBS code");
   const bool p_user = arc || motion == 50 || motion == 52 || g10 || non_modal == 40 ||
                       b.g_code(GGroup::path_control) == 640 || motion == 820 || motion == 860 ||
                       motion == 880 || motion == 890 || motion == 840 || motion == 740 ||
                       (overrides >= 50 && overrides <= 53) || (io >= 62 && io <= 66) || orient ||
-                      user_m;
+                      user_m || thread;
   require('p', p_user,
           "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
           "M63 M64 M65 M66 M98 or user M code to use it");
@@ -149,11 +149,11 @@ void Interpreter::Impl::check_word_users(int motion) const {
   }
   const bool q_user = motion == 50 || g10 || b.g_code(GGroup::path_control) == 640 ||
                       motion == 730 || motion == 830 || b.m_code(MGroup::tool_change) == 61 ||
-                      io >= 66 || orient || user_m;
+                      io >= 66 || orient || user_m || thread;
   require('q', q_user,
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
-  require('r', arc || cycle || g10 || orient, "R word with no g code that uses it");
+  require('r', arc || cycle || g10 || orient || thread, "R word with no g code that uses it");
   if (orient && b.has('r') && (b.get('r') > 360.0 || b.get('r') < 0.0)) {
     fail("R value must be within 0..360 with M19", b.col('r'));
   }
@@ -167,6 +167,7 @@ void Interpreter::Impl::check_spindle_words(int motion) const {
   if (css == 960 && !b.has('s')) {
     fail("S word missing with G96", b.g_column[static_cast<std::size_t>(GGroup::spindle_mode)]);
   }
+  if (motion == 760) check_threading_words();
   if (motion == 330 || motion == 331) {
     if (!b.has('k')) fail("K word missing with g33/g33.1");
     if (b.has('f')) fail("F word used with a g33/g33.1", b.col('f'));

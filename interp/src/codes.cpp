@@ -45,7 +45,7 @@ constexpr std::array kGCodes{
     GEntry{712, GGroup::motion, false},       GEntry{720, GGroup::motion, false},
     GEntry{721, GGroup::motion, false},       GEntry{722, GGroup::motion, false},
     GEntry{730, GGroup::motion, true},        GEntry{740, GGroup::motion, true},
-    GEntry{760, GGroup::motion, false},       GEntry{800, GGroup::motion, true},
+    GEntry{760, GGroup::motion, true},        GEntry{800, GGroup::motion, true},
     GEntry{810, GGroup::motion, true},        GEntry{820, GGroup::motion, true},
     GEntry{830, GGroup::motion, true},        GEntry{840, GGroup::motion, true},
     GEntry{850, GGroup::motion, true},        GEntry{860, GGroup::motion, true},

@@ -159,6 +159,19 @@ struct CycleGeometry {
   std::optional<double> dwell;
 };
 
+// G76 as its words give it (cycle_g76.cpp): the drive line from (x0, z0) to Z z1, the depths
+// as radii.
+struct ThreadingCycle {
+  double x0 = 0, z0 = 0, z1 = 0;
+  double pitch = 0;
+  double i = 0, j = 0, k = 0;
+  double degression = 1;
+  double tan_q = 0;
+  double taper = 0;  // E, along Z
+  bool entry_taper = false, exit_taper = false;
+  int spring_passes = 0;
+};
+
 struct Interpreter::Impl {
   explicit Impl(InterpOptions opts);
 
@@ -233,6 +246,12 @@ struct Interpreter::Impl {
   void do_spindle_synced(int code);
   bool tapping_is_rigid(int code) const;
   void rigid_tap_hole(int code, const CycleGeometry& g, double a, double b, double& current_c);
+
+  // cycle_g76.cpp: the lathe threading cycle.
+  void check_threading_words() const;
+  ThreadingCycle read_threading_cycle() const;
+  void threading_pass(const ThreadingCycle& t, double depth);
+  void do_threading_cycle();
 
   // motion.cpp
   void do_motion();

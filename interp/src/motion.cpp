@@ -155,6 +155,10 @@ void Interpreter::Impl::do_motion() {
     if (axis_words) do_spindle_synced(code);
     return;
   }
+  if (code == 760) {
+    if (axis_words) do_threading_cycle();
+    return;
+  }
   const bool arc_words = block_.has('i') || block_.has('j') || block_.has('k') || block_.has('r');
   if ((code == 20 || code == 30) && comp_.arc_not_allowed &&
       (axis_words || arc_words || explicit_code >= 0)) {

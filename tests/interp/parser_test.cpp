@@ -101,8 +101,7 @@ TEST(Errors, Wording) {
 
 TEST(Errors, UnsupportedFeaturesAreRejected) {
   expect_errors({
-      {"G76 P1 Z-1\nM2\n",
-       "G76 is not supported: threading cycles are for lathe mode, which cncd does not have"},
+      {"G72 Q1\nM2\n", "G72 is not supported"},
   });
 }
 
