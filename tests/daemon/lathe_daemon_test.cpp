@@ -1,5 +1,7 @@
 // The sim lathe (config/examples/sim_lathe.ini): an XZ machine that starts in G8 (radii), and
-// runs examples/lathe_turning.ngc (G7 diameters, G96 turning, G33 threading) to done.
+// runs examples/lathe_turning.ngc (G7 diameters, G96 turning, G33 threading) and a G76 thread
+// to done.
+#include <algorithm>
 #include <string>
 
 #include "machine_fixture.hpp"
@@ -55,6 +57,33 @@ TEST_F(LatheTest, StartsInTheXzPlaneWithRadiiAndRunsTheTurningExample) {
   EXPECT_NEAR(s["position"]["commanded"]["z"].get<double>(), 7.0, 1e-9);
   EXPECT_EQ(s["diameter_mode"], true);
   EXPECT_NEAR(s["work_position"]["commanded"]["x"].get<double>(), 40.0, 1e-9);
+}
+
+// The M12x1.75 G76 of tests/golden/lathe_g76_m12 (its passes on the helix are checked in
+// g76_plan_test.cpp): 14 passes, each in step with the spindle, to done.
+TEST_F(LatheTest, RunsAG76ThreadToDone) {
+  ready_machine();
+  const auto program = dir_.write(
+      "m12.ngc", slurp(std::string(CNCD_SOURCE_DIR) + "/tests/golden/lathe_g76_m12/program.ngc"));
+  result_of(call("program.open", {{"path", program.string()}}));
+  result_of(call("program.run"));
+  int passes = 0;
+  bool synced = false;
+  double deepest = 1e9;
+  const json s = wait_until([&](const json& st) {
+    const bool now = !st["sync"].is_null() && st["sync"]["mode"] == "thread";
+    if (now && !synced) ++passes;
+    synced = now;
+    if (now) deepest = std::min(deepest, st["position"]["commanded"]["x"].get<double>());
+    return st["exec"] == "idle";
+  });
+  EXPECT_EQ(s["program"]["result"], "done") << s["program"].dump();
+  // Status is sampled: a pass lasts a second, the moves between them a fraction of one.
+  EXPECT_GE(passes, 7);
+  EXPECT_LE(passes, 14);
+  EXPECT_NEAR(deepest, 7 - 1 - 1.07, 1e-9);
+  EXPECT_NEAR(s["position"]["commanded"]["x"].get<double>(), 20, 1e-9);
+  EXPECT_NEAR(s["position"]["commanded"]["z"].get<double>(), -20, 1e-9);
 }
 
 }  // namespace
