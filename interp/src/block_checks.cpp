@@ -73,7 +73,8 @@ void Interpreter::Impl::check_block() const {
   }
   // Only G0-G3 may stand without an axis word (a move to where the tool is), and G5.2, whose
   // first line may give only the weight of the start point or the order.
-  if (motion >= 0 && motion != 800 && motion > 30 && motion != 52 && !axis_words) {
+  if (motion >= 0 && motion != 800 && motion > 30 && motion != 52 && !is_g7x_code(motion) &&
+      !axis_words) {
     fail("All axes missing with motion code", motion_column);
   }
   if (axis_words && motion < 0 && !axes_belong_elsewhere() &&
@@ -117,13 +118,15 @@ void Interpreter::Impl::check_word_users(int motion) const {
   const bool bezier = motion == 50 || motion == 51;  // G5, G5.1
   const bool synced = motion == 330 || motion == 331;
   const bool thread = motion == 760;
-  require('d', css || b.g_code(GGroup::cutter_comp) > 400,
+  const bool g70 = motion == 700;
+  const bool roughing = is_g7x_code(motion) && !g70;  // G71, G72 and their .1 and .2
+  require('d', css || b.g_code(GGroup::cutter_comp) > 400 || g70 || roughing,
           "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
-  require('e', io >= 66 || thread, "E word with no G70, G76, M66, M67 or M68 to use it");
+  require('e', io >= 66 || thread || g70, "E word with no G70, G76, M66, M67 or M68 to use it");
   require('h',
           b.g_code(GGroup::tool_length) == 430 || b.g_code(GGroup::tool_length) == 432 || thread,
           "H word with no G43 or G76 to use it");
-  require('i', arc || bezier || g10 || motion == 870 || motion == 331 || thread,
+  require('i', arc || bezier || g10 || motion == 870 || motion == 331 || thread || roughing,
           "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
   require('j', arc || bezier || g10 || motion == 870 || thread,
           "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
@@ -137,7 +140,7 @@ void Interpreter::Impl::check_word_users(int motion) const {
                       b.g_code(GGroup::path_control) == 640 || motion == 820 || motion == 860 ||
                       motion == 880 || motion == 890 || motion == 840 || motion == 740 ||
                       (overrides >= 50 && overrides <= 53) || (io >= 62 && io <= 66) || orient ||
-                      user_m || thread;
+                      user_m || thread || g70;
   require('p', p_user,
           "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 "
           "M63 M64 M65 M66 M98 or user M code to use it");
@@ -149,11 +152,12 @@ void Interpreter::Impl::check_word_users(int motion) const {
   }
   const bool q_user = motion == 50 || g10 || b.g_code(GGroup::path_control) == 640 ||
                       motion == 730 || motion == 830 || b.m_code(MGroup::tool_change) == 61 ||
-                      io >= 66 || orient || user_m || thread;
+                      io >= 66 || orient || user_m || thread || g70 || roughing;
   require('q', q_user,
           "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that "
           "uses it");
-  require('r', arc || cycle || g10 || orient || thread, "R word with no g code that uses it");
+  require('r', arc || cycle || g10 || orient || thread || roughing,
+          "R word with no g code that uses it");
   if (orient && b.has('r') && (b.get('r') > 360.0 || b.get('r') < 0.0)) {
     fail("R value must be within 0..360 with M19", b.col('r'));
   }

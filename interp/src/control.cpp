@@ -149,6 +149,7 @@ void Interpreter::Impl::do_return(bool has_value, double value) {
     sources_.pop_back();
   }
   source().seek(frame.return_offset, frame.return_line);
+  if (frame.g7x) finish_g7x();
 }
 
 // LinuxCNC's wording for O-word label errors: "LINE: what: 'the line as written'".

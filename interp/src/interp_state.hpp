@@ -123,9 +123,14 @@ struct CallFrame {
   std::int64_t sub_offset = 0;
   int sub_line_before = 0;
   SavedModalState saved_modal;  // M70/M73 in this subroutine
+  bool g7x = false;             // a G70-G72 profile: its return runs the cycle
 };
 
 class CanonSink;
+struct G7xRun;  // cycle_g7x.cpp
+namespace g7x {
+struct Move;
+}
 
 inline constexpr int kG5xBase = 5221;  // G54 X; each system takes 20 parameters, R at +9
 inline constexpr int kG92Base = 5211;
@@ -294,6 +299,12 @@ struct Interpreter::Impl {
   void do_canned_cycle(int code);
   void check_cycle_plane_words() const;
   void cycle_body(int code, const CycleGeometry& g, double a, double b, double& current_c);
+  // cycle_g7x.cpp: G70, G71, G72 and their .1 and .2 forms.
+  static bool is_g7x_code(int code);
+  void do_g7x(int code);
+  bool g7x_capture(const CanonCommand& command);  // a move of the profile, kept
+  void finish_g7x();
+  void emit_g7x_move(const G7xRun& run, const g7x::Move& move);
   // control.cpp: O-words.
   void handle_o_word();
   void do_call();
@@ -392,6 +403,7 @@ struct Interpreter::Impl {
   CompState comp_;
   struct Comp;  // cutter_comp.hpp
   SplineState spline_;
+  std::shared_ptr<G7xRun> g7x_;  // a G7x cycle reading its profile
   NumeryxState nx_;
   std::vector<ForFrame> nx_loops_;
   int nx_cycle_distance_ = -1;  // this block's g90/g91 that belongs to the drilling cycle

@@ -83,6 +83,7 @@ void Interpreter::Impl::reset_modal_state() {
 }
 
 void Interpreter::Impl::emit_command(const CanonCommand& command) {
+  if (g7x_ && g7x_capture(command)) return;
   // A command held back behind a compensated move is checked at its own line too;
   // send_command() checks every other one as it goes out.
   if (!comp_.queue.empty() && !all_finite(command.op))

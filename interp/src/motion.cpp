@@ -132,6 +132,10 @@ void Interpreter::Impl::do_motion() {
   for (int axis = 0; axis < kAxes; ++axis)
     axis_words |= block_.has(kAxisLetters[axis]);
   if (code == 530 || code < 0 || code == 800) return;
+  if (is_g7x_code(code)) {
+    if (explicit_code >= 0) do_g7x(code);
+    return;
+  }
   if (code == 52) {
     if (axis_words || explicit_code == 52) do_nurbs_point();
     return;

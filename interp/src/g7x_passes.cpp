@@ -1,0 +1,108 @@
+// The passes of the G7x cycles, in the cycle's frame: roughing passes across the stock and the
+// pass along the profile, with or without its pockets.
+#include <cmath>
+
+#include "g7x_profile.hpp"
+
+namespace cncd::interp::g7x {
+namespace {
+
+void add(Moves& out, Move::Kind kind, Pt to) {
+  Move move;
+  move.kind = kind;
+  move.seg.b = to;
+  out.push_back(move);
+}
+
+// A piece of the profile: an arc as an arc, unless it has no length (it would be a circle).
+void add_piece(Moves& out, const Seg& piece) {
+  const bool empty =
+      std::fabs(piece.a.u - piece.b.u) < 1e-12 && std::fabs(piece.a.v - piece.b.v) < 1e-12;
+  if (!piece.arc || empty) {
+    add(out, Move::Kind::feed, piece.b);
+    return;
+  }
+  out.push_back(Move{Move::Kind::arc, piece});
+}
+
+// One pass at u = level from v = from to where it meets the path; `back` is how the tool comes
+// back to its start.
+void pass(const Path& path, double level, double from, double retract, Move::Kind back,
+          Moves& out) {
+  const double end = next_hit(path, level, from, NAN);
+  if (std::isnan(end)) return;
+  add(out, Move::Kind::feed, {level, end});
+  add(out, Move::Kind::traverse, {level + retract, end + retract});
+  add(out, Move::Kind::traverse, {level + retract, from - retract});
+  add(out, back, {level, from});
+}
+
+// The pockets of a falling piece: passes at peak, peak - step, ... while above its end.
+void pocket(const Path& path, const Seg& seg, double peak, double step, double retract,
+            Moves& out) {
+  Seg rest = seg;
+  for (double level = peak; level > seg.b.u + kEps; level -= step) {
+    if (level > seg.a.u + kEps) continue;
+    const Pt at = point_at(rest, level);
+    add_piece(out, head(rest, at));
+    rest = tail(rest, at);
+    pass(path, level, at.v, retract, Move::Kind::feed, out);
+  }
+  add_piece(out, rest);
+}
+
+void follow_monotonic(const Path& path, Moves& out) {
+  bool in_pocket = false;
+  double top = 0;
+  for (const Seg& seg : path) {
+    Seg piece = seg;
+    if (in_pocket) {
+      if (seg.b.u < top - kEps) continue;
+      piece = tail(seg, point_at(seg, top));
+      in_pocket = false;
+    } else if (descends(seg)) {
+      in_pocket = true;
+      top = seg.a.u;
+      continue;
+    }
+    add(out, Move::Kind::feed, piece.a);
+    add_piece(out, piece);
+  }
+}
+
+}  // namespace
+
+void rough(const Path& path, Pt entry, double step, double retract, Moves& out) {
+  if (path.empty()) return;
+  const Pt start = path.front().a;
+  const double low = lowest_u(path);
+  for (double level = entry.u; level > low + kEps; level -= step) {
+    double from = entry.v;
+    if (std::fabs(entry.u - start.u) > kEps) {
+      from = entry.v + (level - entry.u) / (start.u - entry.u) * (start.v - entry.v);
+    }
+    add(out, Move::Kind::traverse, {level, from});
+    pass(path, level, from, retract, Move::Kind::traverse, out);
+  }
+}
+
+void follow(const Path& path, Follow how, double step, double retract, Moves& out) {
+  if (how == Follow::monotonic) {
+    follow_monotonic(path, out);
+    return;
+  }
+  double peak = 0;
+  bool falling = false;
+  for (const Seg& seg : path) {
+    if (how == Follow::pockets && descends(seg)) {
+      if (!falling) peak = seg.a.u;
+      falling = true;
+      pocket(path, seg, peak, step, retract, out);
+      continue;
+    }
+    falling = false;
+    add_piece(out, seg);
+  }
+}
+
+}  // namespace cncd::interp::g7x

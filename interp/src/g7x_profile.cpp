@@ -1,0 +1,233 @@
+// Offsets and pass-line intersections of the G7x profile.
+#include "g7x_profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+namespace cncd::interp::g7x {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+double radius(const Seg& s) {
+  return std::hypot(s.a.u - s.c.u, s.a.v - s.c.v);
+}
+
+double angle_of(const Seg& s, Pt p) {
+  return std::atan2(p.v - s.c.v, p.u - s.c.u);
+}
+
+// How far the arc turns from its start to `p`, in [0, 2pi).
+double sweep_to(const Seg& s, Pt p) {
+  double sweep = angle_of(s, p) - angle_of(s, s.a);
+  if (!s.ccw) sweep = -sweep;
+  while (sweep < 0)
+    sweep += kTwoPi;
+  while (sweep >= kTwoPi)
+    sweep -= kTwoPi;
+  return sweep;
+}
+
+double full_sweep(const Seg& s) {
+  const double sweep = sweep_to(s, s.b);
+  return sweep < kEps ? kTwoPi : sweep;
+}
+
+bool on_arc(const Seg& s, Pt p) {
+  return sweep_to(s, p) <= full_sweep(s) + 1e-12;
+}
+
+// The direction of travel at the start (at_end false) or the end of `s`, of unit length.
+Pt tangent(const Seg& s, bool at_end) {
+  if (!s.arc) {
+    const double len = std::hypot(s.b.u - s.a.u, s.b.v - s.a.v);
+    return {(s.b.u - s.a.u) / len, (s.b.v - s.a.v) / len};
+  }
+  const Pt p = at_end ? s.b : s.a;
+  const double r = radius(s);
+  const double ru = (p.u - s.c.u) / r;
+  const double rv = (p.v - s.c.v) / r;
+  return s.ccw ? Pt{-rv, ru} : Pt{rv, -ru};
+}
+
+Seg offset_one(const Seg& s, double d) {
+  Seg out = s;
+  if (!s.arc) {
+    const Pt t = tangent(s, false);
+    out.a = {s.a.u - t.v * d, s.a.v + t.u * d};
+    out.b = {s.b.u - t.v * d, s.b.v + t.u * d};
+    return out;
+  }
+  // Left of a counter-clockwise arc is toward its center.
+  const double r = radius(s);
+  const double scale = (s.ccw ? r - d : r + d) / r;
+  out.a = {s.c.u + (s.a.u - s.c.u) * scale, s.c.v + (s.a.v - s.c.v) * scale};
+  const double rb = std::hypot(s.b.u - s.c.u, s.b.v - s.c.v);
+  const double scale_b = (s.ccw ? rb - d : rb + d) / rb;
+  out.b = {s.c.u + (s.b.u - s.c.u) * scale_b, s.c.v + (s.b.v - s.c.v) * scale_b};
+  return out;
+}
+
+// Where the circle or line carrying `x` meets the one carrying `y`, nearest to `near`.
+std::optional<Pt> meet(const Seg& x, const Seg& y, Pt near) {
+  std::vector<Pt> points;
+  if (!x.arc && !y.arc) {
+    const double d1u = x.b.u - x.a.u, d1v = x.b.v - x.a.v;
+    const double d2u = y.b.u - y.a.u, d2v = y.b.v - y.a.v;
+    const double den = d1u * d2v - d1v * d2u;
+    if (std::fabs(den) < 1e-15) return std::nullopt;
+    const double t = ((y.a.u - x.a.u) * d2v - (y.a.v - x.a.v) * d2u) / den;
+    return Pt{x.a.u + t * d1u, x.a.v + t * d1v};
+  }
+  if (x.arc && y.arc) {
+    const double ra = radius(x), rb = radius(y);
+    const double du = y.c.u - x.c.u, dv = y.c.v - x.c.v;
+    const double dist = std::hypot(du, dv);
+    if (dist < kEps) return std::nullopt;
+    const double along = (ra * ra - rb * rb + dist * dist) / (2 * dist);
+    const double h2 = ra * ra - along * along;
+    if (h2 < 0) return std::nullopt;
+    const double h = std::sqrt(h2);
+    const Pt m{x.c.u + along * du / dist, x.c.v + along * dv / dist};
+    points.push_back({m.u - h * dv / dist, m.v + h * du / dist});
+    points.push_back({m.u + h * dv / dist, m.v - h * du / dist});
+  } else {
+    const Seg& line = x.arc ? y : x;
+    const Seg& circle = x.arc ? x : y;
+    const double r = radius(circle);
+    const double du = line.b.u - line.a.u, dv = line.b.v - line.a.v;
+    const double fu = line.a.u - circle.c.u, fv = line.a.v - circle.c.v;
+    const double qa = du * du + dv * dv;
+    const double qb = 2 * (fu * du + fv * dv);
+    const double qc = fu * fu + fv * fv - r * r;
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc < 0) return std::nullopt;
+    for (const double sign : {-1.0, 1.0}) {
+      const double t = (-qb + sign * std::sqrt(disc)) / (2 * qa);
+      points.push_back({line.a.u + t * du, line.a.v + t * dv});
+    }
+  }
+  auto distance = [&](Pt p) { return std::hypot(p.u - near.u, p.v - near.v); };
+  return *std::min_element(points.begin(), points.end(),
+                           [&](Pt p, Pt q) { return distance(p) < distance(q); });
+}
+
+bool same(Pt p, Pt q) {
+  return std::fabs(p.u - q.u) < 1e-7 && std::fabs(p.v - q.v) < 1e-7;
+}
+
+}  // namespace
+
+Path offset_path(const Path& path, double d) {
+  if (d == 0.0) return path;
+  Path out;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    Seg next = offset_one(path[i], d);
+    if (!out.empty()) {
+      Seg& prev = out.back();
+      const Pt corner = path[i].a;
+      if (!same(prev.b, next.a)) {
+        const Pt t1 = tangent(path[i - 1], true);
+        const Pt t2 = tangent(path[i], false);
+        const double turn = t1.u * t2.v - t1.v * t2.u;
+        if (turn < 0) {
+          out.push_back(Seg{prev.b, next.a, true, corner, false});
+        } else if (const auto p = meet(prev, next, corner)) {
+          out.back().b = *p;
+          next.a = *p;
+        }
+      }
+    }
+    out.push_back(next);
+  }
+  return out;
+}
+
+void level_hits(const Seg& seg, double level, std::vector<double>& out) {
+  if (!seg.arc) {
+    const double lo = std::min(seg.a.u, seg.b.u), hi = std::max(seg.a.u, seg.b.u);
+    if (level < lo - kEps || level > hi + kEps) return;
+    if (std::fabs(seg.b.u - seg.a.u) < kEps) {
+      out.push_back(seg.a.v);
+      out.push_back(seg.b.v);
+      return;
+    }
+    const double t = (level - seg.a.u) / (seg.b.u - seg.a.u);
+    out.push_back(seg.a.v + t * (seg.b.v - seg.a.v));
+    return;
+  }
+  const double r = radius(seg);
+  const double du = level - seg.c.u;
+  if (std::fabs(du) > r + kEps) return;
+  const double h = std::sqrt(std::max(0.0, r * r - du * du));
+  for (const double v : {seg.c.v + h, seg.c.v - h}) {
+    if (on_arc(seg, {level, v})) out.push_back(v);
+  }
+}
+
+double next_hit(const Path& path, double level, double below, double fallback) {
+  std::vector<double> hits;
+  for (const Seg& seg : path)
+    level_hits(seg, level, hits);
+  double best = fallback;
+  bool found = false;
+  for (const double v : hits) {
+    if (v < below - 1e-7 && (!found || v > best)) {
+      best = v;
+      found = true;
+    }
+  }
+  return best;
+}
+
+Pt point_at(const Seg& seg, double level) {
+  if (!seg.arc) {
+    if (std::fabs(seg.b.u - seg.a.u) < kEps) return seg.a;
+    const double t = (level - seg.a.u) / (seg.b.u - seg.a.u);
+    return {level, seg.a.v + t * (seg.b.v - seg.a.v)};
+  }
+  std::vector<double> hits;
+  level_hits(seg, level, hits);
+  Pt best = seg.b;
+  double best_sweep = kTwoPi * 2;
+  for (const double v : hits) {
+    const double sweep = sweep_to(seg, {level, v});
+    if (sweep < best_sweep) {
+      best_sweep = sweep;
+      best = {level, v};
+    }
+  }
+  return best;
+}
+
+Seg head(const Seg& seg, Pt p) {
+  Seg out = seg;
+  out.b = p;
+  return out;
+}
+
+Seg tail(const Seg& seg, Pt p) {
+  Seg out = seg;
+  out.a = p;
+  return out;
+}
+
+bool descends(const Seg& seg) {
+  return seg.b.u < seg.a.u - kEps;
+}
+
+double lowest_u(const Path& path) {
+  double low = path.empty() ? 0.0 : path.front().a.u;
+  for (const Seg& seg : path) {
+    low = std::min({low, seg.a.u, seg.b.u});
+    if (seg.arc) {
+      const Pt left{seg.c.u - radius(seg), seg.c.v};
+      if (on_arc(seg, left)) low = std::min(low, left.u);
+    }
+  }
+  return low;
+}
+
+}  // namespace cncd::interp::g7x
