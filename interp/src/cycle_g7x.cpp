@@ -21,6 +21,7 @@ struct G7xRun {
   // The profile's moves in (x, z): u = x, v = z; an arc's ccw turns from +X toward +Z.
   g7x::Path moves;
   g7x::Pt last;
+  double last_a = 0;  // A: a move that changes it asks for the corner at its end rounded by |A|
   // The cycle's frame: u along X (G70, G71) or Z (G72), each axis turned so that the profile
   // starts below the start point and runs toward -v.
   bool swap = false;
@@ -60,9 +61,9 @@ bool Interpreter::Impl::is_g7x_code(int code) {
 
 void Interpreter::Impl::do_g7x(int code) {
   const std::string name = code_name(code);
+  if (!block_.has('q')) fail("G7x.x  requires a Q word");
   if (modal_.plane != Plane::xz) fail(name + " can only be used in XZ plane (G18)");
   if (code != 700 && comp_.on()) fail(name + " cannot be used with cutter compensation enabled");
-  if (!block_.has('q')) fail("G7x.x  requires a Q word");
   auto run = std::make_shared<G7xRun>();
   run->code = code;
   if (block_.has('d')) run->d = block_.get('d');
@@ -73,6 +74,7 @@ void Interpreter::Impl::do_g7x(int code) {
   run->start = target_from_words();
   emit_straight(StraightKind::traverse, run->start);
   run->last = {run->start[kX], run->start[kZ]};
+  run->last_a = run->start[kA];
   block_.o_name = std::to_string(to_int(block_.get('q')));
   block_.call_args.clear();
   do_call();
@@ -81,35 +83,48 @@ void Interpreter::Impl::do_g7x(int code) {
   g7x_ = std::move(run);
 }
 
+bool Interpreter::Impl::reading_g7x_profile() const {
+  return g7x_ && calls_.size() >= g7x_->depth;
+}
+
 bool Interpreter::Impl::g7x_capture(const CanonCommand& command) {
-  if (!g7x_ || calls_.size() < g7x_->depth) return false;
+  if (!reading_g7x_profile()) return false;
   G7xRun& run = *g7x_;
   g7x::Seg seg;
   seg.a = run.last;
+  Pose end{};
   if (const auto* t = std::get_if<StraightTraverse>(&command.op)) {
-    seg.b = {t->end[kX], t->end[kZ]};
+    end = t->end;
   } else if (const auto* f = std::get_if<StraightFeed>(&command.op)) {
-    seg.b = {f->end[kX], f->end[kZ]};
+    end = f->end;
   } else if (const auto* a = std::get_if<ArcFeed>(&command.op)) {
-    const Pose end = a->end();
+    end = a->end();
     const Pose center = a->center();
-    seg.b = {end[kX], end[kZ]};
     seg.arc = true;
     seg.c = {center[kX], center[kZ]};
     seg.ccw = a->rotation < 0;  // ARC_FEED turns in (Z, X)
   } else {
     return false;
   }
+  seg.b = {end[kX], end[kZ]};
+  if (end[kA] != run.last_a) seg.round = std::fabs(end[kA]);
+  run.last_a = end[kA];
   run.moves.push_back(seg);
   run.last = seg.b;
   return true;
 }
 
 void Interpreter::Impl::emit_g7x_move(const G7xRun& run, const g7x::Move& move) {
+  // Axes other than X and Z stay where the cycle started, whatever the profile did with them.
   const g7x::Pt to = run.to_xz(move.seg.b);
-  Pose end = pos_;
+  Pose end = run.start;
   end[kX] = to.u;
   end[kZ] = to.v;
+  // The profile's own moves were not checked for a feed rate; the cycle's are.
+  if (move.kind != g7x::Move::Kind::traverse && modal_.feed_rate == 0.0 &&
+      modal_.feed_mode != FeedMode::inverse_time) {
+    fail("Cannot do g1 with zero feed rate");
+  }
   if (move.kind != g7x::Move::Kind::arc) {
     emit_straight(move.kind == g7x::Move::Kind::feed ? StraightKind::feed : StraightKind::traverse,
                   end);
@@ -158,16 +173,19 @@ void Interpreter::Impl::finish_g7x() {
     seg.ccw = seg.ccw != run.flips();
     profile.push_back(seg);
   }
+  profile = g7x::round_corners(profile);
+  // The roughing cycles carry the profile on up to the start point's level; G70 ends with it.
   auto path_at = [&](double distance) {
     g7x::Path path = g7x::offset_path(profile, distance);
     const g7x::Pt end = path.back().b;
-    if (end.u < s.u - g7x::kEps) path.push_back(g7x::line(end, {s.u, end.v}));
+    if (family != 70 && end.u < s.u - g7x::kEps) path.push_back(g7x::line(end, {s.u, end.v}));
     return path;
   };
   g7x::Moves moves;
-  auto approach = [&](const g7x::Path& path) {
-    const g7x::Pt first = path.front().a;
-    const g7x::Pt entry{s.u, std::fmax(s.v, first.v)};
+  // The tool enters level with the start point or with the profile's first point (before its
+  // offset), whichever is further up the passes.
+  auto approach = [&]() {
+    const g7x::Pt entry{s.u, std::fmax(s.v, profile.front().a.v)};
     moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, entry)});
     return entry;
   };
@@ -175,13 +193,13 @@ void Interpreter::Impl::finish_g7x() {
     for (int pass = 1; pass <= run.passes; ++pass) {
       const double distance = run.d - (run.d - run.e) * pass / run.passes;
       const g7x::Path path = path_at(distance);
-      approach(path);
+      approach();
       moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, path.front().a)});
       g7x::follow(path, g7x::Follow::plain, run.i, run.r, moves);
     }
   } else {
     const g7x::Path path = path_at(run.d);
-    const g7x::Pt entry = approach(path);
+    const g7x::Pt entry = approach();
     if (variant != 2) g7x::rough(path, entry, run.i, run.r, moves);
     moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, path.front().a)});
     const auto how = variant == 1 ? g7x::Follow::monotonic : g7x::Follow::pockets;

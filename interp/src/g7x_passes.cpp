@@ -1,6 +1,7 @@
 // The passes of the G7x cycles, in the cycle's frame: roughing passes across the stock and the
 // pass along the profile, with or without its pockets.
 #include <cmath>
+#include <optional>
 
 #include "g7x_profile.hpp"
 
@@ -14,11 +15,13 @@ void add(Moves& out, Move::Kind kind, Pt to) {
   out.push_back(move);
 }
 
+bool is_point(const Seg& seg) {
+  return std::fabs(seg.a.u - seg.b.u) < 1e-12 && std::fabs(seg.a.v - seg.b.v) < 1e-12;
+}
+
 // A piece of the profile: an arc as an arc, unless it has no length (it would be a circle).
 void add_piece(Moves& out, const Seg& piece) {
-  const bool empty =
-      std::fabs(piece.a.u - piece.b.u) < 1e-12 && std::fabs(piece.a.v - piece.b.v) < 1e-12;
-  if (!piece.arc || empty) {
+  if (!piece.arc || is_point(piece)) {
     add(out, Move::Kind::feed, piece.b);
     return;
   }
@@ -31,6 +34,8 @@ void pass(const Path& path, double level, double from, double retract, Move::Kin
           Moves& out) {
   const double end = next_hit(path, level, from, NAN);
   if (std::isnan(end)) return;
+  // A short pass backs off by half its length at most, so that the way back does not cross it.
+  retract = std::fmin(retract, (from - end) / 2);
   add(out, Move::Kind::feed, {level, end});
   add(out, Move::Kind::traverse, {level + retract, end + retract});
   add(out, Move::Kind::traverse, {level + retract, from - retract});
@@ -51,22 +56,28 @@ void pocket(const Path& path, const Seg& seg, double peak, double step, double r
   add_piece(out, rest);
 }
 
+// Each piece at or above the highest u met so far, up to where u starts to fall: a line fed
+// from its start, an arc that reaches that height entered by a feed to where it does, and cut
+// when more than a point of it does.
 void follow_monotonic(const Path& path, Moves& out) {
-  bool in_pocket = false;
-  double top = 0;
+  double top = path.empty() ? 0.0 : path.front().a.u;
   for (const Seg& seg : path) {
+    const bool start_in = seg.a.u >= top - kEps;
+    const bool end_in = seg.b.u >= top - kEps;
+    if (!start_in && !end_in) continue;
     Seg piece = seg;
-    if (in_pocket) {
-      if (seg.b.u < top - kEps) continue;
-      piece = tail(seg, point_at(seg, top));
-      in_pocket = false;
-    } else if (descends(seg)) {
-      in_pocket = true;
-      top = seg.a.u;
-      continue;
+    if (!start_in) {
+      piece = tail(seg, point_at(seg, top, true));
+    } else if (!end_in) {
+      piece = head(seg, point_at(seg, top));
     }
-    add(out, Move::Kind::feed, piece.a);
-    add_piece(out, piece);
+    // An arc that bulges past its end is cut at its highest point: u falls after it.
+    const std::optional<Pt> peak = piece.arc && !is_point(piece) ? arc_peak(piece) : std::nullopt;
+    if (peak && peak->u > piece.b.u + kEps) piece = head(piece, *peak);
+    const bool empty = is_point(piece);
+    if (piece.arc || !empty) add(out, Move::Kind::feed, piece.a);
+    if (!empty) add_piece(out, piece);
+    top = std::fmax(top, std::fmax(piece.a.u, piece.b.u));
   }
 }
 

@@ -102,7 +102,10 @@ std::optional<Pt> meet(const Seg& x, const Seg& y, Pt near) {
     const double qa = du * du + dv * dv;
     const double qb = 2 * (fu * du + fv * dv);
     const double qc = fu * fu + fv * fv - r * r;
-    const double disc = qb * qb - 4 * qa * qc;
+    double disc = qb * qb - 4 * qa * qc;
+    // A line that misses the circle by a hair (a corner meant to be smooth, written with
+    // rounded numbers) meets it where it comes closest.
+    if (disc < 0 && -disc < 8e-3 * qa * r) disc = 0;  // missing by less than 0.001
     if (disc < 0) return std::nullopt;
     for (const double sign : {-1.0, 1.0}) {
       const double t = (-qb + sign * std::sqrt(disc)) / (2 * qa);
@@ -114,11 +117,54 @@ std::optional<Pt> meet(const Seg& x, const Seg& y, Pt near) {
                            [&](Pt p, Pt q) { return distance(p) < distance(q); });
 }
 
+// Whether `p`, a point on the line or circle carrying `s`, lies within `s` or less than 0.001
+// beyond one of its ends.
+bool contains(const Seg& s, Pt p) {
+  constexpr double kSlack = 1e-3;
+  if (s.arc) {
+    const double slack = kSlack / radius(s);
+    const double sweep = sweep_to(s, p);
+    return sweep <= full_sweep(s) + slack || sweep >= kTwoPi - slack;
+  }
+  const double du = s.b.u - s.a.u, dv = s.b.v - s.a.v;
+  const double len = std::hypot(du, dv);
+  const double along = ((p.u - s.a.u) * du + (p.v - s.a.v) * dv) / len;
+  return along >= -kSlack && along <= len + kSlack;
+}
+
 bool same(Pt p, Pt q) {
   return std::fabs(p.u - q.u) < 1e-7 && std::fabs(p.v - q.v) < 1e-7;
 }
 
 }  // namespace
+
+Path round_corners(const Path& path) {
+  Path out;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    Seg next = path[i];
+    if (!out.empty() && out.back().round > 0 && !out.back().arc && !next.arc) {
+      Seg& prev = out.back();
+      const Pt t1 = tangent(prev, true);
+      const Pt t2 = tangent(next, false);
+      const double turn = t1.u * t2.v - t1.v * t2.u;
+      const double cosine = t1.u * t2.u + t1.v * t2.v;
+      const double angle = std::atan2(std::fabs(turn), cosine);
+      const double r = prev.round;
+      const double cut = r * std::tan(angle / 2);
+      const Pt corner = next.a;
+      const Pt from{corner.u - t1.u * cut, corner.v - t1.v * cut};
+      const Pt to{corner.u + t2.u * cut, corner.v + t2.v * cut};
+      // The center lies on the side the path turns to.
+      const double side = turn > 0 ? 1.0 : -1.0;
+      const Pt center{from.u - t1.v * r * side, from.v + t1.u * r * side};
+      prev.b = from;
+      next.a = to;
+      if (std::fabs(turn) > kEps) out.push_back(Seg{from, to, true, center, turn > 0, 0});
+    }
+    out.push_back(next);
+  }
+  return out;
+}
 
 Path offset_path(const Path& path, double d) {
   if (d == 0.0) return path;
@@ -132,11 +178,14 @@ Path offset_path(const Path& path, double d) {
         const Pt t1 = tangent(path[i - 1], true);
         const Pt t2 = tangent(path[i], false);
         const double turn = t1.u * t2.v - t1.v * t2.u;
-        if (turn < 0) {
-          out.push_back(Seg{prev.b, next.a, true, corner, false});
-        } else if (const auto p = meet(prev, next, corner)) {
-          out.back().b = *p;
+        // Pieces that still cross (an inside corner, or one so nearly straight that the
+        // offsets overlap) are cut where they do; an outside corner gets its arc.
+        const auto p = meet(prev, next, corner);
+        if (p && (turn >= 0 || (contains(prev, *p) && contains(next, *p)))) {
+          prev.b = *p;
           next.a = *p;
+        } else if (turn < 0) {
+          out.push_back(Seg{prev.b, next.a, true, corner, false, 0});
         }
       }
     }
@@ -182,7 +231,7 @@ double next_hit(const Path& path, double level, double below, double fallback) {
   return best;
 }
 
-Pt point_at(const Seg& seg, double level) {
+Pt point_at(const Seg& seg, double level, bool last) {
   if (!seg.arc) {
     if (std::fabs(seg.b.u - seg.a.u) < kEps) return seg.a;
     const double t = (level - seg.a.u) / (seg.b.u - seg.a.u);
@@ -193,7 +242,7 @@ Pt point_at(const Seg& seg, double level) {
   Pt best = seg.b;
   double best_sweep = kTwoPi * 2;
   for (const double v : hits) {
-    const double sweep = sweep_to(seg, {level, v});
+    const double sweep = sweep_to(seg, {level, v}) * (last ? -1.0 : 1.0);
     if (sweep < best_sweep) {
       best_sweep = sweep;
       best = {level, v};
@@ -216,6 +265,12 @@ Seg tail(const Seg& seg, Pt p) {
 
 bool descends(const Seg& seg) {
   return seg.b.u < seg.a.u - kEps;
+}
+
+std::optional<Pt> arc_peak(const Seg& seg) {
+  const Pt top{seg.c.u + radius(seg), seg.c.v};
+  if (on_arc(seg, top)) return top;
+  return std::nullopt;
 }
 
 double lowest_u(const Path& path) {

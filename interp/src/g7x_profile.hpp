@@ -4,6 +4,7 @@
 // line meets it.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 namespace cncd::interp::g7x {
@@ -19,6 +20,7 @@ struct Seg {
   bool arc = false;
   Pt c;              // arc center
   bool ccw = false;  // arc turns from +u toward +v
+  double round = 0;  // the radius that rounds the corner at its end, 0 = sharp
 };
 
 using Path = std::vector<Seg>;
@@ -32,6 +34,9 @@ inline Seg line(Pt a, Pt b) {
 
 inline constexpr double kEps = 1e-9;
 
+// The corners between lines that ask for it rounded by an arc of that radius.
+Path round_corners(const Path& path);
+
 // The profile moved `d` to the left of its direction of travel (the side of the stock): each
 // piece moved, the gap at an outside corner closed by an arc of radius `d` around it, the
 // overlap at an inside corner cut where the two pieces meet.
@@ -43,8 +48,8 @@ void level_hits(const Seg& seg, double level, std::vector<double>& out);
 // The highest v below `below` where the line u = `level` meets `path`; `fallback` if none.
 double next_hit(const Path& path, double level, double below, double fallback);
 
-// The point of `seg` at u = `level` (the first from its start, for an arc).
-Pt point_at(const Seg& seg, double level);
+// The point of `seg` at u = `level` (for an arc, the first from its start, or the `last`).
+Pt point_at(const Seg& seg, double level, bool last = false);
 
 // `seg` from its start to `p` and from `p` to its end.
 Seg head(const Seg& seg, Pt p);
@@ -52,6 +57,9 @@ Seg tail(const Seg& seg, Pt p);
 
 // Whether u falls along the whole of `seg` (its end lower than its start).
 bool descends(const Seg& seg);
+
+// The point of highest u on the arc `seg`, when its sweep reaches it.
+std::optional<Pt> arc_peak(const Seg& seg);
 
 // The lowest u on `path`.
 double lowest_u(const Path& path);

@@ -303,6 +303,7 @@ struct Interpreter::Impl {
   static bool is_g7x_code(int code);
   void do_g7x(int code);
   bool g7x_capture(const CanonCommand& command);  // a move of the profile, kept
+  bool reading_g7x_profile() const;
   void finish_g7x();
   void emit_g7x_move(const G7xRun& run, const g7x::Move& move);
   // control.cpp: O-words.

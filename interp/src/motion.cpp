@@ -132,10 +132,6 @@ void Interpreter::Impl::do_motion() {
   for (int axis = 0; axis < kAxes; ++axis)
     axis_words |= block_.has(kAxisLetters[axis]);
   if (code == 530 || code < 0 || code == 800) return;
-  if (is_g7x_code(code)) {
-    if (explicit_code >= 0) do_g7x(code);
-    return;
-  }
   if (code == 52) {
     if (axis_words || explicit_code == 52) do_nurbs_point();
     return;
@@ -150,6 +146,10 @@ void Interpreter::Impl::do_motion() {
   }
   if (non_modal == 530 && modal_.incremental)
     fail("Cannot use g53 incremental", block_.g_column[0]);
+  if (is_g7x_code(code)) {
+    if (explicit_code >= 0) do_g7x(code);
+    return;
+  }
   if (code >= 382 && code <= 385) {
     if (axis_words && comp_.on()) fail("Cannot probe with cutter radius comp on");
     if (axis_words) do_probe(code);
@@ -168,7 +168,7 @@ void Interpreter::Impl::do_motion() {
       (axis_words || arc_words || explicit_code >= 0)) {
     fail("The move just after exiting cutter compensation mode must be straight, not an arc");
   }
-  if (code == 10 || code == 20 || code == 30) {
+  if ((code == 10 || code == 20 || code == 30) && !reading_g7x_profile()) {
     if (modal_.feed_mode == FeedMode::inverse_time && !block_.has('f') && axis_words) {
       fail(code == 10 ? "F word missing with inverse time g1 move"
                       : "F word missing with inverse time arc move");
