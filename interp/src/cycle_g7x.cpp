@@ -195,7 +195,7 @@ void Interpreter::Impl::finish_g7x() {
       const g7x::Path path = path_at(distance);
       approach();
       moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, path.front().a)});
-      g7x::follow(path, g7x::Follow::plain, run.i, run.r, moves);
+      g7x::follow(path, g7x::Follow::plain, run.i, run.r, NAN, moves);
     }
   } else {
     const g7x::Path path = path_at(run.d);
@@ -203,7 +203,9 @@ void Interpreter::Impl::finish_g7x() {
     if (variant != 2) g7x::rough(path, entry, run.i, run.r, moves);
     moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, path.front().a)});
     const auto how = variant == 1 ? g7x::Follow::monotonic : g7x::Follow::pockets;
-    g7x::follow(path, how, run.i, run.r, moves);
+    // After roughing passes the pockets are cut on the same levels; without them, from the
+    // top of each pocket.
+    g7x::follow(path, how, run.i, run.r, variant == 2 ? NAN : s.u, moves);
   }
   for (const g7x::Move& move : moves)
     emit_g7x_move(run, move);

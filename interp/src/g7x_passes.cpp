@@ -19,13 +19,14 @@ bool is_point(const Seg& seg) {
   return std::fabs(seg.a.u - seg.b.u) < 1e-12 && std::fabs(seg.a.v - seg.b.v) < 1e-12;
 }
 
-// A piece of the profile: an arc as an arc, unless it has no length (it would be a circle).
+// A piece of the profile: a line fed (even when it has no length), an arc cut unless it has no
+// length (it would be a circle).
 void add_piece(Moves& out, const Seg& piece) {
-  if (!piece.arc || is_point(piece)) {
+  if (!piece.arc) {
     add(out, Move::Kind::feed, piece.b);
-    return;
+  } else if (!is_point(piece)) {
+    out.push_back(Move{Move::Kind::arc, piece});
   }
-  out.push_back(Move{Move::Kind::arc, piece});
 }
 
 // One pass at u = level from v = from to where it meets the path; `back` is how the tool comes
@@ -42,11 +43,28 @@ void pass(const Path& path, double level, double from, double retract, Move::Kin
   add(out, back, {level, from});
 }
 
-// The pockets of a falling piece: passes at peak, peak - step, ... while above its end.
-void pocket(const Path& path, const Seg& seg, double peak, double step, double retract,
+// The path with each arc that bulges above both its ends cut in two at its highest u.
+Path split_at_peaks(const Path& path) {
+  Path out;
+  for (const Seg& seg : path) {
+    const std::optional<Pt> peak = seg.arc ? arc_peak(seg) : std::nullopt;
+    if (peak && peak->u > std::fmax(seg.a.u, seg.b.u) + kEps) {
+      out.push_back(head(seg, *peak));
+      out.push_back(tail(seg, *peak));
+    } else {
+      out.push_back(seg);
+    }
+  }
+  return out;
+}
+
+// The pockets of a falling piece: passes at origin, origin - step, ... between its ends.
+void pocket(const Path& path, const Seg& seg, double origin, double step, double retract,
             Moves& out) {
   Seg rest = seg;
-  for (double level = peak; level > seg.b.u + kEps; level -= step) {
+  for (int k = 0;; ++k) {
+    const double level = origin - k * step;
+    if (level <= seg.b.u + kEps) break;
     if (level > seg.a.u + kEps) continue;
     const Pt at = point_at(rest, level);
     add_piece(out, head(rest, at));
@@ -74,9 +92,10 @@ void follow_monotonic(const Path& path, Moves& out) {
     // An arc that bulges past its end is cut at its highest point: u falls after it.
     const std::optional<Pt> peak = piece.arc && !is_point(piece) ? arc_peak(piece) : std::nullopt;
     if (peak && peak->u > piece.b.u + kEps) piece = head(piece, *peak);
-    const bool empty = is_point(piece);
-    if (piece.arc || !empty) add(out, Move::Kind::feed, piece.a);
-    if (!empty) add_piece(out, piece);
+    if (piece.arc || !is_point(piece)) {
+      add(out, Move::Kind::feed, piece.a);
+      add_piece(out, piece);
+    }
     top = std::fmax(top, std::fmax(piece.a.u, piece.b.u));
   }
 }
@@ -97,18 +116,18 @@ void rough(const Path& path, Pt entry, double step, double retract, Moves& out) 
   }
 }
 
-void follow(const Path& path, Follow how, double step, double retract, Moves& out) {
+void follow(const Path& path, Follow how, double step, double retract, double grid, Moves& out) {
   if (how == Follow::monotonic) {
     follow_monotonic(path, out);
     return;
   }
   double peak = 0;
   bool falling = false;
-  for (const Seg& seg : path) {
+  for (const Seg& seg : how == Follow::pockets ? split_at_peaks(path) : path) {
     if (how == Follow::pockets && descends(seg)) {
       if (!falling) peak = seg.a.u;
       falling = true;
-      pocket(path, seg, peak, step, retract, out);
+      pocket(path, seg, std::isnan(grid) ? peak : grid, step, retract, out);
       continue;
     }
     falling = false;

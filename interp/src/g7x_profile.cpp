@@ -169,13 +169,16 @@ Path round_corners(const Path& path) {
 Path offset_path(const Path& path, double d) {
   if (d == 0.0) return path;
   Path out;
+  std::size_t prev_index = 0;  // the piece of `path` that out.back() is the offset of
   for (std::size_t i = 0; i < path.size(); ++i) {
+    // An arc around the inside of a corner no larger than the offset vanishes from it.
+    if (path[i].arc && (path[i].ccw ? radius(path[i]) - d : radius(path[i]) + d) <= kEps) continue;
     Seg next = offset_one(path[i], d);
     if (!out.empty()) {
       Seg& prev = out.back();
       const Pt corner = path[i].a;
       if (!same(prev.b, next.a)) {
-        const Pt t1 = tangent(path[i - 1], true);
+        const Pt t1 = tangent(path[prev_index], true);
         const Pt t2 = tangent(path[i], false);
         const double turn = t1.u * t2.v - t1.v * t2.u;
         // Pieces that still cross (an inside corner, or one so nearly straight that the
@@ -190,6 +193,7 @@ Path offset_path(const Path& path, double d) {
       }
     }
     out.push_back(next);
+    prev_index = i;
   }
   return out;
 }

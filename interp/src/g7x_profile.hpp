@@ -76,10 +76,10 @@ using Moves = std::vector<Move>;
 // off by `retract` on the way back.
 void rough(const Path& path, Pt entry, double step, double retract, Moves& out);
 
-// Along `path`: lines fed, arcs cut. With `pockets`, every stretch where u falls is cut in
-// passes `step` apart as it is met; with `monotonic`, such stretches are left out instead, and
-// each line is fed from its start.
+// Along `path`: lines fed, arcs cut. With `pockets`, every stretch where u falls is cut as it
+// is met, in passes at grid, grid - step, ... (with a NaN grid: from the stretch's top); with
+// `monotonic`, such stretches are left out instead, and each line is fed from its start.
 enum class Follow { plain, pockets, monotonic };
-void follow(const Path& path, Follow how, double step, double retract, Moves& out);
+void follow(const Path& path, Follow how, double step, double retract, double grid, Moves& out);
 
 }  // namespace cncd::interp::g7x
