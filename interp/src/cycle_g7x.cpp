@@ -63,7 +63,9 @@ void Interpreter::Impl::do_g7x(int code) {
   const std::string name = code_name(code);
   if (!block_.has('q')) fail("G7x.x  requires a Q word");
   if (modal_.plane != Plane::xz) fail(name + " can only be used in XZ plane (G18)");
-  if (code != 700 && comp_.on()) fail(name + " cannot be used with cutter compensation enabled");
+  // rs274 runs G70 through cutter compensation; here it is refused like G71 and G72 rather
+  // than run on a profile the compensation has already moved.
+  if (comp_.on()) fail(name + " cannot be used with cutter compensation enabled");
   auto run = std::make_shared<G7xRun>();
   run->code = code;
   if (block_.has('d')) run->d = block_.get('d');
@@ -154,7 +156,8 @@ void Interpreter::Impl::finish_g7x() {
   for (const g7x::Seg& seg : run.moves) {
     if (std::hypot(seg.b.u - seg.a.u, seg.b.v - seg.a.v) > g7x::kEps) raw.push_back(seg);
   }
-  if (raw.size() < 2) fail("G7X error: the profile needs at least two moves");
+  // A profile of one move or none cuts nothing; the tool stays where the subroutine left it.
+  if (raw.size() < 2) return;
   const g7x::Pt s_xz{run.start[kX], run.start[kZ]};
   run.swap = family == 72;
   run.su = run.sv = 1;

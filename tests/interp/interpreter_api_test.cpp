@@ -271,6 +271,20 @@ TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
   }
 }
 
+// rs274 runs G70 through cutter compensation; cncd refuses it there, as it and rs274 refuse
+// G71 and G72, rather than finish along a profile the compensation has already moved.
+TEST(InterpreterApi, LatheFinishingIsRefusedUnderCutterCompensation) {
+  Interpreter interp;
+  ASSERT_FALSE(interp.open_string(
+      "G18 G21 F100\nO100 sub\nG0 X5 Z1\nG1 Z-5\nX12\nO100 endsub\nG42 D1 G70 Q100 X12 Z2\nM2\n",
+      "c.ngc"));
+  NullSink sink;
+  const auto error = run_program(interp, sink);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->message, "G70.0 cannot be used with cutter compensation enabled");
+  EXPECT_EQ(error->line, 7);
+}
+
 // The whole path the daemon uses: program -> canon -> MachineTracker -> machine moves.
 TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   struct Machine final : CanonSink {
