@@ -62,6 +62,7 @@ bool Interpreter::Impl::is_g7x_code(int code) {
 void Interpreter::Impl::do_g7x(int code) {
   const std::string name = code_name(code);
   if (!block_.has('q')) fail("G7x.x  requires a Q word");
+  if (reading_g7x_profile()) fail(name + " cannot be used in the profile of another G7x cycle");
   if (modal_.plane != Plane::xz) fail(name + " can only be used in XZ plane (G18)");
   // rs274 runs G70 through cutter compensation; here it is refused like G71 and G72 rather
   // than run on a profile the compensation has already moved.
@@ -159,24 +160,36 @@ void Interpreter::Impl::finish_g7x() {
   // A profile of one move or none cuts nothing; the tool stays where the subroutine left it.
   if (raw.size() < 2) return;
   const g7x::Pt s_xz{run.start[kX], run.start[kZ]};
-  run.swap = family == 72;
-  run.su = run.sv = 1;
-  const g7x::Pt s0 = run.to_frame(s_xz);
-  const g7x::Pt p0 = run.to_frame(raw.front().b);
-  const g7x::Pt end0 = run.to_frame(raw.back().b);
-  run.su = p0.u <= s0.u ? 1 : -1;
-  run.sv = end0.v <= p0.v ? 1 : -1;
+  // The profile in the frame of G71 (swap false) or G72, turned to the profile's quadrant;
+  // empty when it turns back along the passes somewhere.
+  auto frame_profile = [&](bool swap) {
+    run.swap = swap;
+    run.su = run.sv = 1;
+    const g7x::Pt s0 = run.to_frame(s_xz);
+    const g7x::Pt p0 = run.to_frame(raw.front().b);
+    const g7x::Pt end0 = run.to_frame(raw.back().b);
+    run.su = p0.u <= s0.u ? 1 : -1;
+    run.sv = end0.v <= p0.v ? 1 : -1;
+    g7x::Path path;
+    for (std::size_t k = 1; k < raw.size(); ++k) {
+      g7x::Seg seg = raw[k];
+      seg.a = run.to_frame(seg.a);
+      seg.b = run.to_frame(seg.b);
+      seg.c = run.to_frame(seg.c);
+      seg.ccw = seg.ccw != run.flips();
+      path.push_back(seg);
+    }
+    path = g7x::round_corners(path);
+    for (const g7x::Seg& seg : path) {
+      if (!g7x::v_never_rises(seg)) return g7x::Path{};
+    }
+    return path;
+  };
+  // G70 takes G71's frame, or G72's when the profile turns back along Z.
+  g7x::Path profile = frame_profile(family == 72);
+  if (profile.empty() && family == 70) profile = frame_profile(true);
+  if (profile.empty()) fail("G7X error: Not monotonic");
   const g7x::Pt s = run.to_frame(s_xz);
-  g7x::Path profile;
-  for (std::size_t k = 1; k < raw.size(); ++k) {
-    g7x::Seg seg = raw[k];
-    seg.a = run.to_frame(seg.a);
-    seg.b = run.to_frame(seg.b);
-    seg.c = run.to_frame(seg.c);
-    seg.ccw = seg.ccw != run.flips();
-    profile.push_back(seg);
-  }
-  profile = g7x::round_corners(profile);
   // The roughing cycles carry the profile on up to the start point's level; G70 ends with it.
   auto path_at = [&](double distance) {
     g7x::Path path = g7x::offset_path(profile, distance);

@@ -267,6 +267,18 @@ Seg tail(const Seg& seg, Pt p) {
   return out;
 }
 
+bool v_never_rises(const Seg& seg) {
+  if (seg.b.v > seg.a.v + kEps) return false;
+  if (!seg.arc) return true;
+  // An arc turns back in v where it passes the top or the bottom of its circle between its ends.
+  const double r = radius(seg);
+  for (const Pt turn : {Pt{seg.c.u, seg.c.v + r}, Pt{seg.c.u, seg.c.v - r}}) {
+    const double sweep = sweep_to(seg, turn);
+    if (sweep > 1e-9 && sweep < full_sweep(seg) - 1e-9) return false;
+  }
+  return true;
+}
+
 bool descends(const Seg& seg) {
   return seg.b.u < seg.a.u - kEps;
 }

@@ -55,6 +55,9 @@ Pt point_at(const Seg& seg, double level, bool last = false);
 Seg head(const Seg& seg, Pt p);
 Seg tail(const Seg& seg, Pt p);
 
+// Whether v never rises along `seg` (the roughing cycles' profiles run one way).
+bool v_never_rises(const Seg& seg);
+
 // Whether u falls along the whole of `seg` (its end lower than its start).
 bool descends(const Seg& seg);
 

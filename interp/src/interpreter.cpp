@@ -71,6 +71,7 @@ void Interpreter::Impl::reset_modal_state() {
   g92_offset_ = parameters_.get(5210) != 0.0 ? read_offset_parameters(kG92Base) : Pose{};
   control_.clear();
   calls_.clear();
+  g7x_.reset();
   saved_modal_top_ = SavedModalState{};
   subs_.clear();
   preamble_done_ = false;
@@ -308,6 +309,7 @@ std::optional<InterpError> Interpreter::open_mdi(std::string line) {
   impl_->loops_without_motion_ = 0;
   impl_->control_.clear();
   impl_->calls_.clear();
+  impl_->g7x_.reset();
   return std::nullopt;
 }
 

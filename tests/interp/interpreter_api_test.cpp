@@ -285,6 +285,21 @@ TEST(InterpreterApi, LatheFinishingIsRefusedUnderCutterCompensation) {
   EXPECT_EQ(error->line, 7);
 }
 
+// A cycle inside the profile of another would lose the outer one's profile; rs274 prints a
+// muddle of both, cncd refuses it at the inner cycle's line.
+TEST(InterpreterApi, LatheCycleInsideAProfileIsRefused) {
+  Interpreter interp;
+  ASSERT_FALSE(
+      interp.open_string("G18 G21 F100\nO100 sub\nG0 X5 Z1\nG71 Q100 X3 Z2\nG1 Z-3\n"
+                         "O100 endsub\nG0 X20 Z5\nG71 Q100 X12 Z2\nM2\n",
+                         "n.ngc"));
+  NullSink sink;
+  const auto error = run_program(interp, sink);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->message, "G71.0 cannot be used in the profile of another G7x cycle");
+  EXPECT_EQ(error->line, 4);
+}
+
 // The whole path the daemon uses: program -> canon -> MachineTracker -> machine moves.
 TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   struct Machine final : CanonSink {
