@@ -16,8 +16,7 @@ namespace {
 using nlohmann::json;
 
 struct Point {
-  double x = 0;
-  double z = 0;
+  double x = 0, z = 0;
 };
 
 // A line (or, with `arc`, an arc about c) from a to b in the XZ plane.

@@ -271,33 +271,31 @@ TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
   }
 }
 
-// rs274 runs G70 through cutter compensation; cncd refuses it there, as it and rs274 refuse
-// G71 and G72, rather than finish along a profile the compensation has already moved.
-TEST(InterpreterApi, LatheFinishingIsRefusedUnderCutterCompensation) {
-  Interpreter interp;
-  ASSERT_FALSE(interp.open_string(
-      "G18 G21 F100\nO100 sub\nG0 X5 Z1\nG1 Z-5\nX12\nO100 endsub\nG42 D1 G70 Q100 X12 Z2\nM2\n",
-      "c.ngc"));
-  NullSink sink;
-  const auto error = run_program(interp, sink);
-  ASSERT_TRUE(error);
-  EXPECT_EQ(error->message, "G70.0 cannot be used with cutter compensation enabled");
-  EXPECT_EQ(error->line, 7);
-}
-
-// A cycle inside the profile of another would lose the outer one's profile; rs274 prints a
-// muddle of both, cncd refuses it at the inner cycle's line.
-TEST(InterpreterApi, LatheCycleInsideAProfileIsRefused) {
-  Interpreter interp;
-  ASSERT_FALSE(
-      interp.open_string("G18 G21 F100\nO100 sub\nG0 X5 Z1\nG71 Q100 X3 Z2\nG1 Z-3\n"
-                         "O100 endsub\nG0 X20 Z5\nG71 Q100 X12 Z2\nM2\n",
-                         "n.ngc"));
-  NullSink sink;
-  const auto error = run_program(interp, sink);
-  ASSERT_TRUE(error);
-  EXPECT_EQ(error->message, "G71.0 cannot be used in the profile of another G7x cycle");
-  EXPECT_EQ(error->line, 4);
+// Lathe cycles cncd refuses where rs274 goes on: G70 under cutter compensation (rs274
+// compensates the finishing pass; here the profile read would already be compensated), and a
+// cycle in the profile of another (rs274 prints a muddle of both).
+TEST(InterpreterApi, LatheCyclesRefusedWhereTheyCannotBeRight) {
+  const std::string profile = "G18 G21 F100\nO100 sub\nG0 X5 Z1\nG1 Z-5\nX12\nO100 endsub\n";
+  const struct {
+    std::string text;
+    const char* message;
+    int line;
+  } cases[] = {
+      {profile + "G42 D1 G70 Q100 X12 Z2\nM2\n",
+       "G70.0 cannot be used with cutter compensation enabled", 7},
+      {"G18 G21 F100\nO100 sub\nG0 X5 Z1\nG71 Q100 X3 Z2\nG1 Z-3\nO100 endsub\n"
+       "G71 Q100 X12 Z2\nM2\n",
+       "G71.0 cannot be used in the profile of another G7x cycle", 4},
+  };
+  for (const auto& c : cases) {
+    Interpreter interp;
+    ASSERT_FALSE(interp.open_string(c.text, "c.ngc"));
+    NullSink sink;
+    const auto error = run_program(interp, sink);
+    ASSERT_TRUE(error) << c.message;
+    EXPECT_EQ(error->message, c.message);
+    EXPECT_EQ(error->line, c.line);
+  }
 }
 
 // The whole path the daemon uses: program -> canon -> MachineTracker -> machine moves.
