@@ -15,7 +15,7 @@ namespace cncd::interp {
 struct G7xRun {
   int code = 0;
   double d = 0, e = 0, i = 1, r = 0.5;
-  int passes = 1;
+  double passes = 1;  // G70's P, fractions kept
   Pose start{};
   std::size_t depth = 0;  // the call level of the profile subroutine
   // The profile's moves in (x, z): u = x, v = z; an arc's ccw turns from +X toward +Z.
@@ -73,7 +73,7 @@ void Interpreter::Impl::do_g7x(int code) {
   if (block_.has('e')) run->e = block_.get('e');
   if (block_.has('i')) run->i = block_.get('i');
   if (block_.has('r')) run->r = block_.get('r');
-  if (block_.has('p')) run->passes = to_int(block_.get('p'));
+  if (block_.has('p')) run->passes = block_.get('p');
   run->start = target_from_words();
   emit_straight(StraightKind::traverse, run->start);
   run->last = {run->start[kX], run->start[kZ]};
@@ -206,8 +206,10 @@ void Interpreter::Impl::finish_g7x() {
     return entry;
   };
   if (family == 70) {
-    for (int pass = 1; pass <= run.passes; ++pass) {
-      const double distance = run.d - (run.d - run.e) * pass / run.passes;
+    // Whole passes, the last at E, each (D - E) / P nearer than the one before.
+    const int count = to_int(run.passes);
+    for (int pass = 1; pass <= count; ++pass) {
+      const double distance = run.e + (run.d - run.e) * (count - pass) / run.passes;
       const g7x::Path path = path_at(distance);
       approach();
       moves.push_back({g7x::Move::Kind::traverse, g7x::line({}, path.front().a)});
