@@ -260,44 +260,6 @@ TEST(InterpreterApi, MdiKeepsModalStateAndNeedsNoProgramEnd) {
   EXPECT_FALSE(run_program(interp, printer).has_value());
 }
 
-TEST(InterpreterApi, UnsupportedFeaturesAreRejectedNotIgnored) {
-  for (const char* line : {"G70 Q1", "G71 Q1", "G72 Q1"}) {
-    Interpreter interp;
-    ASSERT_FALSE(interp.open_string(std::string(line) + "\nM2\n", "u.ngc"));
-    NullSink sink;
-    const auto error = run_program(interp, sink);
-    ASSERT_TRUE(error) << line;
-    EXPECT_NE(error->message.find("is not supported"), std::string::npos) << error->message;
-  }
-}
-
-// Lathe cycles cncd refuses where rs274 goes on: G70 under cutter compensation (rs274
-// compensates the finishing pass; here the profile read would already be compensated), and a
-// cycle in the profile of another (rs274 prints a muddle of both).
-TEST(InterpreterApi, LatheCyclesRefusedWhereTheyCannotBeRight) {
-  const std::string profile = "G18 G21 F100\nO100 sub\nG0 X5 Z1\nG1 Z-5\nX12\nO100 endsub\n";
-  const struct {
-    std::string text;
-    const char* message;
-    int line;
-  } cases[] = {
-      {profile + "G42 D1 G70 Q100 X12 Z2\nM2\n",
-       "G70.0 cannot be used with cutter compensation enabled", 7},
-      {"G18 G21 F100\nO100 sub\nG0 X5 Z1\nG71 Q100 X3 Z2\nG1 Z-3\nO100 endsub\n"
-       "G71 Q100 X12 Z2\nM2\n",
-       "G71.0 cannot be used in the profile of another G7x cycle", 4},
-  };
-  for (const auto& c : cases) {
-    Interpreter interp;
-    ASSERT_FALSE(interp.open_string(c.text, "c.ngc"));
-    NullSink sink;
-    const auto error = run_program(interp, sink);
-    ASSERT_TRUE(error) << c.message;
-    EXPECT_EQ(error->message, c.message);
-    EXPECT_EQ(error->line, c.line);
-  }
-}
-
 // The whole path the daemon uses: program -> canon -> MachineTracker -> machine moves.
 TEST(InterpreterApi, MachineTrackerFollowsOffsetsUnitsAndToolLength) {
   struct Machine final : CanonSink {

@@ -99,12 +99,6 @@ TEST(Errors, Wording) {
   });
 }
 
-TEST(Errors, UnsupportedFeaturesAreRejected) {
-  expect_errors({
-      {"G72 Q1\nM2\n", "G72 is not supported"},
-  });
-}
-
 TEST(Comments, LastCommentOfALineAndMessages) {
   const std::string canon = canon_of("(first)(second)\n(MSG, Hello There)\nG0 X1 ; trailing\nM2\n");
   EXPECT_NE(canon.find("COMMENT(\"second\")"), std::string::npos);
