@@ -310,7 +310,9 @@ PathReference planned_optimal(const config::MachineConfig& machine,
   PathReference out;
   out.move_s.assign(moves, 0.0);
   Grid grid(machine, ReferenceOptions{});
-  std::size_t done = 0;  // programmed moves complete before the current segment
+  std::size_t done = 0;   // programmed moves complete before the current segment
+  bool piece_of = false;  // the segment before was a blend arc
+  const Segment* previous = nullptr;
   for (const Segment& seg : planned) {
     const auto index = static_cast<std::uint32_t>(std::min(done, moves - 1));
     if (seg.kind == Segment::Kind::dwell) {
@@ -327,7 +329,12 @@ PathReference planned_optimal(const config::MachineConfig& machine,
       } else {
         grid.limit(seg.junction_velocity * seg.junction_velocity);
       }
-      if (seg.kind == Segment::Kind::blend) ++out.blends;
+      // An arc the planner runs in pieces (each sized for its own speeds) is one blend.
+      if (blend && !(piece_of && previous->blend_center == seg.blend_center &&
+                     previous->radius == seg.radius))
+        ++out.blends;
+      piece_of = blend;
+      previous = &seg;
     }
     done += seg.moves;
   }

@@ -313,11 +313,11 @@ void Planner::emit_held(const Segment& prev, double start_speed, double limit_af
     // (reach_speed backwards).
     Segment& blend = pending_blend_->segment;
     Segment sized = blend;
-    set_blend_limits(sized, pending_blend_->entry_speed, reach_speed(prev, end));
+    const double exit = reach_speed(prev, end);
+    set_blend_limits(sized, pending_blend_->entry_speed, exit);
     // The segments after it were planned with its earlier speed limit: never above that.
     if (sized.axis_velocity <= blend.axis_velocity) blend = sized;
-    start_speed = std::min(start_speed, blend.axis_velocity);
-    output_.push_back(blend);
+    start_speed = std::min(start_speed, emit_blend(blend, pending_blend_->entry_speed, exit));
     pending_blend_.reset();
   }
   if (push) output_.push_back(prev);

@@ -1,7 +1,8 @@
 // Speed and acceleration limits of blend arcs and fillets: the centripetal and tangential parts
 // of the acceleration within every axis's limit at every point of the arc, sized for the
 // fastest speed the arc can be run at, and lowered to what the segments around it let through
-// once both of its neighbours are known.
+// once both of its neighbours are known; an arc held below its top speed by those runs in
+// pieces, each sized for the speeds the path can have on it.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -51,7 +52,8 @@ double tangential_limit(const AxisShare& axis, double centripetal) {
 
 }  // namespace
 
-void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_speed) const {
+void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_speed,
+                               double top) const {
   // Along the arc the acceleration on axis i is a_t T_i + a_n N_i, a_t the tangential part (of
   // either sign, at most the arc's acceleration limit) and a_n = v^2 / r the centripetal part
   // (from 0 up to what the arc's speed limit needs). Each axis stays within its limit at every
@@ -134,7 +136,8 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
     cap = std::min(v, std::sqrt(centripetal * blend.radius));
     accel = tangential(centripetal);
   };
-  const double fastest = blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v;
+  const double fastest =
+      std::min(top, blend.feed > 0 ? std::min(v, blend.feed * config_.max_feed_override) : v);
   limits(fastest, blend.axis_velocity, blend.max_acceleration);
   auto set_feed_limit = [&blend] {
     blend.max_velocity =
@@ -185,6 +188,75 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
   blend.axis_velocity = hi_cap;
   blend.max_acceleration = hi_accel;
   set_feed_limit();
+}
+
+double Planner::emit_blend(const Segment& blend, double entry, double exit) {
+  if (jerk_ > 0 || !(std::min(entry, exit) < blend.axis_velocity) || !(blend.length > 0)) {
+    output_.push_back(blend);
+    return blend.axis_velocity;
+  }
+  // The pieces follow one another along the arc's circle, each a blend arc of its own whose
+  // u and v are the arc's turned to where it starts; the arc's move count and its end junction
+  // go with the last, its outputs with the first.
+  constexpr int n = kBlendPieces;
+  std::array<Segment, n> pieces;
+  std::array<double, n> most_accel{};  // the most tangential acceleration each piece may get
+  const double step = blend.sweep / n;
+  auto point = [&blend](double phi) {
+    AxisPose p{};
+    for (int i = 0; i < kAxes; ++i)
+      p[i] = blend.blend_center[i] +
+             blend.radius * (std::cos(phi) * blend.blend_u[i] + std::sin(phi) * blend.blend_v[i]);
+    return p;
+  };
+  for (int k = 0; k < n; ++k) {
+    Segment& piece = pieces[static_cast<std::size_t>(k)];
+    piece = blend;
+    const double from = step * k;
+    const double c = std::cos(from), s = std::sin(from);
+    for (int i = 0; i < kAxes; ++i) {
+      piece.blend_u[i] = c * blend.blend_u[i] + s * blend.blend_v[i];
+      piece.blend_v[i] = -s * blend.blend_u[i] + c * blend.blend_v[i];
+    }
+    piece.sweep = step;
+    piece.length = blend.length / n;
+    piece.start = k == 0 ? blend.start : pieces[static_cast<std::size_t>(k) - 1].end;
+    piece.end = k == n - 1 ? blend.end : point(step * (k + 1));
+    piece.start_direction =
+        k == 0 ? blend.start_direction : pieces[static_cast<std::size_t>(k) - 1].end_direction;
+    for (int i = 0; i < kAxes; ++i)
+      piece.end_direction[i] =
+          -std::sin(step) * piece.blend_u[i] + std::cos(step) * piece.blend_v[i];
+    if (k == n - 1) piece.end_direction = blend.end_direction;
+    piece.moves = k == n - 1 ? blend.moves : 0;
+    piece.continuous = k == n - 1 ? blend.continuous : true;
+    if (k > 0) piece.sync = {};
+    // With no centripetal part all of the acceleration is left along the path.
+    Segment crawl = piece;
+    set_blend_limits(crawl, 1e300, 1e300, 0.0);
+    most_accel[static_cast<std::size_t>(k)] =
+        std::max(crawl.max_acceleration, blend.max_acceleration);
+  }
+  const double dt = static_cast<double>(config_.servo_period_ns) * 1e-9;
+  double bound_in = entry;
+  for (int k = 0; k < n; ++k) {
+    Segment& piece = pieces[static_cast<std::size_t>(k)];
+    // No profile leaves the piece faster than the rest of the arc lets the path slow down to
+    // `exit`, at the most acceleration each piece after it may get.
+    double run = 0, margin = 0;
+    for (int j = k + 1; j < n; ++j) {
+      run += 2.0 * most_accel[static_cast<std::size_t>(j)] * piece.length;
+      margin = std::max(margin, 2.0 * most_accel[static_cast<std::size_t>(j)] * dt);
+    }
+    const double bound_out = k == n - 1 ? exit : std::sqrt(exit * exit + run) + margin;
+    Segment sized = piece;
+    // Never above the arc's speed limit, which the segments around it were planned with.
+    set_blend_limits(sized, bound_in, bound_out, blend.axis_velocity);
+    if (sized.max_acceleration >= blend.max_acceleration) piece = sized;
+    bound_in = reach_speed(piece, bound_in);
+    output_.push_back(piece);
+  }
+  return pieces[n - 1].axis_velocity;
 }
 
 }  // namespace cncd::motion

@@ -77,18 +77,35 @@ double centripetal_share(const config::MachineConfig& config, const Segment& arc
   return worst;
 }
 
-// Two corners joined by a short line, planned: their blend arcs and the line between them.
+// Two corners joined by a short line, planned: their blend arcs (each in pieces where the
+// speeds at its ends keep it below its top speed) and the line between them.
 struct TwoCorners {
-  Segment first, second, between;
+  std::vector<Segment> first, second;
+  Segment between;
 };
 TwoCorners two_corners(const config::MachineConfig& config, const std::vector<AxisPose>& points) {
-  std::vector<Segment> arcs;
+  std::vector<std::vector<Segment>> arcs;
   std::vector<Segment> lines;
-  for (const auto& seg : plan_path(config, AxisPose{}, points, 0.1))
-    (seg.kind == Segment::Kind::blend ? arcs : lines).push_back(seg);
+  bool in_arc = false;
+  for (const auto& seg : plan_path(config, AxisPose{}, points, 0.1)) {
+    const bool arc = seg.kind == Segment::Kind::blend;
+    if (arc && !in_arc) arcs.emplace_back();
+    if (arc) arcs.back().push_back(seg);
+    if (!arc) lines.push_back(seg);
+    in_arc = arc;
+  }
   EXPECT_EQ(arcs.size(), 2u);
   EXPECT_EQ(lines.size(), 3u);
   if (arcs.size() != 2 || lines.size() != 3) return {};
+  // The pieces of an arc follow on from one another along one circle.
+  for (const auto& pieces : arcs) {
+    for (std::size_t k = 1; k < pieces.size(); ++k) {
+      EXPECT_EQ(pieces[k].start, pieces[k - 1].end);
+      EXPECT_NEAR(pieces[k].radius, pieces[0].radius, 1e-12);
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(pieces[k].blend_center[i], pieces[0].blend_center[i], 1e-12);
+    }
+  }
   return {arcs[0], arcs[1], lines[1]};
 }
 
@@ -127,10 +144,16 @@ TEST(BlendLoad, AnArcEnteredBelowItsTopSpeedGetsMoreTangentialAcceleration) {
   const AxisPose a{10, 0, 0};
   const AxisPose b = step(a, 120, 2);  // 120 degrees at a, then 20 at b
   const auto corners = two_corners(config, {a, b, step(b, 140, 10)});
+  ASSERT_FALSE(corners.second.empty());
   // The same gentle corner at the end of the same 2 mm line, entered straight on from further
   // back (no corner before it): the arc sized for its top speed.
   const Segment top = last_arc(config, step(b, 120, -40), {step(b, 120, -2), b, step(b, 140, 10)});
-  expect_sized_for_neighbour(config, corners.second, top, corners.first, corners.between);
+  expect_sized_for_neighbour(config, corners.second.front(), top, corners.first.back(),
+                             corners.between);
+  // The arc's slow end, near the sharp corner, is sized for a lower speed than its fast end
+  // (its centripetal part takes less, the part along the path more).
+  ASSERT_EQ(corners.second.size(), 4u);
+  EXPECT_LT(corners.second.front().axis_velocity, corners.second.back().axis_velocity);
 }
 
 // A gentle corner, a short line, then a sharp corner: the gentle corner's arc can be left no
@@ -142,8 +165,12 @@ TEST(BlendLoad, AnArcLeftBelowItsTopSpeedGetsMoreTangentialAcceleration) {
   const AxisPose c = step(b, 20, 2.3);  // 20 degrees at b, then 120 at c
   const auto corners = two_corners(config, {b, c, step(c, 140, 10)});
   // The same gentle corner followed by a long straight line: sized for its top speed.
+  ASSERT_FALSE(corners.first.empty());
   const Segment top = last_arc(config, AxisPose{}, {b, step(b, 20, 50)});
-  expect_sized_for_neighbour(config, corners.first, top, corners.second, corners.between);
+  expect_sized_for_neighbour(config, corners.first.back(), top, corners.second.front(),
+                             corners.between);
+  ASSERT_EQ(corners.first.size(), 4u);
+  EXPECT_LT(corners.first.back().axis_velocity, corners.first.front().axis_velocity);
 }
 
 // Under S-curve profiles a speed limit just above the speeds the path reaches still costs time
@@ -156,9 +183,10 @@ TEST(BlendLoad, UnderAJerkLimitAnArcKeepsItsTopLimits) {
   const AxisPose b{50, 0, 0};
   const AxisPose c = step(b, 20, 2.3);
   const auto corners = two_corners(config, {b, c, step(c, 140, 10)});
+  ASSERT_EQ(corners.first.size(), 1u);
   const Segment top = last_arc(config, AxisPose{}, {b, step(b, 20, 50)});
-  EXPECT_DOUBLE_EQ(corners.first.axis_velocity, top.axis_velocity);
-  EXPECT_DOUBLE_EQ(corners.first.max_acceleration, top.max_acceleration);
+  EXPECT_DOUBLE_EQ(corners.first[0].axis_velocity, top.axis_velocity);
+  EXPECT_DOUBLE_EQ(corners.first[0].max_acceleration, top.max_acceleration);
   EXPECT_NEAR(top.axis_velocity, std::sqrt(0.95 * 2000 * top.radius), 1e-9);
   EXPECT_GE(top.max_acceleration, std::sqrt(1 - 0.95 * 0.95) * 2000 * (1 - 1e-12));
   EXPECT_LE(worst_load(config, top), 1 + 1e-9);
@@ -213,7 +241,16 @@ TEST(BlendLoad, RandomDensePathsKeepEveryAxisWithinItsLimitsOnTheArcs) {
       feeds.push_back(20 + 200 * unit(rng));
     }
     const double tolerance = 0.01 + 0.2 * unit(rng);
-    for (const auto& seg : plan_path(config, AxisPose{}, points, tolerance, feeds)) {
+    const auto planned = plan_path(config, AxisPose{}, points, tolerance, feeds);
+    // Every programmed move counted once, arcs in pieces or not, and the path continuous.
+    std::uint32_t moves = 0;
+    for (std::size_t k = 0; k < planned.size(); ++k) {
+      moves += planned[k].moves;
+      for (int i = 0; k > 0 && i < 3; ++i)
+        EXPECT_NEAR(planned[k].start[i], planned[k - 1].end[i], 1e-9) << "trial " << trial;
+    }
+    EXPECT_EQ(moves, points.size()) << "trial " << trial;
+    for (const auto& seg : planned) {
       if (seg.kind != Segment::Kind::blend) continue;
       ++arcs;
       // Within the limits, and at them on some axis somewhere: each arc takes all its sweep

@@ -88,8 +88,10 @@ class Planner {
   // of the segments before and after it can enter and leave the arc; where they keep it
   // below the arc's speed limit, the centripetal part is sized for the fastest such profile
   // and the tangential part gets the rest.
-  void set_blend_limits(Segment& blend, double entry_speed = 1e300,
-                        double exit_speed = 1e300) const;
+  // `top`: the centripetal part is never sized for more than this speed (a piece of an arc
+  // whose limits the segments around it were planned with).
+  void set_blend_limits(Segment& blend, double entry_speed = 1e300, double exit_speed = 1e300,
+                        double top = 1e300) const;
   // Joins the held segment to `next` (a planned move): marks a tangent junction, or inserts
   // a blend arc (trimming both lines), or leaves a stop. Emits the held segment.
   void join(Segment& next, const Move& move);
@@ -163,6 +165,13 @@ class Planner {
   // again now that what follows it is known: it cannot be left faster than prev lets the path
   // slow down to its end junction. `push` false: the blend after prev used it up.
   void emit_held(const Segment& prev, double start_speed, double limit_after, bool push = true);
+  // Emits the blend arc or fillet `blend` (its limits final for the bounds `entry` and `exit`
+  // on the speeds at its ends) in kBlendPieces pieces where those bounds keep it below its top
+  // speed: each piece's centripetal part sized for the fastest speed the path can have there,
+  // so the slow end of the arc keeps more of the acceleration for speeding up or slowing down.
+  // Returns the speed limit of the last piece.
+  double emit_blend(const Segment& blend, double entry, double exit);
+  static constexpr int kBlendPieces = 4;
   // The fastest `seg` can be at one end when it is at most `bound` at the other: its speed
   // limit, or bound^2 + 2 a length, with two servo periods' acceleration as a margin for the
   // servo loop's steps.
