@@ -123,8 +123,12 @@ Segment last_arc(const config::MachineConfig& config, const AxisPose& start,
 void expect_sized_for_neighbour(const config::MachineConfig& config, const Segment& soft,
                                 const Segment& top, const Segment& sharp, const Segment& between) {
   EXPECT_NEAR(top.radius, soft.radius, 1e-9);
-  // At its top speed the centripetal part takes 0.95 of what the axes allow.
-  EXPECT_NEAR(centripetal_share(config, top), 0.95, 1e-4);
+  // At its top speed the centripetal part takes 0.98 of what the axes allow, or as much as
+  // leaves the tangential part 0.1 of the plane's smallest limit (2000).
+  const double share = centripetal_share(config, top);
+  EXPECT_LE(share, 0.98 + 1e-4);
+  EXPECT_TRUE(share > 0.98 - 1e-4 || std::abs(top.max_acceleration - 0.1 * 2000) < 1e-6)
+      << share << " " << top.max_acceleration;
   // Between the sharp corner and the arc the speed changes by at most sqrt(v_sharp^2 + 2 a L):
   // the arc keeps a speed limit at least that high (plus its own speeding up or slowing down)
   // and gets much more of the acceleration along the path.
@@ -195,8 +199,8 @@ TEST(BlendLoad, UnderAJerkLimitAnArcKeepsItsTopLimits) {
 // A corner in the YZ plane, the path climbing along Z and turning by 50 degrees about it: along
 // the arc the tangent lies mostly along Z (1000 mm/s^2) and the normal mostly along Y (2000).
 // Each axis is held to its limit at every point of the sweep, not the plane to its smallest:
-// the centripetal part takes 0.95 of what Y allows where the normal lies along Y, and the arc
-// runs sqrt(2) times faster than sqrt(0.95 x 1000 r), Z keeping more than 0.1 of its limit
+// the centripetal part takes 0.98 of what Y allows where the normal lies along Y, and the arc
+// runs sqrt(2) times faster than sqrt(0.98 x 1000 r), Z keeping more than 0.1 of its limit
 // for speeding up and slowing down.
 TEST(BlendLoad, AnArcHoldsEachAxisToItsOwnLimit) {
   const auto config = small_mill();
@@ -205,9 +209,9 @@ TEST(BlendLoad, AnArcHoldsEachAxisToItsOwnLimit) {
   const AxisPose c{0, b[1] + 20 * std::sin(tilt), b[2] + 20 * std::cos(tilt)};
   const Segment arc = last_arc(config, AxisPose{}, {b, c});
   ASSERT_GT(arc.radius, 0.5);
-  EXPECT_NEAR(centripetal_share(config, arc), 0.95, 1e-4);
-  EXPECT_NEAR(arc.axis_velocity, std::sqrt(0.95 * 2000 * arc.radius), 1e-9);
-  EXPECT_GT(arc.axis_velocity, 1.4 * std::sqrt(0.95 * 1000 * arc.radius));
+  EXPECT_NEAR(centripetal_share(config, arc), 0.98, 1e-4);
+  EXPECT_NEAR(arc.axis_velocity, std::sqrt(0.98 * 2000 * arc.radius), 1e-9);
+  EXPECT_GT(arc.axis_velocity, 1.4 * std::sqrt(0.98 * 1000 * arc.radius));
   EXPECT_GT(arc.max_acceleration, 0.1 * 1000);
   EXPECT_LE(worst_load(config, arc), 1 + 1e-9);
   EXPECT_GT(worst_load(config, arc), 0.999);

@@ -67,6 +67,9 @@ class Planner {
   // the normal, and what is left along the path is found axis by axis (blend_limits.cpp).
   static constexpr double kArcNormalShare = 0.8;
   static constexpr double kBlendNormalShare = 0.95;
+  // Under trapezoidal profiles, where an arc below its top speed runs in pieces sized for the
+  // speeds on them (emit_blend), the centripetal part may take more at the top.
+  static constexpr double kBlendNormalShareTrapezoidal = 0.98;
   // A blend arc's centripetal part stops short of kBlendNormalShare where the tangential part
   // would keep less than this share of the plane's smallest acceleration limit.
   static constexpr double kBlendTangentialFloor = 0.1;
