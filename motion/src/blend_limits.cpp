@@ -113,15 +113,16 @@ void Planner::set_blend_limits(Segment& blend, double entry_speed, double exit_s
     return accel;
   };
   // The most the centripetal part may take: kBlendNormalShareTrapezoidal of what every axis
-  // allows (the pieces of emit_blend size an arc's slower parts for less), as
-  // long as the tangential part keeps kBlendTangentialFloor of the plane's smallest limit (a
-  // blend left with next to no tangential acceleration would slow everything that has to
-  // brake through it). Under S-curve profiles, where a segment of low acceleration ahead makes
-  // the path ease its acceleration off at the jerk limit, kBlendNormalShare of the plane's
-  // smallest limit, as if the two parts shared it: the tangential part keeps at least the
-  // sqrt(1 - share^2) of it that sharing would leave.
+  // allows (the pieces of emit_blend size an arc's slower parts for less), as long as the
+  // tangential part keeps kBlendTangentialFloorTrapezoidal of the plane's smallest limit
+  // (kBlendTangentialFloor under S-curve profiles; a blend left with next to no tangential
+  // acceleration would slow everything that has to brake through it). Under S-curve profiles, where
+  // a segment of low acceleration ahead makes the path ease its acceleration off at the jerk limit,
+  // kBlendNormalShare of the plane's smallest limit, as if the two parts shared it: the tangential
+  // part keeps at least the sqrt(1 - share^2) of it that sharing would leave.
   double most = jerk_ > 0 ? kBlendNormalShare * plane_a : kBlendNormalShareTrapezoidal * normal_a;
-  const double keep = kBlendTangentialFloor * plane_a;
+  const double keep =
+      (jerk_ > 0 ? kBlendTangentialFloor : kBlendTangentialFloorTrapezoidal) * plane_a;
   if (tangential(most) < keep) {
     double lo = 0;
     for (int step = 0; step < 40; ++step) {

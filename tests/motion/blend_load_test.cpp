@@ -124,10 +124,10 @@ void expect_sized_for_neighbour(const config::MachineConfig& config, const Segme
                                 const Segment& top, const Segment& sharp, const Segment& between) {
   EXPECT_NEAR(top.radius, soft.radius, 1e-9);
   // At its top speed the centripetal part takes 0.98 of what the axes allow, or as much as
-  // leaves the tangential part 0.1 of the plane's smallest limit (2000).
+  // leaves the tangential part 0.05 of the plane's smallest limit (2000).
   const double share = centripetal_share(config, top);
   EXPECT_LE(share, 0.98 + 1e-4);
-  EXPECT_TRUE(share > 0.98 - 1e-4 || std::abs(top.max_acceleration - 0.1 * 2000) < 1e-6)
+  EXPECT_TRUE(share > 0.98 - 1e-4 || std::abs(top.max_acceleration - 0.05 * 2000) < 1e-6)
       << share << " " << top.max_acceleration;
   // Between the sharp corner and the arc the speed changes by at most sqrt(v_sharp^2 + 2 a L):
   // the arc keeps a speed limit at least that high (plus its own speeding up or slowing down)

@@ -73,6 +73,9 @@ class Planner {
   // A blend arc's centripetal part stops short of kBlendNormalShare where the tangential part
   // would keep less than this share of the plane's smallest acceleration limit.
   static constexpr double kBlendTangentialFloor = 0.1;
+  // Under trapezoidal profiles, where an arc below its top speed runs in pieces and the
+  // servo loop's backward pass brakes through whatever an arc leaves, a lower floor.
+  static constexpr double kBlendTangentialFloorTrapezoidal = 0.05;
   // A curve of `radius` in a plane whose acceleration limit is `plane_a`, never faster than
   // `fastest` (in-plane speed, units/s): the centripetal part gets what `fastest` needs, at
   // most `max_normal` of the limit, and the tangential part what is left, at right angles, so
