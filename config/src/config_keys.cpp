@@ -3,6 +3,7 @@
 #include <array>
 
 #include "key_makers.hpp"
+#include "kins_key_specs.hpp"
 #include "panel_key_specs.hpp"
 #include "telemetry_key_specs.hpp"
 
@@ -73,7 +74,8 @@ constexpr std::array kMachineKeys{
     bool_key("TRAJ", "NO_FORCE_HOMING", "0", "Allow programs and MDI before the machine is homed"),
     text_key("KINS", "KINEMATICS", "",
              "Kinematics module and its arguments: trivkins (e.g. trivkins coordinates=XYYZ, a "
-             "gantry) or corexykins (joint 0 = X + Y, joint 1 = X - Y); docs/kinematics.md"),
+             "gantry), corexykins (joint 0 = X + Y, joint 1 = X - Y), xyzac-trt-kins or "
+             "xyzbc-trt-kins (a tilting rotary table, TCP with M428); docs/kinematics.md"),
     integer_key("KINS", "JOINTS", "", 1, 16, "", "Number of joints (motors)"),
     real_key("DISPLAY", "MAX_FEED_OVERRIDE", "1.0", 0, 10, "ratio",
              "Highest feed override an operator may set; 1.2 = 120 %"),
@@ -388,7 +390,8 @@ constexpr std::array kMachineKeys{
                 "Repeats of a failed request before the drive is faulted"),
 };
 
-constexpr auto kKeys = panel_keys::with_panel_keys(join_keys(kMachineKeys, kTelemetryKeys));
+constexpr auto kKeys = panel_keys::with_panel_keys(
+    join_keys(join_keys(kMachineKeys, kins_keys::kKinsKeys), kTelemetryKeys));
 
 bool matches_section(std::string_view pattern, std::string_view section) {
   if (pattern == "JOINT_n") return section.starts_with("JOINT_") && section.size() > 6;

@@ -11,6 +11,9 @@ namespace cncd::config {
 struct KinsChoice {
   bool ok = false;      // a module cncd has, with arguments it could read
   bool corexy = false;  // corexykins: joints 0 and 1 are X + Y and X - Y
+  // xyzac-trt-kins ('A') or xyzbc-trt-kins ('B'): joints X Y Z, the tilting axis and C; '\0'
+  // for the others.
+  char tilt = '\0';
   std::string module;
   std::string args;
   std::string coordinates;  // trivkins coordinates= letters, upper case; empty: not given
@@ -23,7 +26,12 @@ KinsChoice load_kinematics(TypedReader& r);
 // or an extra joint), with the problems of JOINTS and [TRAJ] COORDINATES against it. trivkins:
 // the letters of coordinates=, without it joint n drives the n-th of XYZABCUVW, and a gantry
 // written only in [TRAJ] COORDINATES (XYYZ) is taken as that joint list. corexykins: joints 0
-// and 1 are the X + Y and X - Y motors, joint n >= 2 the n-th of XYZABCUVW.
+// and 1 are the X + Y and X - Y motors, joint n >= 2 the n-th of XYZABCUVW. Table-rotary:
+// joints 0-4 are X Y Z A C (xyzac) or X Y Z B C (xyzbc).
 std::string joint_map(TypedReader& r, const KinsChoice& k, MachineConfig& c);
+
+// A table-rotary machine's geometry ([KINS] X_ROT_POINT ... TOOL_OFFSET) and [TRAJ]
+// TCP_TOLERANCE; nothing for the other modules.
+void load_table_rotary(TypedReader& r, const KinsChoice& k, MachineConfig& c);
 
 }  // namespace cncd::config

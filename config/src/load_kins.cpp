@@ -11,14 +11,14 @@
 namespace cncd::config {
 namespace {
 
-constexpr std::string_view kSupported = "cncd supports trivkins and corexykins";
+constexpr std::string_view kSupported =
+    "cncd supports trivkins, corexykins, xyzac-trt-kins and xyzbc-trt-kins";
 
 // LinuxCNC's other kinematics modules (man 9 kins): known, not (yet) cncd's.
-constexpr std::array<std::string_view, 16> kLinuxCncModules = {
-    "genhexkins",     "genserkins",     "lineardeltakins", "maxkins",
-    "pentakins",      "pumakins",       "rosekins",        "rotarydeltakins",
-    "rotatekins",     "scarakins",      "tripodkins",      "xyzab_tdr_kins",
-    "xyzac-trt-kins", "xyzbc-trt-kins", "5axiskins",       "millturn"};
+constexpr std::array<std::string_view, 14> kLinuxCncModules = {
+    "genhexkins", "genserkins",     "lineardeltakins", "maxkins",    "pentakins",
+    "pumakins",   "rosekins",       "rotarydeltakins", "rotatekins", "scarakins",
+    "tripodkins", "xyzab_tdr_kins", "5axiskins",       "millturn"};
 
 // trivkins coordinates=LETTERS: false (with a problem) when one is no axis letter.
 bool read_coordinates(TypedReader& r, const std::string& value, KinsChoice& k) {
@@ -124,7 +124,52 @@ std::string corexy_map(TypedReader& r, const MachineConfig& c) {
   return std::string(2, '\0') + std::string(kAxisLetters.substr(2));
 }
 
+// xyzac-trt-kins and xyzbc-trt-kins: joints 0-4 are X, Y, Z, the tilting axis and C, as in
+// LinuxCNC; each of them an axis of [TRAJ] COORDINATES, written once.
+std::string table_rotary_map(TypedReader& r, const KinsChoice& k, const MachineConfig& c) {
+  const std::string map = std::string("XYZ") + k.tilt + "C";
+  const std::set<char> distinct(c.coordinates.begin(), c.coordinates.end());
+  if (distinct.size() != c.coordinates.size()) {
+    r.problem("TRAJ", "COORDINATES",
+              repeated_letters(c.coordinates) + " repeated, but " + k.module +
+                  " drives each axis with one joint and has no gantry; write each letter once");
+  }
+  for (const char letter : map) {
+    if (distinct.count(letter) == 0) {
+      r.problem("TRAJ", "COORDINATES",
+                "COORDINATES " + c.coordinates + " has no " + letter + ", but " + k.module +
+                    " moves " + map + " with joints 0 to 4");
+    }
+  }
+  if (c.joint_count - c.extra_joints < 5) {
+    r.problem("KINS", "JOINTS",
+              "JOINTS = " + std::to_string(c.joint_count) + " is too few: " + k.module +
+                  " needs joints 0 to 4 for " + map);
+  }
+  return map;
+}
+
 }  // namespace
+
+void load_table_rotary(TypedReader& r, const KinsChoice& k, MachineConfig& c) {
+  if (k.tilt == '\0') return;
+  TableRotaryConfig& t = c.table_rotary;
+  const auto read = [&](std::string_view key, double& into) {
+    if (const auto value = r.real("KINS", key)) into = *value;
+  };
+  read("X_ROT_POINT", t.x_rot_point);
+  read("Y_ROT_POINT", t.y_rot_point);
+  read("Z_ROT_POINT", t.z_rot_point);
+  read(k.tilt == 'A' ? "Y_OFFSET" : "X_OFFSET", k.tilt == 'A' ? t.y_offset : t.x_offset);
+  read("Z_OFFSET", t.z_offset);
+  read("TOOL_OFFSET", t.tool_offset);
+  if (const auto tolerance = r.real("TRAJ", "TCP_TOLERANCE")) t.tcp_tolerance = *tolerance;
+  const std::string_view other = k.tilt == 'A' ? "X_OFFSET" : "Y_OFFSET";
+  if (r.given("KINS", other)) {
+    r.warning("KINS", other,
+              std::string(other) + " is not a parameter of " + k.module + "; ignored");
+  }
+}
 
 KinsChoice load_kinematics(TypedReader& r) {
   KinsChoice k;
@@ -141,7 +186,9 @@ KinsChoice load_kinematics(TypedReader& r) {
     return k;
   }
   k.corexy = module == "corexykins";
-  if (module != "trivkins" && !k.corexy) {
+  if (module == "xyzac-trt-kins") k.tilt = 'A';
+  if (module == "xyzbc-trt-kins") k.tilt = 'B';
+  if (module != "trivkins" && !k.corexy && k.tilt == '\0') {
     const bool known = std::find(kLinuxCncModules.begin(), kLinuxCncModules.end(), module) !=
                        kLinuxCncModules.end();
     r.problem("KINS", "KINEMATICS",
@@ -159,12 +206,12 @@ KinsChoice load_kinematics(TypedReader& r) {
     const std::size_t equal = word.find('=');
     const std::string name = to_lower(word.substr(0, equal));
     const std::string value = equal == std::string::npos ? "" : word.substr(equal + 1);
-    if (!k.corexy && name == "coordinates") {
+    if (!k.corexy && k.tilt == '\0' && name == "coordinates") {
       if (!read_coordinates(r, value, k)) {
         k.ok = false;
         return k;
       }
-    } else if (k.corexy || name != "kinstype") {
+    } else if (k.corexy || name != (k.tilt != '\0' ? "sparm" : "kinstype")) {
       r.warning("KINS", "KINEMATICS",
                 "unknown " + module + " argument '" + printable(word) + "' ignored");
     }
@@ -173,7 +220,9 @@ KinsChoice load_kinematics(TypedReader& r) {
 }
 
 std::string joint_map(TypedReader& r, const KinsChoice& k, MachineConfig& c) {
-  std::string map = k.corexy ? corexy_map(r, c) : trivkins_map(r, k, c);
+  std::string map = k.corexy         ? corexy_map(r, c)
+                    : k.tilt != '\0' ? table_rotary_map(r, k, c)
+                                     : trivkins_map(r, k, c);
   const int kinematic_joints = c.joint_count - c.extra_joints;
   if (static_cast<int>(map.size()) > kinematic_joints) map.resize(std::max(0, kinematic_joints));
   const std::set<char> distinct(c.coordinates.begin(), c.coordinates.end());

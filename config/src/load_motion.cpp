@@ -206,6 +206,7 @@ void load_motion(TypedReader& r, MachineConfig& c) {
   }
   if (!k.ok) return;
   const std::string map = joint_map(r, k, c);
+  load_table_rotary(r, k, c);
 
   for (const char letter : kAxisLetters) {
     const bool driven = map.find(letter) != std::string::npos;

@@ -31,6 +31,8 @@ RateLimit joint_rate_limit(const config::JointConfig& joint,
 std::unique_ptr<const Kinematics> make_kinematics(const config::MachineConfig& config) {
   // The loader refuses every other module.
   if (config.kinematics == "corexykins") return make_corexykins(config);
+  if (config.kinematics == "xyzac-trt-kins" || config.kinematics == "xyzbc-trt-kins")
+    return make_trtkins(config);
   return make_trivkins(config);
 }
 

@@ -8,9 +8,11 @@
 
 namespace cncd::motion {
 
-// trivkins (kins_trivial.cpp) and corexykins (kins_corexy.cpp).
+// trivkins (kins_trivial.cpp), corexykins (kins_corexy.cpp), xyzac-trt-kins and
+// xyzbc-trt-kins (kins_trt.cpp).
 std::unique_ptr<const Kinematics> make_trivkins(const config::MachineConfig& config);
 std::unique_ptr<const Kinematics> make_corexykins(const config::MachineConfig& config);
+std::unique_ptr<const Kinematics> make_trtkins(const config::MachineConfig& config);
 
 // Every axis's own limits, one bound an axis in axis order (those the machine lacks too: no
 // move ever has a share along them).

@@ -1,5 +1,5 @@
-// [KINS] KINEMATICS: trivkins and corexykins load, every other module and every bad value is
-// refused at its FILE:LINE with the section, the key and what is wrong.
+// [KINS] KINEMATICS: trivkins, corexykins and the table-rotary modules load, every other module and
+// every bad value is refused at its FILE:LINE with the section, the key and what is wrong.
 #include <gtest/gtest.h>
 
 #include "cncd/config/machine_config.hpp"
@@ -71,14 +71,16 @@ TEST_F(KinematicsConfigTest, UnknownModuleIsRefused) {
   EXPECT_EQ(problems_with(10, "KINEMATICS = corexy"),
             problem_at(10,
                        "[KINS] KINEMATICS: kinematics 'corexy' is no kinematics module LinuxCNC or "
-                       "cncd knows; cncd supports trivkins and corexykins"));
+                       "cncd knows; cncd supports trivkins, corexykins, xyzac-trt-kins and "
+                       "xyzbc-trt-kins"));
 }
 
 TEST_F(KinematicsConfigTest, LinuxCncModulesCncdLacksAreRefused) {
-  for (const char* module : {"xyzac-trt-kins", "xyzbc-trt-kins", "genhexkins", "scarakins"}) {
+  for (const char* module : {"genhexkins", "scarakins", "5axiskins"}) {
     EXPECT_EQ(problems_with(10, std::string("KINEMATICS = ") + module + " coordinates=XYZAC"),
               problem_at(10, std::string("[KINS] KINEMATICS: kinematics '") + module +
-                                 "' is not supported; cncd supports trivkins and corexykins"));
+                                 "' is not supported; cncd supports trivkins, corexykins, "
+                                 "xyzac-trt-kins and xyzbc-trt-kins"));
   }
 }
 
@@ -123,6 +125,36 @@ TEST_F(KinematicsConfigTest, CorexyArgumentsAreIgnoredWithAWarning) {
 TEST_F(KinematicsConfigTest, TrivkinsBadCoordinatesAreRefused) {
   EXPECT_EQ(problems_with(10, "KINEMATICS = trivkins coordinates=XQZ"),
             problem_at(10, "[KINS] KINEMATICS: coordinates=XQZ: 'Q' is not an axis letter"));
+}
+
+TEST_F(KinematicsConfigTest, TheTrunnionExampleLoadsWithItsGeometry) {
+  const auto result =
+      load_machine_config(std::string(CNCD_CONFIG_EXAMPLES_DIR) + "/sim_xyzac_trt.ini");
+  ASSERT_TRUE(result.ok()) << ::testing::PrintToString(strings(result.problems));
+  EXPECT_TRUE(result.warnings.empty()) << ::testing::PrintToString(strings(result.warnings));
+  const MachineConfig& c = *result.config;
+  EXPECT_EQ(c.kinematics, "xyzac-trt-kins");
+  ASSERT_EQ(c.joints.size(), 5u);
+  EXPECT_EQ(c.joints[3].axis, 'A');
+  EXPECT_EQ(c.joints[4].axis, 'C');
+  EXPECT_EQ(c.table_rotary.y_offset, 20);
+  EXPECT_EQ(c.table_rotary.z_offset, 10);
+  EXPECT_EQ(c.table_rotary.tcp_tolerance, 0.005);
+}
+
+TEST_F(KinematicsConfigTest, TableRotaryNeedsItsFiveAxes) {
+  auto ini = replace_line(minimal_ini(), 10, "KINEMATICS = xyzbc-trt-kins");
+  EXPECT_EQ(problems_of(ini),
+            (std::vector<std::string>{
+                problem_at(6,
+                           "[TRAJ] COORDINATES: COORDINATES XYZ has no B, but xyzbc-trt-kins "
+                           "moves XYZBC with joints 0 to 4")[0],
+                problem_at(6,
+                           "[TRAJ] COORDINATES: COORDINATES XYZ has no C, but xyzbc-trt-kins "
+                           "moves XYZBC with joints 0 to 4")[0],
+                problem_at(11,
+                           "[KINS] JOINTS: JOINTS = 3 is too few: xyzbc-trt-kins needs joints 0 "
+                           "to 4 for XYZBC")[0]}));
 }
 
 }  // namespace

@@ -162,11 +162,10 @@ TEST_F(ValidationTest, UnknownDriver) {
 }
 
 TEST_F(ValidationTest, UnsupportedKinematics) {
-  EXPECT_EQ(
-      problems_with(10, "KINEMATICS = xyzac-trt-kins"),
-      problem_at(10,
-                 "[KINS] KINEMATICS: kinematics 'xyzac-trt-kins' is not supported; cncd supports "
-                 "trivkins and corexykins"));
+  EXPECT_EQ(problems_with(10, "KINEMATICS = pumakins"),
+            problem_at(10,
+                       "[KINS] KINEMATICS: kinematics 'pumakins' is not supported; cncd supports "
+                       "trivkins, corexykins, xyzac-trt-kins and xyzbc-trt-kins"));
 }
 
 TEST_F(ValidationTest, DisplayOverrideLimitsAreRead) {

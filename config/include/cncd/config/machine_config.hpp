@@ -46,6 +46,19 @@ struct AxisConfig {
   SourceRef source;
 };
 
+// The geometry of a table-rotary machine ([KINS] keys named as LinuxCNC's xyzac-trt-kins and
+// xyzbc-trt-kins pins; docs/kinematics.md). Machine units.
+struct TableRotaryConfig {
+  // Where the C axis (the rotary table's) crosses, relative to the machine's zero.
+  double x_rot_point = 0, y_rot_point = 0, z_rot_point = 0;
+  // From the C axis to the tilting axis: Y and Z for A (xyzac), X and Z for B (xyzbc).
+  double x_offset = 0, y_offset = 0, z_offset = 0;
+  // From the tool tip the table turns about up to the controlled point, along the spindle.
+  double tool_offset = 0;
+  // [TRAJ] TCP_TOLERANCE: how far the tool tip may leave a programmed line under TCP.
+  double tcp_tolerance = 0.005;
+};
+
 struct JointConfig {
   JointType type = JointType::linear;
   // The axis this joint drives (trivkins joint map); '\0' for an extra joint that no axis
@@ -299,8 +312,10 @@ struct MachineConfig {
   std::filesystem::path position_file_seed;
   bool no_force_homing = false;
   // [KINS]
-  std::string kinematics = "trivkins";  // module name only: "trivkins" or "corexykins"
-  std::string kinematics_args;          // the rest, e.g. "coordinates=XYYZ kinstype=both"
+  // Module name only: "trivkins", "corexykins", "xyzac-trt-kins" or "xyzbc-trt-kins".
+  std::string kinematics = "trivkins";
+  std::string kinematics_args;     // the rest, e.g. "coordinates=XYYZ kinstype=both"
+  TableRotaryConfig table_rotary;  // xyzac-trt-kins and xyzbc-trt-kins
   int joint_count = 0;
   int extra_joints = 0;  // [EMCMOT] EMCMOT = motmod num_extrajoints=N
   // [DISPLAY]

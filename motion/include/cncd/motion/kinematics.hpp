@@ -7,6 +7,9 @@
 // trivkins: each joint drives one axis (coordinates= or [TRAJ] COORDINATES; a letter repeated
 // is a gantry, its first joint leads the axis). corexykins: joint 0 = X + Y and joint 1 =
 // X - Y (the two belt motors), joint n = the n-th of XYZABCUVW from joint 2 on.
+// xyzac-trt-kins, xyzbc-trt-kins: joints 0-4 drive X Y Z A C (X Y Z B C) one to one, as
+// LinuxCNC's identity mode; under TCP (M428) the planner turns the programmed tool tip into
+// those joints with tcp_inverse() (docs/kinematics.md).
 #pragma once
 
 #include <array>
@@ -78,10 +81,25 @@ class Kinematics {
   virtual std::span<const RateLimit> rate_limits() const noexcept = 0;
   // Bit i set: axis i shares a joint with another axis (corexy's X and Y).
   virtual std::uint32_t coupled_axes() const noexcept = 0;
+
+  // Tool centre point control (the table-rotary modules). `machine`: the pose the joints
+  // give (forward()'s axes: where the tool's controlled point stands and the rotaries'
+  // angles); `part`: the tool tip in the part's frame, the coordinates the part would have
+  // with every rotary at 0, the rotaries' angles the same. Without TCP both are the identity.
+  virtual bool has_tcp() const noexcept { return false; }
+  // RT. The part pose of a machine pose.
+  CNCD_RT virtual void tcp_forward(const AxisPose& machine, AxisPose& part) const noexcept {
+    part = machine;
+  }
+  // RT. The machine pose that puts the tool tip at a part pose.
+  CNCD_RT virtual void tcp_inverse(const AxisPose& part, AxisPose& machine) const noexcept {
+    machine = part;
+  }
 };
 
 // Non-RT. The kinematics [KINS] KINEMATICS names (config::MachineConfig::kinematics, which the
-// config loader has checked): trivkins with its joint map (JointConfig::axis), or corexykins.
+// config loader has checked): trivkins with its joint map (JointConfig::axis), corexykins,
+// xyzac-trt-kins or xyzbc-trt-kins (MachineConfig::table_rotary).
 std::unique_ptr<const Kinematics> make_kinematics(const config::MachineConfig& config);
 
 }  // namespace cncd::motion
