@@ -102,8 +102,8 @@ void VirtualMachine::flush() {
 
 void VirtualMachine::pump() {
   auto& out = planner_.output();
-  while (!out.empty()) {
-    ASSERT_TRUE(loop_->segments().push(out.front()));
+  // A full ring takes the rest as the loop makes room (run_until_idle()).
+  while (!out.empty() && loop_->segments().push(out.front())) {
     out.pop_front();
     ++pushed_;
   }
@@ -122,7 +122,9 @@ int VirtualMachine::run_until_idle(int max_cycles) {
     loop_->cycle(0);
     const auto s = loop_->status();
     trajectory_.push_back(s.commanded);
-    if (s.motion == motion::MotionState::idle && s.queued == 0) return i + 1;
+    pump();
+    if (s.motion == motion::MotionState::idle && s.queued == 0 && planner_.output().empty())
+      return i + 1;
   }
   ADD_FAILURE() << "motion did not finish within " << max_cycles << " cycles";
   return max_cycles;

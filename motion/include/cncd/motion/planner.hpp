@@ -40,6 +40,12 @@ class Planner {
   std::optional<Segment> plan(const Move& move, const AxisPose& start, bool check_limits,
                               std::string& error) const;
 
+  // Under TCP (Move::tcp on a table-rotary machine): whether every joint stays within its
+  // [JOINT_n] soft limits along `move`, planned from the tool tip at `start` (the part's
+  // frame), as push() checks it. False with `error` (the joint and where) when one does not;
+  // true for every other move.
+  bool tcp_joints_within_limits(const Move& move, const AxisPose& start, std::string& error) const;
+
   // Forgets any held move and output, and starts the next move at `start`.
   void reset(const AxisPose& start);
   // Plans `move` from where the last pushed move ends. The segments that are final go to
@@ -146,6 +152,25 @@ class Planner {
   // are trimmed by their start or end angle. False when no fillet fits; nothing changes then.
   // arc_blend.cpp.
   bool fillet(Held& held, Segment& next);
+
+  // Tool centre point control (tcp_path.cpp). push() hands a Move::tcp move, and any move
+  // while a TCP piece is held, to push_tcp(): the tool tip's path is planned in the part's
+  // frame and cut into pieces straight in joint space, within TCP_TOLERANCE of it and short
+  // enough that the turns between them fit in the joints' acceleration.
+  bool push_tcp(const Move& move, bool check_limits, std::string& error);
+  // The pieces of the tip's path `tip` (planned from the part pose of end_), in joint space.
+  bool tcp_pieces(const Segment& tip, std::vector<Segment>& pieces, std::string& error) const;
+  // `n` equal pieces of `tip`; the largest distance of their tool tip from the path.
+  double cut_tcp(const Segment& tip, int n, std::vector<Segment>& pieces) const;
+  // Every piece's joints within their [JOINT_n] soft limits.
+  bool tcp_within_joint_limits(const std::vector<Segment>& pieces, std::string& error) const;
+  // Ends the held piece into `next` (a piece): at the speed at which the jump in every
+  // joint's speed fits the share of its acceleration kept for it, or at rest.
+  void tcp_join(Segment& next, Move::PathMode mode);
+  static constexpr double kTcpPathShare = 0.5;   // of each joint's acceleration, along a piece
+  static constexpr double kTcpJumpShare = 0.25;  // at each junction, within one servo period
+  static constexpr int kMaxTcpPieces = 20000;
+  bool held_tcp_ = false;  // held_ is a TCP piece
 
   const config::MachineConfig& config_;
   std::shared_ptr<const Kinematics> kins_;

@@ -110,7 +110,11 @@ struct Move {
   double tolerance = 0;  // units
   // G64 Q: consecutive feed lines of the same feed whose points all lie within this of one
   // straight line are run as that line; 0 = no merging.
-  double merge_tolerance = 0;         // units
+  double merge_tolerance = 0;  // units
+  // Tool centre point control (M428) on a table-rotary machine: `end` (and an arc's centre)
+  // is the tool tip in the part's frame, and the planner cuts the move into pieces straight
+  // in joint space whose tip stays within [TRAJ] TCP_TOLERANCE of the programmed path.
+  bool tcp = false;
   std::int32_t line = 0;              // source line of the program, 0 = none
   IoAction action;                    // Kind::action
   SyncOutputs sync;                   // set as this move starts (traverse, feed, arc)

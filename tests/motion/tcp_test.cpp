@@ -1,0 +1,186 @@
+// Tool centre point control on the trunnion example (config/examples/sim_xyzac_trt.ini): the
+// tool tip, found from every servo period's joint commands through the kinematics, stays on
+// the programmed path within TCP_TOLERANCE, and no joint is ever asked for more than its
+// MAX_VELOCITY or MAX_ACCELERATION, where the rotaries make the joints race included.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "cncd/config/machine_config.hpp"
+#include "cncd/motion/kinematics.hpp"
+#include "machine_fixture.hpp"
+
+namespace cncd::test {
+namespace {
+
+using motion::AxisPose;
+using motion::Move;
+
+constexpr int kA = 3, kC = 5;
+constexpr double kTolerance = 0.005;  // the example's TCP_TOLERANCE
+// What the finite differences of positions in a double add to a speed or an acceleration.
+constexpr double kRoundOff = 1e-9;
+
+config::MachineConfig trunnion() {
+  const auto result = config::load_machine_config(std::string(CNCD_SOURCE_DIR) +
+                                                  "/config/examples/sim_xyzac_trt.ini");
+  EXPECT_TRUE(result.ok()) << (result.problems.empty() ? "" : result.problems[0].to_string());
+  return result.ok() ? *result.config : config::MachineConfig{};
+}
+
+Move tcp_move(Move::Kind kind, AxisPose end, double feed, bool tcp = true) {
+  Move m;
+  m.kind = kind;
+  m.end = end;
+  m.feed = feed;
+  m.tcp = tcp;
+  m.path_mode = Move::PathMode::blend;
+  return m;
+}
+
+AxisPose pose(double x, double y, double z, double a, double c) {
+  return {x, y, z, a, 0, c, 0, 0, 0};
+}
+
+// On and homed at the origin, then (TCP off, so the joints) at `at`, records cleared.
+void ready_at(VirtualMachine& m, const AxisPose& at) {
+  m.ready();
+  m.queue(tcp_move(Move::Kind::traverse, at, 0, false));
+  m.run_until_idle();
+  m.cycles(2);
+  m.clear_trajectory();
+}
+
+// The tool tip (part's frame) of every recorded period.
+std::vector<AxisPose> tips(const VirtualMachine& m) {
+  const auto kins = motion::make_kinematics(m.config());
+  std::vector<AxisPose> out;
+  for (const AxisPose& joints : m.trajectory()) {
+    AxisPose part{};
+    kins->tcp_forward(joints, part);
+    out.push_back(part);
+  }
+  return out;
+}
+
+// Distance of `p`'s X Y Z from the line segment a-b.
+double from_line(const AxisPose& p, const AxisPose& a, const AxisPose& b) {
+  double ab = 0, ap = 0;
+  for (int i = 0; i < 3; ++i) {
+    ab += (b[i] - a[i]) * (b[i] - a[i]);
+    ap += (p[i] - a[i]) * (b[i] - a[i]);
+  }
+  const double t = ab > 0 ? std::clamp(ap / ab, 0.0, 1.0) : 0.0;
+  double d = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double e = p[i] - (a[i] + t * (b[i] - a[i]));
+    d += e * e;
+  }
+  return std::sqrt(d);
+}
+
+Peaks expect_joints_within_limits(const VirtualMachine& m, const char* what) {
+  const Peaks p = joint_peaks(m);
+  std::printf("%s: peak joint velocity %.4f %%, acceleration %.4f %%\n", what, 100 * p.velocity,
+              100 * p.acceleration);
+  EXPECT_LE(p.velocity, 1.0 + kRoundOff) << what;
+  EXPECT_LE(p.acceleration, 1.0 + kRoundOff) << what;
+  return p;
+}
+
+TEST(TcpTest, TiltingAWithXyzHeldKeepsTheToolTipOnItsPoint) {
+  VirtualMachine m(trunnion());
+  const AxisPose point = pose(30, 40, 20, 0, 0);
+  ready_at(m, point);  // A = C = 0: the part's frame is the machine's
+  m.queue(tcp_move(Move::Kind::feed, pose(30, 40, 20, -90, 0), 30));  // G1 A-90 F1800
+  m.run_until_idle();
+  double worst = 0;
+  for (const AxisPose& tip : tips(m))
+    worst = std::max(worst, from_line(tip, point, point));
+  std::printf("G1 A-90 under TCP: the tip within %.6f mm of its point\n", worst);
+  EXPECT_LE(worst, kTolerance);
+  // The table did tilt, and the joints carried the point around the A axis (Y 20, Z 10):
+  // 20 mm behind and 10 above it, turned -90 degrees, it is 10 mm behind and 20 below.
+  const auto& end = m.trajectory().back();
+  EXPECT_NEAR(end[kA], -90, 1e-9);
+  EXPECT_NEAR(end[0], 30, 1e-9);
+  EXPECT_NEAR(end[1], 30, 1e-9);
+  EXPECT_NEAR(end[2], -10, 1e-9);
+  expect_joints_within_limits(m, "G1 A-90 under TCP");
+}
+
+TEST(TcpTest, WithTcpOffTheSameMoveTurnsTheTableAlone) {
+  VirtualMachine m(trunnion());
+  ready_at(m, pose(30, 40, 20, 0, 0));
+  m.queue(tcp_move(Move::Kind::feed, pose(30, 40, 20, -90, 0), 30, false));
+  m.run_until_idle();
+  ASSERT_GT(m.trajectory().size(), 100u);
+  for (const AxisPose& joints : m.trajectory()) {
+    EXPECT_EQ(joints[0], 30);
+    EXPECT_EQ(joints[1], 40);
+    EXPECT_EQ(joints[2], 20);
+  }
+  EXPECT_NEAR(m.trajectory().back()[kA], -90, 1e-9);
+}
+
+TEST(TcpTest, AStraightLineWhileAAndCTurnStaysWithinTheTolerance) {
+  VirtualMachine m(trunnion());
+  const AxisPose from = pose(-20, -10, 0, 0, 0);
+  const AxisPose to = pose(30, 20, 10, -30, 60);
+  ready_at(m, from);
+  m.queue(tcp_move(Move::Kind::feed, to, 10));
+  m.run_until_idle();
+  const auto path = tips(m);
+  double worst = 0;
+  for (const AxisPose& tip : path)
+    worst = std::max(worst, from_line(tip, from, to));
+  std::printf("line under TCP with A and C turning: the tip within %.6f mm of the line\n", worst);
+  EXPECT_LE(worst, kTolerance + 1e-9);
+  EXPECT_LE(from_line(path.back(), to, to), 1e-9);  // and it ends where it should
+  EXPECT_NEAR(path.back()[kC], 60, 1e-9);
+  expect_joints_within_limits(m, "line under TCP with A and C turning");
+}
+
+TEST(TcpTest, ALargeCSwingAtANearZeroKeepsEveryJointWithinItsLimits) {
+  // Near the C axis's singularity (A 0: C alone no longer changes the tool's direction) a
+  // short line asks C for half a turn: the X and Y joints must carry the point 60 mm from
+  // the C axis around it while the tip hardly moves. The feed drops; no joint's limit gives.
+  VirtualMachine m(trunnion());
+  const AxisPose from = pose(60, 0, 0, -0.01, 0);
+  ready_at(m, from);
+  m.queue(tcp_move(Move::Kind::feed, pose(61, 0, 0, 0, 180), 50));
+  m.queue(tcp_move(Move::Kind::traverse, pose(0, 61, 0, 0, 90), 0));
+  m.run_until_idle();
+  const Peaks p = expect_joints_within_limits(m, "C swing of 180 degrees at A 0");
+  EXPECT_GT(p.velocity, 0.9);  // a joint's limit, not the feed, sets the pace
+  // Half a turn at 60 mm takes X and Y 188 mm at 20 mm/s at most: far longer than the 1 mm
+  // line at 50 mm/s or C's own 6 s.
+  EXPECT_GT(static_cast<double>(m.trajectory().size()) * m.period_s(), 9.0);
+  const auto path = tips(m);
+  EXPECT_LE(from_line(path.back(), pose(0, 61, 0, 0, 90), pose(0, 61, 0, 0, 90)), 1e-9);
+}
+
+TEST(TcpTest, AJointPastItsLimitIsRefusedThoughTheTipStaysInTheBox) {
+  // The tip at X 120, well within the X axis's -200 .. 200, and C turning: the table carries
+  // that point around the C axis, to Y 120 sin C, past the Y joint's 100 from C 56.4 on.
+  const config::MachineConfig config = trunnion();
+  motion::Planner planner(config);
+  planner.reset(pose(0, 0, 0, 0, 0));
+  std::string error;
+  ASSERT_TRUE(planner.push(tcp_move(Move::Kind::feed, pose(120, 0, 0, 0, 0), 10), true, error))
+      << error;
+  EXPECT_TRUE(planner.push(tcp_move(Move::Kind::feed, pose(120, 0, 0, 0, 50), 10), true, error))
+      << error;  // Y 120 sin 50 = 91.9
+  EXPECT_FALSE(planner.push(tcp_move(Move::Kind::feed, pose(120, 0, 0, 0, 90), 10), true, error));
+  EXPECT_EQ(error.substr(0, 31), "the move takes joint 1 (Y) to 1") << error;
+  EXPECT_NE(error.find("outside its soft limits [-100.0000, 100.0000]"), std::string::npos)
+      << error;
+  // With TCP off the same move only turns C: accepted.
+  EXPECT_TRUE(
+      planner.push(tcp_move(Move::Kind::feed, pose(120, 0, 0, 0, 90), 10, false), true, error))
+      << error;
+}
+
+}  // namespace
+}  // namespace cncd::test
