@@ -94,7 +94,7 @@ CodeInfo m_code_info(int code) {
       {61, 61, MGroup::tool_change, true}, {7, 9, MGroup::coolant, true},
       {48, 53, MGroup::overrides, true},   {62, 68, MGroup::io, true},
       {70, 73, MGroup::spindle, true},     {98, 99, MGroup::stopping, true},
-      {100, 199, MGroup::user, true},
+      {100, 199, MGroup::user, true},      {428, 429, MGroup::user, true},
   };
   for (const Codes& codes : kCodes) {
     if (code >= codes.first && code <= codes.last) {

@@ -136,6 +136,11 @@ void Interpreter::Impl::read_input_result() {
 void Interpreter::Impl::do_user_m_code() {
   const int code = block_.m_code(MGroup::user);
   if (code < 0) return;
+  if (code == 428 || code == 429) {
+    // Not user programs: the machine's TCP switch (docs/kinematics.md).
+    emit(SetTcp{code == 428});
+    return;
+  }
   const auto executable = find_user_m_code(options_.user_m_path, code);
   if (executable.empty()) {
     fail("Unknown m code used: M" + std::to_string(code),

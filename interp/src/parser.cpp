@@ -215,8 +215,10 @@ void BlockParser::add_g(Block& block, int number, int col) {
 void BlockParser::read_m(Block& block, int col) {
   const int number = read_integer_value();
   if (number < 0) fail("Negative m code used", col);
-  if (number > 199) fail("M-code greater than 199: M" + std::to_string(number), col);
   const CodeInfo info = m_code_info(number);
+  // Above M199 only M428 and M429 (the TCP switch, as LinuxCNC's samples remap them).
+  if (number > 199 && info.group < 0)
+    fail("M-code greater than 199: M" + std::to_string(number), col);
   if (info.group < 0) fail("Unknown m code used: M" + std::to_string(number), col);
   const auto group = static_cast<std::size_t>(info.group);
   if (block.m[group] != -1) fail("Two m codes used from same modal group", col);

@@ -31,6 +31,7 @@ void ProgramFeeder::start_program(const motion::AxisPose* at, bool mdi) {
   if (!mdi) {
     per_revolution_ = false;
     css_max_rpm_ = 0;
+    tcp_ = false;
   }
   per_rev_ = 0;
   holds_.clear();
@@ -97,6 +98,7 @@ void ProgramFeeder::begin_move(motion::Move& next, int line) {
   }
   next.sync = sync_;
   sync_ = {};
+  next.tcp = tcp_;
   end_ = next.end;
 }
 
@@ -210,6 +212,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
             moving(move);
             probe_seen_ = true;
             return true;
+          },
+          [&](const in::SetTcp& c) {
+            switch_tcp(c.on, m.line);
+            return false;
           },
           [&](const in::SetFeedMode& c) {
             per_revolution_ = c.mode == in::FeedRateMode::per_revolution;

@@ -7,7 +7,9 @@
 #include <utility>
 #include <vector>
 
+#include "cncd/motion/kinematics.hpp"
 #include "cncd/pipeline/feeder.hpp"
+#include "number_text.hpp"
 
 namespace cncd::pipeline {
 
@@ -161,6 +163,29 @@ void ProgramFeeder::restore_io_state() {
   }
   need_at_speed_ = false;
   pending_.insert(pending_.begin(), front.begin(), front.end());
+}
+
+void ProgramFeeder::switch_tcp(bool on, int line) {
+  if (unsupported_) return;
+  const std::string code = on ? "M428" : "M429";
+  if (machine_ != nullptr && !motion::make_kinematics(*machine_)->has_tcp()) {
+    unsupported_ = Unsupported{line, code + " switches tool centre point control, which needs " +
+                                         "xyzac-trt-kins or xyzbc-trt-kins; [KINS] KINEMATICS " +
+                                         "is " + machine_->kinematics};
+    return;
+  }
+  if (on == tcp_) return;
+  // At every rotary at 0 the part's frame is the machine's: the positions the program and the
+  // interpreter hold stay true across the switch.
+  for (const int axis : {3, 4, 5}) {
+    const double at = end_[static_cast<std::size_t>(axis)];
+    if (std::abs(at) <= 1e-9) continue;
+    unsupported_ = Unsupported{
+        line, code + " with " + config::kAxisLetters[static_cast<std::size_t>(axis)] + " at " +
+                  fixed4(at) + ": TCP is switched with the rotary axes at 0 (G0 A0 B0 C0 first)"};
+    return;
+  }
+  tcp_ = on;
 }
 
 }  // namespace cncd::pipeline

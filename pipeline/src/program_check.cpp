@@ -123,7 +123,17 @@ class CheckSink final : public interp::CanonSink, public motion::MoveQueue {
     }
     if (feed) report_.feed_length += xyz_distance(position_, move.end);
     reach(move.end, move.line, feed ? "feed move" : "rapid move");
+    check_joints(move, feed ? "feed move" : "rapid move");
     position_ = move.end;
+  }
+
+  // Under TCP the joints follow the tool tip: each within its [JOINT_n] soft limits over the
+  // whole path, as the planner checks it (one report per line).
+  void check_joints(const motion::Move& move, const char* what) {
+    std::string error;
+    if (planner_.tcp_joints_within_limits(move, position_, error)) return;
+    if (first_report(move.line, kAxes + 1, false))
+      report_.problems.push_back({file_, move.line, std::string(what) + ": " + error});
   }
 
   // A straight move is checked at its end: the limits form a box and the move starts inside
@@ -230,6 +240,7 @@ class CheckSink final : public interp::CanonSink, public motion::MoveQueue {
       if (options_.preview != nullptr) preview_arc(*segment, move);
     }
     reach(move.end, move.line, "arc");
+    check_joints(move, "arc");
     position_ = move.end;
   }
 

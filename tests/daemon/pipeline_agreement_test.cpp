@@ -99,6 +99,20 @@ class PipelineAgreementTest : public MachineTest {
     return location(s["program"].value("error", ""));
   }
 
+  // Each case gives the same verdict and line through cncd-check, program.open and
+  // program.run.
+  void expect_same_verdicts(const std::vector<EdgeCase>& cases) {
+    for (const EdgeCase& c : cases) {
+      SCOPED_TRACE(c.name);
+      const auto program = dir_.write(std::string(c.name) + ".ngc", c.text);
+      const std::string expected =
+          c.error_line == 0 ? "" : program.string() + ":" + std::to_string(c.error_line) + ":";
+      EXPECT_EQ(check(program), expected) << "cncd-check";
+      EXPECT_EQ(open(program), expected) << "program.open";
+      EXPECT_EQ(run(program, c.text), expected) << "program.run";
+    }
+  }
+
   // "FILE:LINE:" at the start of the first line of `text` that has one.
   static std::string location(const std::string& text) {
     const auto colon = text.find(".ngc:");
@@ -112,15 +126,29 @@ class PipelineAgreementTest : public MachineTest {
 
 TEST_F(PipelineAgreementTest, EveryPathGivesTheSameVerdictAtTheSameLine) {
   ready_machine();
-  for (const EdgeCase& c : edge_cases()) {
-    SCOPED_TRACE(c.name);
-    const auto program = dir_.write(std::string(c.name) + ".ngc", c.text);
-    const std::string expected =
-        c.error_line == 0 ? "" : program.string() + ":" + std::to_string(c.error_line) + ":";
-    EXPECT_EQ(check(program), expected) << "cncd-check";
-    EXPECT_EQ(open(program), expected) << "program.open";
-    EXPECT_EQ(run(program, c.text), expected) << "program.run";
-  }
+  expect_same_verdicts(edge_cases());
+}
+
+// The trunnion example (sim_xyzac_trt.ini) under TCP: the tool tip stays within the axes'
+// limits, but the table's turn carries the X joint past its own (the tip at X 180 Y 90 is
+// 201.2 mm from the C axis, beyond X 200 between C -20 and C -33); the ends of the move are
+// within them. Refused at that line three ways; a program that keeps its joints within
+// their limits runs, and M428 with a rotary off 0 is refused at its line.
+class TrunnionAgreementTest : public PipelineAgreementTest {
+ protected:
+  std::string example() const override { return "sim_xyzac_trt"; }
+};
+
+TEST_F(TrunnionAgreementTest, AJointSwungPastItsLimitIsRefusedAtItsLine) {
+  ready_machine();
+  const std::string head = "G21 G90 G94\nG0 X0 Y0 Z0 A0 C0\nM428\n";
+  const std::vector<EdgeCase> cases = {
+      {"swing_past_joint_x", head + "G0 X180 Y90\nG1 C-50 F600\nG0 X0 Y0 C0\nM429\nM2\n", 5, false},
+      {"swing_within_joints", head + "G0 X150 Y90\nG1 C-50 F600\nG0 X0 Y0 C0\nM429\nM2\n", 0,
+       false},
+      {"switch_off_zero", "G21 G90\nG0 X0 Y0 Z0 A-10 C0\nM428\nG1 X1 F600\nM2\n", 3, false},
+  };
+  expect_same_verdicts(cases);
 }
 
 // The interpreter's part of the verdicts is LinuxCNC's: rs274 accepts the same programs and

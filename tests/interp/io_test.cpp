@@ -67,6 +67,25 @@ TEST(InterpIo, OutputsBecomeTypedCommands) {
   EXPECT_EQ(values[2].value, -1.0);  // no Q: LinuxCNC's -1
 }
 
+// M428 and M429, LinuxCNC's sample remaps for table-rotary kinematics, switch TCP on and off
+// before the block's motion; no other code above M199 is known.
+TEST(InterpIo, M428AndM429SwitchTcpBeforeTheMove) {
+  const auto r = run("M428 G0 X1\nM429\nM2\n");
+  const auto switches = r.all<SetTcp>();
+  ASSERT_EQ(switches.size(), 2u);
+  EXPECT_TRUE(switches[0].on);
+  EXPECT_FALSE(switches[1].on);
+  // The switch comes before the traverse of its block.
+  std::size_t tcp_at = r.commands.size(), traverse_at = r.commands.size();
+  for (std::size_t k = r.commands.size(); k-- > 0;) {
+    if (std::holds_alternative<SetTcp>(r.commands[k].op)) tcp_at = k;
+    if (std::holds_alternative<StraightTraverse>(r.commands[k].op)) traverse_at = k;
+  }
+  EXPECT_LT(tcp_at, traverse_at);
+  EXPECT_EQ(error_of("M430\nM2\n"), "1:1: M-code greater than 199: M430");
+  EXPECT_EQ(error_of("M428 M429\nM2\n"), "1:6: Two m codes used from same modal group");
+}
+
 TEST(InterpIo, OutputsComeBeforeTheToolChangeAndTheMove) {
   const auto r = run("T1 M6 M3 M62 P1 G0 X1\nM2\n");
   std::vector<std::size_t> order;

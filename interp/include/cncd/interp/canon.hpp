@@ -127,6 +127,11 @@ struct ChangeTool {  // M6
 struct ChangeToolNumber {  // M61
   int tool = 0;
 };
+// M428 (on) and M429 (off), as LinuxCNC's table-rotary sample configs remap them: tool
+// centre point control, the programmed X Y Z the tool tip in the part's frame.
+struct SetTcp {
+  bool on = false;
+};
 struct SetFeedOverrideEnable {  // M50 and M48/M49
   bool on = true;
 };
@@ -253,7 +258,7 @@ using CanonOp =
                  Message, DebugMessage, ProgramStop, OptionalProgramStop, ProgramEnd, PalletShuttle,
                  OnReset, Finish, StartChange, OrientSpindle, WaitOrientSpindle, SetToolTableEntry,
                  SetOutputBit, SetOutputValue, WaitInput, UserMCode, TurnProbeOn, TurnProbeOff,
-                 StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap>;
+                 StraightProbe, StartSpeedFeedSynch, StopSpeedFeedSynch, RigidTap, SetTcp>;
 
 // Whether every number in `op` is finite (an overflow shows as inf or NaN).
 bool all_finite(const CanonOp& op);

@@ -210,6 +210,12 @@ class ProgramFeeder final : public interp::CanonSink {
   // then (machine zero when start_program() was not told).
   motion::AxisPose end_{};
 
+  // M428 / M429: tool centre point control on a table-rotary machine (feeder_holds.cpp).
+  // Switched with every rotary at 0, where the part's frame is the machine's; moves queued
+  // while it is on carry Move::tcp. A program starts with it off.
+  void switch_tcp(bool on, int line);
+  bool tcp_ = false;
+
   // Path control mode and G64 P tolerance (machine units) as the interpreter last set them
   // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).
   motion::Move::PathMode path_mode_ = motion::Move::PathMode::blend;
