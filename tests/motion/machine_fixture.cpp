@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -186,6 +187,16 @@ Peaks joint_peaks(const VirtualMachine& m) {
     const auto& joint = m.config().joints[j];
     add_peaks(p, m.motor_trajectory(), j, m.period_s(), joint.max_velocity, joint.max_acceleration);
   }
+  return p;
+}
+
+Peaks expect_joints_within_limits(const VirtualMachine& m, const char* what) {
+  constexpr double kRoundOff = 1e-9;
+  const Peaks p = joint_peaks(m);
+  std::printf("%s: peak joint velocity %.6f %%, acceleration %.6f %%\n", what, 100 * p.velocity,
+              100 * p.acceleration);
+  EXPECT_LE(p.velocity, 1.0 + kRoundOff) << what;
+  EXPECT_LE(p.acceleration, 1.0 + kRoundOff) << what;
   return p;
 }
 

@@ -143,6 +143,10 @@ void send_jog(VirtualMachine& m, motion::Command::Kind kind, int index, double v
               double distance = 0, bool joint = false);
 // The servo loop's events since the last call, one line of words each.
 std::string drain_events(VirtualMachine& m);
+// Every joint within 100 % of its speed and acceleration limits over the recorded periods
+// (and 1e-9 for what finite differences of positions in a double add); prints the peaks, as
+// the figures the test stands for, and returns them.
+Peaks expect_joints_within_limits(const VirtualMachine& m, const char* what);
 // Every axis stayed within its velocity and acceleration limits (and 0.1 % for rounding) on
 // the way from `start` through the recorded trajectory.
 void expect_within_limits(const VirtualMachine& m, const motion::AxisPose& start);

@@ -19,8 +19,6 @@ using motion::Move;
 
 constexpr int kA = 3, kC = 5;
 constexpr double kTolerance = 0.005;  // the example's TCP_TOLERANCE
-// What the finite differences of positions in a double add to a speed or an acceleration.
-constexpr double kRoundOff = 1e-9;
 
 config::MachineConfig trunnion() {
   const auto result = config::load_machine_config(std::string(CNCD_SOURCE_DIR) +
@@ -78,15 +76,6 @@ double from_line(const AxisPose& p, const AxisPose& a, const AxisPose& b) {
     d += e * e;
   }
   return std::sqrt(d);
-}
-
-Peaks expect_joints_within_limits(const VirtualMachine& m, const char* what) {
-  const Peaks p = joint_peaks(m);
-  std::printf("%s: peak joint velocity %.4f %%, acceleration %.4f %%\n", what, 100 * p.velocity,
-              100 * p.acceleration);
-  EXPECT_LE(p.velocity, 1.0 + kRoundOff) << what;
-  EXPECT_LE(p.acceleration, 1.0 + kRoundOff) << what;
-  return p;
 }
 
 TEST(TcpTest, TiltingAWithXyzHeldKeepsTheToolTipOnItsPoint) {
