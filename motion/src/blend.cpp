@@ -45,7 +45,7 @@ void Planner::reset(const AxisPose& start) {
 }
 
 bool Planner::push(const Move& move, bool check_limits, std::string& error) {
-  if ((move.tcp && kins_->has_tcp()) || (held_ && held_tcp_))
+  if ((move.tcp && kins_->has_tcp()) || (held_ && held_->tcp))
     return push_tcp(move, check_limits, error);
   auto planned = plan(move, end_, check_limits, error);
   if (!planned) return false;

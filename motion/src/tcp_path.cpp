@@ -37,10 +37,7 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
   const bool tcp = move.tcp && kins_->has_tcp();
   if (!tcp) {
     // Out of TCP (M429): the held piece ends at rest, then the move is planned as any.
-    held_->segment.continuous = false;
-    output_.push_back(held_->segment);
-    held_.reset();
-    held_tcp_ = false;
+    flush();
     return push(move, check_limits, error);
   }
   if (move.probe != ProbeMode::none || move.spindle_sync != SpindleSync::none) {
@@ -56,13 +53,8 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
   if (tip->kind != Segment::Kind::dwell && tip->length > 0 && !tcp_pieces(*tip, pieces, error))
     return false;
   if (check_limits && !tcp_within_joint_limits(pieces, error)) return false;
-  release_merge();
-  if (held_ && !held_tcp_) {
-    // Into TCP (M428): the move before ends at rest.
-    held_->segment.continuous = false;
-    output_.push_back(held_->segment);
-    held_.reset();
-  }
+  // Into TCP (M428): what is held back before it ends at rest.
+  if (!(held_ && held_->tcp)) flush();
   if (pieces.empty()) {
     // Nothing moves (a dwell, or an end where the move starts).
     Segment rest = *tip;
@@ -87,9 +79,9 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
       output_.push_back(piece);
       continue;
     }
-    held_ = Held{piece, end_mode, move.tolerance, piece.length, move.kind == Move::Kind::traverse,
-                 true,  1e300};
-    held_tcp_ = true;
+    held_ =
+        Held{piece, end_mode, move.tolerance, piece.length, move.kind == Move::Kind::traverse, true,
+             0,     true};
   }
   return true;
 }

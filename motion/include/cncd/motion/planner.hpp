@@ -134,6 +134,7 @@ class Planner {
     // before it (as it stands while that arc is held back), or what the segments before it
     // allow across a tangent junction or a kink.
     double entry_speed = 0;
+    bool tcp = false;  // a piece of a TCP move (tcp_path.cpp)
   };
 
   // Consecutive G1 lines of the same feed whose points all lie within Q of the line from the
@@ -170,7 +171,6 @@ class Planner {
   static constexpr double kTcpPathShare = 0.5;   // of each joint's acceleration, along a piece
   static constexpr double kTcpJumpShare = 0.25;  // at each junction, within one servo period
   static constexpr int kMaxTcpPieces = 20000;
-  bool held_tcp_ = false;  // held_ is a TCP piece
 
   const config::MachineConfig& config_;
   std::shared_ptr<const Kinematics> kins_;
