@@ -164,14 +164,11 @@ struct CycleGeometry {
   std::optional<double> dwell;
 };
 
-// G76 as its words give it (cycle_g76.cpp): the drive line from (x0, z0) to Z z1, the depths
-// as radii.
+// G76 as its words give it (cycle_g76.cpp): drive line (x0, z0) to Z z1, depths as radii.
 struct ThreadingCycle {
   double x0 = 0, z0 = 0, z1 = 0;
-  double pitch = 0;
+  double pitch = 0, degression = 1, tan_q = 0;
   double i = 0, j = 0, k = 0;
-  double degression = 1;
-  double tan_q = 0;
   double taper = 0;  // E, along Z
   bool entry_taper = false, exit_taper = false;
   int spring_passes = 0;
