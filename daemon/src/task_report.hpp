@@ -155,7 +155,7 @@ struct PanelReport {
 struct ManualHolder {
   std::string by;      // "the panel's MPG", "the panel's JOG_X_PLUS button", a client
   bool panel = false;  // the panel (at the machine) rather than a client
-  int axis = -1;  // the jog target it moves (an axis, or kMaxAxes + a joint), -1: several
+  int axis = -1;       // the jog target it moves (an axis, or kMaxAxes + a joint), -1: several
 };
 
 struct TaskStatus {

@@ -2,8 +2,8 @@
 // recorded, for the motion tests.
 #pragma once
 
-#include <string>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "cncd/config/machine_config.hpp"
