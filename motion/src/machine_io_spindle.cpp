@@ -153,11 +153,11 @@ SyncFollower::Spindle MachineIo::sync_spindle() const noexcept {
   return s;
 }
 
-bool MachineIo::follow(const Segment& segment, bool first, double feed_override, bool stop,
-                       double dt, double& s, double& v) noexcept {
+bool MachineIo::follow(const Segment& segment, bool first, bool continues, double feed_override,
+                       bool stop, double dt, double& s, double& v) noexcept {
   const SyncFollower::Spindle spindle = sync_spindle();
   if (first) {
-    sync_.start(segment, spindle);
+    sync_.start(segment, spindle, continues);
     tapping_ = segment.spindle_sync == SpindleSync::tap;
   }
   const SyncFollower::Step step = sync_.step(segment, spindle, feed_override, stop, dt);

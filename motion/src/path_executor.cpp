@@ -28,6 +28,7 @@ void PathExecutor::flush() noexcept {
   Segment dropped;
   if (syncing() && gate_ != nullptr) gate_->sync_ended();
   has_active_ = false;
+  thread_chain_ = false;
   for (; window_count_ > 0; --window_count_, ++head_seq_) {
     ++segments_done_;
     moves_done_ += window_at(head_seq_).moves;
@@ -207,6 +208,9 @@ void PathExecutor::finish_front() noexcept {
   const Segment& done = window_at(head_seq_);
   if (has_active_ && done.spindle_sync != SpindleSync::none && gate_ != nullptr)
     gate_->sync_ended();
+  // The next move goes on along this one's helix if it is a thread move too.
+  thread_chain_ = has_active_ && done.spindle_sync == SpindleSync::thread && !abort_requested_ &&
+                  path_s_ >= done.length;
   ++segments_done_;
   moves_done_ += done.moves;
   if (done.action.kind != IoAction::Kind::none) ++actions_done_;
@@ -274,7 +278,8 @@ PathExecutor::Result PathExecutor::advance(double dt, AxisPose& pose, bool joint
       // The spindle's position, not time, moves the path; a pause waits for the move's end.
       double s = path_s_;
       double v = 0;
-      done = gate_->follow(active, !action_started_, feed_override_, abort_requested_, dt, s, v);
+      done = gate_->follow(active, !action_started_, thread_chain_, feed_override_,
+                           abort_requested_, dt, s, v);
       action_started_ = true;
       path_s_ = s;
       path_v_ = done ? 0.0 : v;

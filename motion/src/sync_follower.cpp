@@ -46,7 +46,10 @@ double toward(double from, double to, double step) {
 
 }  // namespace
 
-void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcept {
+void SyncFollower::start(const Segment& segment, const Spindle& spindle, bool continues) noexcept {
+  const int last_direction = direction_;
+  const bool chained = continues && has_helix_end_;
+  has_helix_end_ = false;
   status_ = {};
   std::fill(std::begin(sent_), std::end(sent_), 0.0);
   sent_head_ = 0;
@@ -69,6 +72,12 @@ void SyncFollower::start(const Segment& segment, const Spindle& spindle) noexcep
     status_.phase = SyncStatus::Phase::spindle_stopping;
     origin_ = spindle.revolutions;
     last_progress_ = 0;
+  } else if (chained && direction_ == last_direction) {
+    // On along the helix, from where it left the previous move: at once if the spindle is less
+    // than a revolution past that point, else at the next revolution in its phase.
+    const double past = direction_ * (spindle.revolutions - helix_end_);
+    origin_ = helix_end_ + direction_ * (past <= 1.0 ? 0.0 : std::ceil(past));
+    status_.phase = SyncStatus::Phase::index;
   } else {
     // The next whole revolution in the direction of turning: threads cut again start in phase.
     origin_ = direction_ > 0 ? std::ceil(spindle.revolutions) : std::floor(spindle.revolutions);
@@ -266,6 +275,8 @@ SyncFollower::Step SyncFollower::thread_step(const Segment& segment, const Spind
   if (path_s_ >= length - 1e-9) {
     out.s = length;
     out.done = true;
+    helix_end_ = origin_ + direction_ * length / per_rev;
+    has_helix_end_ = status_.phase == Phase::following;
   } else if (status_.phase == Phase::stopping && at_rest(path_v_)) {
     out.done = true;
   }

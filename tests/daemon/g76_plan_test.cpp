@@ -141,5 +141,71 @@ TEST(G76Plan, AnM12ThreadOnTheSimLatheFollowsTheSpindleAtRs274sDepths) {
   EXPECT_NEAR(samples.back().z, -20, 1e-9);
 }
 
+// A thread with a tapered exit (E8 L2): each pass is a G33 move along Z and a taper out from
+// Z-12 to Z-20 (per revolution 1.75 / cos of the taper's angle, so Z keeps the pitch). The taper
+// goes on along the straight part's helix: past the corner, where the tool comes to rest and
+// catches up again, it stays within pitch x 0.02 of the same helix (before, it waited for the
+// next index and cut a helix shifted by the straight part's length modulo the pitch).
+TEST(G76Plan, ATaperedExitStaysOnTheHelixOfItsPass) {
+  TempDir dir;
+  const auto ini = copy_example_machine(dir.path(), "sim_lathe");
+  const auto loaded = config::load_machine_config(ini);
+  ASSERT_TRUE(loaded.ok());
+  const auto program = dir.write("taper.ngc",
+                                 "G18 G21 G90\nS800 M3\nG0 X7 Z3\n"
+                                 "G76 P1.75 Z-20 I-1 J0.2 K1.07 Q29.5 H1 E8 L2\nG0 X20\nM5\nM2\n");
+  pipeline::PlanSimOptions options;
+  options.interp = pipeline::interpreter_options(*loaded.config);
+  options.start_machine = interp::Pose{7, 0, 3};
+  std::vector<Sample> samples;
+  options.on_sample = [&](double, const motion::AxisPose& p, double revolutions) {
+    samples.push_back({p[0], p[2], revolutions});
+  };
+  const auto r = pipeline::simulate_plan(*loaded.config, program.string(), options);
+  ASSERT_TRUE(r.complete()) << (r.error ? r.error->to_string() : r.stopped->to_string());
+
+  // A pass: from the infeed below X7 (the drive line) to the retract back to it. Its helix is
+  // where the tool stands along Z at each revolution, taken two revolutions after it starts to
+  // move along Z; the rest of the pass is measured against it.
+  int passes = 0, straight = 0, taper = 0;
+  double straight_error = 0, taper_error = 0, last_z = 0, moved_at = -1, helix = 0;
+  bool in_pass = false, have_helix = false;
+  for (const Sample& s : samples) {
+    if (!(s.x < 7 - 1e-9)) {
+      in_pass = false;
+      continue;
+    }
+    if (!in_pass) {
+      in_pass = true;
+      ++passes;
+      moved_at = -1;
+      last_z = s.z;
+      have_helix = false;
+    }
+    if (moved_at < 0 && s.z < last_z && s.x < kPeaks) moved_at = s.revolutions;
+    last_z = s.z;
+    if (moved_at < 0 || s.revolutions < moved_at + 2) continue;
+    const double turns = -s.z / kPitch - s.revolutions;
+    if (!have_helix) helix = turns;
+    have_helix = true;
+    const double error = std::abs(turns - helix - std::round(turns - helix)) * kPitch;
+    // Clear of the corner at Z-12 (a pitch before, one and a half after) and of the end.
+    if (s.z > -12 + kPitch) {
+      straight_error = std::max(straight_error, error);
+      ++straight;
+    } else if (s.z < -12 - 1.5 * kPitch && s.z > -20 + kPitch) {
+      taper_error = std::max(taper_error, error);
+      ++taper;
+    }
+  }
+  EXPECT_EQ(passes, 7);
+  EXPECT_GT(straight, 7 * 300);
+  EXPECT_GT(taper, 7 * 100);
+  EXPECT_LE(straight_error, kPitch * 0.02);
+  EXPECT_LE(taper_error, kPitch * 0.02);
+  std::printf("helix: straight %.4f mm (%d samples), taper %.4f mm (%d samples)\n", straight_error,
+              straight, taper_error, taper);
+}
+
 }  // namespace
 }  // namespace cncd::test

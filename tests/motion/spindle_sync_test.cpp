@@ -199,6 +199,69 @@ TEST_F(SpindleSyncTest, ThreadStartsAtTheIndexAndFollowsTheHelix) {
   EXPECT_NEAR(machine_->status().spindle.actual_rpm, 600, 1e-9);
 }
 
+// The largest distance from the helix z = -pitch x (revolutions - index), over the samples
+// from `from` on where the helix is above `bottom`, two revolutions past `settled` and away
+// from (more than 1.5 revolutions after) the revolution `corner`.
+double off_helix(const std::vector<Sample>& samples, double index, double pitch, double settled,
+                 double corner, double bottom) {
+  double worst = 0;
+  for (std::size_t k = 0; k + 1 < samples.size(); ++k) {
+    const double rev = samples[k + 1].revolutions;
+    const double z_ideal = -pitch * (rev - index);
+    if (rev < settled + 2 || (rev > corner - 0.5 && rev < corner + 1.5) || z_ideal < bottom)
+      continue;
+    worst = std::max(worst, std::abs(samples[k].z - z_ideal));
+  }
+  return worst;
+}
+
+// G33 Z-10.3 then G33 Z-20: the second move goes on along the first one's helix (a taper after
+// the straight part of a thread, a chain of G33 moves), not from the next index: 10.3 mm is not
+// a whole number of pitches, and a new index would shift its helix by 0.2 mm.
+TEST_F(SpindleSyncTest, AThreadMoveAfterAnotherGoesOnAlongItsHelix) {
+  start(mill_with_sim_spindle(3000));
+  const double index = std::ceil(machine_->status().spindle.revolutions);
+  machine_->queue(synced(SpindleSync::thread, -10.3, 1.5));
+  machine_->queue(synced(SpindleSync::thread, -20, 1.5));
+  run(20000, true);
+  EXPECT_EQ(machine_->status().path_errors, 0u);
+  EXPECT_NEAR(machine_->status().commanded[2], -20, 1e-9);
+  const double corner = index + 10.3 / 1.5;
+  EXPECT_LE(off_helix(samples_, index, 1.5, index, corner, -18.5), 1.5 * 0.02);
+  // The second move's part checked: from 1.5 revolutions past the corner to 1.5 mm short of
+  // its end, two and a half revolutions.
+  expect_within_limits(*machine_, {0, 0, 0});
+}
+
+// A hold between the two: the second waits for the spindle to come round to its helix again.
+TEST_F(SpindleSyncTest, AHoldBetweenTwoThreadMovesKeepsTheHelix) {
+  start(mill_with_sim_spindle(3000));
+  const double index = std::ceil(machine_->status().spindle.revolutions);
+  machine_->queue(synced(SpindleSync::thread, -10.3, 1.5));
+  machine_->queue(synced(SpindleSync::thread, -20, 1.5));
+  run(100);
+  ASSERT_EQ(machine_->status().sync.phase, SyncStatus::Phase::following);
+  send({Command::Kind::pause});
+  run(2000);
+  // The first ran to its end and the second held before it, while the spindle turned on.
+  EXPECT_NEAR(machine_->status().commanded[2], -10.3, 1e-9);
+  EXPECT_EQ(machine_->status().motion, MotionState::paused);
+  const double resumed = machine_->status().spindle.revolutions;
+  EXPECT_GT(resumed, index + 10.3 / 1.5 + 5);
+  send({Command::Kind::resume});
+  run(20000, true);
+  EXPECT_NEAR(machine_->status().commanded[2], -20, 1e-9);
+  // Nothing moves before the spindle reaches the helix's phase again, then on it.
+  const double next = index + 10.3 / 1.5 + std::ceil(resumed - index - 10.3 / 1.5);
+  for (const Sample& s : samples_) {
+    if (s.revolutions > resumed && s.revolutions < next - 0.02) {
+      EXPECT_NEAR(s.z, -10.3, 1e-9);
+    }
+  }
+  EXPECT_LE(off_helix(samples_, index, 1.5, next, next, -18.5), 1.5 * 0.02);
+  expect_within_limits(*machine_, {0, 0, 0});
+}
+
 // The signed speed a spindle command asks for, rev/s (forward > 0).
 
 TEST_F(SpindleSyncTest, AFeedHoldBeforeAThreadStartsHoldsBeforeIt) {

@@ -28,10 +28,12 @@ class ActionGate {
   // RT: a segment with outputs to set starts this period.
   CNCD_RT virtual void started(const SyncOutputs& sync) noexcept = 0;
   // RT: one period of `dt` s along a segment in step with the spindle (`first`: its first
-  // period); `s` (in: where the path stood) and `v` are where the path is and its speed.
-  // `stop` (an abort) brings it to rest. True once it is over.
-  CNCD_RT virtual bool follow(const Segment& segment, bool first, double feed_override, bool stop,
-                              double dt, double& s, double& v) noexcept = 0;
+  // period; `continues`: it follows a thread move that ran to its end, with nothing between,
+  // and goes on along the same helix); `s` (in: where the path stood) and `v` are where the
+  // path is and its speed. `stop` (an abort) brings it to rest. True once it is over.
+  CNCD_RT virtual bool follow(const Segment& segment, bool first, bool continues,
+                              double feed_override, bool stop, double dt, double& s,
+                              double& v) noexcept = 0;
   // RT: the segment in step with the spindle is over or dropped.
   CNCD_RT virtual void sync_ended() noexcept = 0;
   // RT: how fast the spindle turns (rev/s, >= 0) for G95 feeds, as measured this period.
@@ -44,8 +46,8 @@ class MachineIo final : public ActionGate {
 
   CNCD_RT bool run(const IoAction& action, bool first) noexcept override;
   CNCD_RT void started(const SyncOutputs& sync) noexcept override;
-  CNCD_RT bool follow(const Segment& segment, bool first, double feed_override, bool stop,
-                      double dt, double& s, double& v) noexcept override;
+  CNCD_RT bool follow(const Segment& segment, bool first, bool continues, double feed_override,
+                      bool stop, double dt, double& s, double& v) noexcept override;
   CNCD_RT void sync_ended() noexcept override;
   CNCD_RT double spindle_rps() const noexcept override { return spindle_.actual_rpm / 60.0; }
   // The X axis's position (machine coordinates) this period: constant surface speed (G96)

@@ -181,6 +181,7 @@ class PathExecutor {
   double cap_soft_ = 0, cap_hard_ = 0;  // the active segment's own speed limits
   double dwell_elapsed_s_ = 0;
   bool action_started_ = false;  // the active action has been asked once
+  bool thread_chain_ = false;    // the segment done last was a thread move, run to its end
   ActionGate* gate_ = nullptr;
   bool pause_requested_ = false;
   bool abort_requested_ = false;

@@ -13,7 +13,12 @@
 //
 // A thread (SpindleSync::thread, G33) takes the spindle as the program turns it: the path
 // starts at the next whole revolution (the index) and catches up with the helix within the
-// line's acceleration, follows it, and slows to rest at the line's end.
+// line's acceleration, follows it, and slows to rest at the line's end. A thread move that
+// follows another one (a taper after the straight part of a G76 pass, a chain of G33 moves)
+// goes on along the same helix: its path starts at the revolution where the helix left the
+// previous move's end, so the thread stays in phase across the corner. Where the spindle has
+// turned more than a revolution past that point (a hold between the two), the path waits for
+// the next revolution in that phase instead.
 #pragma once
 
 #include <cstdint>
@@ -50,8 +55,10 @@ class SyncFollower {
     double error_limit = 0;
   };
 
-  // RT: a synchronized segment starts, the spindle as measured.
-  CNCD_RT void start(const Segment& segment, const Spindle& spindle) noexcept;
+  // RT: a synchronized segment starts, the spindle as measured; `continues`: a thread segment
+  // that goes on along the helix of the thread segment that ended last.
+  CNCD_RT void start(const Segment& segment, const Spindle& spindle,
+                     bool continues = false) noexcept;
   // RT: one period of `dt` s. `feed_override` scales a tap's speed; `stop` (an abort) brings
   // the spindle (tap) or the path (thread) to rest, after which the step is done.
   CNCD_RT Step step(const Segment& segment, const Spindle& spindle, double feed_override, bool stop,
@@ -69,12 +76,14 @@ class SyncFollower {
                            double dt) noexcept;
 
   SyncStatus status_{};
-  int direction_ = 1;         // the spindle's direction into the hole / along the thread
-  double origin_ = 0;         // spindle revolutions at the path's start (s = 0)
-  double command_ = 0;        // tap: spindle speed commanded, rev/s, > 0 into the hole
-  double accel_ = 0;          // tap: the ramp, rev/s^2
-  double path_v_ = 0;         // thread: path speed
-  double path_s_ = 0;         // thread: path position
+  int direction_ = 1;     // the spindle's direction into the hole / along the thread
+  double origin_ = 0;     // spindle revolutions at the path's start (s = 0)
+  double command_ = 0;    // tap: spindle speed commanded, rev/s, > 0 into the hole
+  double accel_ = 0;      // tap: the ramp, rev/s^2
+  double path_v_ = 0;     // thread: path speed
+  double path_s_ = 0;     // thread: path position
+  double helix_end_ = 0;  // thread: revolutions where the last one's helix reached its end
+  bool has_helix_end_ = false;
   bool locked_ = false;       // tap: the spindle's position is locked to the path's
   bool out_at_top_ = false;   // tap: back at the top, told to stop
   double last_s_ = 0;         // tap: the path position given last period
