@@ -180,10 +180,12 @@ void Task::mdi(const std::string& line, std::uint64_t token) {
 }
 
 void Task::start_run(Mode mode, const motion::Status& status) {
+  // Under TCP (kept from the last MDI command) the program's position is the tool tip's.
+  const motion::AxisPose at = runner_->program_start(status.commanded, mode == Mode::mdi);
   interp::Pose position{};
-  std::copy(status.commanded.begin(), status.commanded.end(), position.begin());
+  std::copy(at.begin(), at.end(), position.begin());
   interp_->set_machine_position(position);
-  runner_->start(&status.commanded, mode == Mode::mdi, interp_->state().tool_in_spindle);
+  runner_->start(&at, mode == Mode::mdi, interp_->state().tool_in_spindle);
   path_errors_base_ = status.path_errors;
   input_waits_seen_ = status.input_waits;
   probes_seen_ = status.probe.done;

@@ -246,6 +246,10 @@ void Interpreter::set_position(const Pose& position) {
   impl_->sync_standalone();
 }
 
+void Interpreter::set_tcp_switch(std::function<Pose(const Pose& machine, bool tcp_on)> tcp_switch) {
+  impl_->options_.tcp_switch = std::move(tcp_switch);
+}
+
 void Interpreter::set_machine_position(const Pose& machine) {
   Pose program = machine;
   for (std::size_t axis = 0; axis < kAxes; ++axis) {

@@ -137,8 +137,28 @@ void Interpreter::Impl::do_user_m_code() {
   const int code = block_.m_code(MGroup::user);
   if (code < 0) return;
   if (code == 428 || code == 429) {
-    // Not user programs: the machine's TCP switch (docs/kinematics.md).
-    emit(SetTcp{code == 428});
+    // Not user programs: the machine's TCP switch (docs/kinematics.md). The program goes on
+    // from where the tool stands, in the frame switched to: LinuxCNC's remaps read the
+    // position back after switching the kinematics.
+    const bool on = code == 428;
+    if (options_.tcp_switch) {
+      if (comp_.on()) {
+        fail("Cannot switch TCP (M" + std::to_string(code) + ") with cutter radius compensation on",
+             block_.m_column[static_cast<std::size_t>(MGroup::user)]);
+      }
+      Pose machine = program_to_machine(pos_);
+      for (std::size_t axis = 0; axis < kAxes; ++axis) {
+        if (is_linear_axis(static_cast<int>(axis))) machine[axis] = to_machine_units(machine[axis]);
+      }
+      Pose moved = options_.tcp_switch(machine, on);
+      if (moved != machine) {
+        for (std::size_t axis = 0; axis < kAxes; ++axis) {
+          if (is_linear_axis(static_cast<int>(axis))) moved[axis] = to_program_units(moved[axis]);
+        }
+        pos_ = machine_to_program(moved);
+      }
+    }
+    emit(SetTcp{on});
     return;
   }
   const auto executable = find_user_m_code(options_.user_m_path, code);

@@ -175,17 +175,27 @@ void ProgramFeeder::switch_tcp(bool on, int line) {
     return;
   }
   if (on == tcp_) return;
-  // At every rotary at 0 the part's frame is the machine's: the positions the program and the
-  // interpreter hold stay true across the switch.
-  for (const int axis : {3, 4, 5}) {
-    const double at = end_[static_cast<std::size_t>(axis)];
-    if (std::abs(at) <= 1e-9) continue;
-    unsupported_ = Unsupported{
-        line, code + " with " + config::kAxisLetters[static_cast<std::size_t>(axis)] + " at " +
-                  fixed4(at) + ": TCP is switched with the rotary axes at 0 (G0 A0 B0 C0 first)"};
-    return;
-  }
+  // The tool stays where it is; the program goes on in the other frame (the interpreter has
+  // made the same change to its position, through tcp_switched()).
+  end_ = tcp_switched(end_, on);
   tcp_ = on;
+}
+
+motion::AxisPose ProgramFeeder::tcp_switched(const motion::AxisPose& machine, bool on) const {
+  return on == tcp_ ? machine : in_frame(machine, on);
+}
+
+motion::AxisPose ProgramFeeder::in_frame(const motion::AxisPose& machine, bool on) const {
+  if (machine_ == nullptr) return machine;
+  const auto kins = motion::make_kinematics(*machine_);
+  if (!kins->has_tcp()) return machine;
+  motion::AxisPose moved = machine;
+  if (on) {
+    kins->tcp_forward(machine, moved);
+  } else {
+    kins->tcp_inverse(machine, moved);
+  }
+  return moved;
 }
 
 }  // namespace cncd::pipeline

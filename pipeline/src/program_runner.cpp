@@ -10,7 +10,11 @@ using Push = motion::MoveQueue::Push;
 ProgramRunner::ProgramRunner(interp::Interpreter& interp, interp::Units machine_units,
                              ProgramFeeder::MessageHandler on_message,
                              const config::MachineConfig* machine)
-    : interp_(interp), feeder_(machine_units, std::move(on_message), machine) {}
+    : interp_(interp), feeder_(machine_units, std::move(on_message), machine) {
+  // M428/M429: the interpreter goes on from where the feeder puts the tool in the new frame.
+  interp_.set_tcp_switch(
+      [this](const interp::Pose& at, bool on) { return feeder_.tcp_switched(at, on); });
+}
 
 void ProgramRunner::start(const motion::AxisPose* at, bool mdi, int tool) {
   feeder_.start_program(at, mdi);

@@ -133,7 +133,7 @@ TEST_F(PipelineAgreementTest, EveryPathGivesTheSameVerdictAtTheSameLine) {
 // limits, but the table's turn carries the X joint past its own (the tip at X 180 Y 90 is
 // 201.2 mm from the C axis, beyond X 200 between C -20 and C -33); the ends of the move are
 // within them. Refused at that line three ways; a program that keeps its joints within
-// their limits runs, and M428 with a rotary off 0 is refused at its line.
+// their limits runs, and so does M428 with a rotary off 0.
 class TrunnionAgreementTest : public PipelineAgreementTest {
  protected:
   std::string example() const override { return "sim_xyzac_trt"; }
@@ -146,7 +146,7 @@ TEST_F(TrunnionAgreementTest, AJointSwungPastItsLimitIsRefusedAtItsLine) {
       {"swing_past_joint_x", head + "G0 X180 Y90\nG1 C-50 F600\nG0 X0 Y0 C0\nM429\nM2\n", 5, false},
       {"swing_within_joints", head + "G0 X150 Y90\nG1 C-50 F600\nG0 X0 Y0 C0\nM429\nM2\n", 0,
        false},
-      {"switch_off_zero", "G21 G90\nG0 X0 Y0 Z0 A-10 C0\nM428\nG1 X1 F600\nM2\n", 3, false},
+      {"switch_off_zero", "G21 G90\nG0 X0 Y0 Z0 A-10 C0\nM428\nG1 X1 F600\nM429\nM2\n", 0, false},
   };
   expect_same_verdicts(cases);
 }

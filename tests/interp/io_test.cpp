@@ -86,6 +86,35 @@ TEST(InterpIo, M428AndM429SwitchTcpBeforeTheMove) {
   EXPECT_EQ(error_of("M428 M429\nM2\n"), "1:6: Two m codes used from same modal group");
 }
 
+// With a machine that says where the switch puts the tool (InterpOptions::tcp_switch: here a
+// table turned 90 degrees, X Y -> Y -X, and a G54 offset of X 5), the program goes on from
+// there in the new frame: a move of Z alone after M428 leaves X and Y where the tool stands.
+TEST(InterpIo, M428AndM429GoOnFromWhereTheSwitchPutsTheTool) {
+  InterpOptions options;
+  int switches = 0;
+  options.tcp_switch = [&](const Pose& machine, bool on) {
+    ++switches;
+    Pose moved = machine;
+    moved[0] = on ? machine[1] : -machine[1];
+    moved[1] = on ? -machine[0] : machine[0];
+    return moved;
+  };
+  const auto r = run("G10 L2 P1 X5\nG54 G0 X5 Y0 Z2\nM428\nG1 Z0 F100\nM429\nG1 Z2\nM2\n", options);
+  EXPECT_EQ(switches, 2);
+  const auto feeds = r.all<StraightFeed>();
+  ASSERT_EQ(feeds.size(), 2u);
+  // Machine X 10 Y 0 is X 0 Y -10 in the turned frame: program X -5 with the offset.
+  EXPECT_NEAR(feeds[0].end[0], -5, 1e-12);
+  EXPECT_NEAR(feeds[0].end[1], -10, 1e-12);
+  EXPECT_NEAR(feeds[0].end[2], 0, 1e-12);
+  EXPECT_NEAR(feeds[1].end[0], 5, 1e-12);
+  EXPECT_NEAR(feeds[1].end[1], 0, 1e-12);
+  EXPECT_NEAR(feeds[1].end[2], 2, 1e-12);
+  // Where the position would jump under the compensated path: refused at the M code.
+  EXPECT_EQ(error_of("G0 X0 Y0\nG41 D1 G1 X10 F100\nM428\nM2\n", options),
+            "3:1: Cannot switch TCP (M428) with cutter radius compensation on");
+}
+
 TEST(InterpIo, OutputsComeBeforeTheToolChangeAndTheMove) {
   const auto r = run("T1 M6 M3 M62 P1 G0 X1\nM2\n");
   std::vector<std::size_t> order;

@@ -85,6 +85,10 @@ struct InterpOptions {
   std::shared_ptr<ProbeFileWriter> probe_writer;
   // The machine's INI, for #<_ini[SECTION]KEY>: the text of KEY in SECTION (names as written
   // there, matched exactly), or nothing. Null: no INI, and no such parameter exists.
+  // M428/M429, the TCP switch of a table-rotary machine: where the machine's position (machine
+  // coordinates and units) lies in the frame the switch leads to (the part's for M428, the
+  // joints' for M429). Null: the position stays as it is (no such machine, or rs274's canon).
+  std::function<Pose(const Pose& machine, bool tcp_on)> tcp_switch;
   std::function<std::optional<std::string>(const std::string& section, const std::string& key)>
       ini_value;
 };
@@ -157,6 +161,8 @@ class Interpreter {
   // (what the servo loop reports); the interpreter applies its own offsets and units. Call it
   // after open(), whose reset may change them.
   void set_machine_position(const Pose& machine);
+  // Replaces InterpOptions::tcp_switch (the caller that runs the program knows the TCP state).
+  void set_tcp_switch(std::function<Pose(const Pose& machine, bool tcp_on)> tcp_switch);
 
   // Opens a program file and resets to the start-of-program modal state. With `index` (of
   // this file, index_program()), a call finds a subroutine defined below it there rather than

@@ -104,6 +104,14 @@ class ProgramFeeder final : public interp::CanonSink {
   // Where the machine stands after a move that ended early (a probing move that tripped): the
   // next move starts there (machine coordinates).
   void set_position(const motion::AxisPose& at) { end_ = at; }
+  // Where `machine` (machine coordinates: the joints' axes, or under TCP the tool tip in the
+  // part's frame) lies once TCP is switched `on`: itself when that changes nothing.
+  motion::AxisPose tcp_switched(const motion::AxisPose& machine, bool on) const;
+  // Where the program stands when the machine's axes stand at `joints`: under TCP kept from
+  // the last MDI command, the tool tip in the part's frame.
+  motion::AxisPose program_start(const motion::AxisPose& joints, bool mdi) const {
+    return mdi && tcp_ ? in_frame(joints, true) : joints;
+  }
   // Offsets, units and feed as the commands so far left them.
   const interp::MachineTracker& tracker() const { return tracker_; }
 
@@ -214,6 +222,8 @@ class ProgramFeeder final : public interp::CanonSink {
   // Switched with every rotary at 0, where the part's frame is the machine's; moves queued
   // while it is on carry Move::tcp. A program starts with it off.
   void switch_tcp(bool on, int line);
+  // `machine` in the part's frame (`tcp`) or in the joints' from the other one.
+  motion::AxisPose in_frame(const motion::AxisPose& machine, bool tcp) const;
   bool tcp_ = false;
 
   // Path control mode and G64 P tolerance (machine units) as the interpreter last set them

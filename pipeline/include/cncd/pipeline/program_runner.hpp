@@ -52,6 +52,11 @@ class ProgramRunner {
   ProgramRunner(interp::Interpreter& interp, interp::Units machine_units,
                 ProgramFeeder::MessageHandler on_message = {},
                 const config::MachineConfig* machine = nullptr);
+  // The interpreter asks the runner's feeder where M428/M429 put the tool: not copied, and
+  // the interpreter forgets it when the runner goes.
+  ~ProgramRunner() { interp_.set_tcp_switch({}); }
+  ProgramRunner(const ProgramRunner&) = delete;
+  ProgramRunner& operator=(const ProgramRunner&) = delete;
 
   // A new run of what the interpreter has open; `at` is where the machine stands (machine
   // coordinates) when known, `tool` the tool in the spindle.
@@ -79,6 +84,10 @@ class ProgramRunner {
   // Hands the pending moves on without reading (the offline check counts what the block that
   // failed queued before its error).
   Drained drain(motion::MoveQueue& queue) { return feeder_.drain(queue); }
+  // ProgramFeeder::program_start().
+  motion::AxisPose program_start(const motion::AxisPose& joints, bool mdi) const {
+    return feeder_.program_start(joints, mdi);
+  }
   const Error& error() const { return error_; }
 
   // The machine has stopped at the M0/M1/M60: reading goes on.
