@@ -26,6 +26,14 @@ AxisPose rate(const Segment& piece) {
   return r;
 }
 
+// Whether the joints go on in the same direction from piece `a` into piece `b`.
+bool tangent(const Segment& a, const Segment& b) {
+  double c = 0;
+  for (int i = 0; i < kAxes; ++i)
+    c += a.end_direction[i] * b.start_direction[i];
+  return c > 1.0 - 5e-13;
+}
+
 double tip_distance(const AxisPose& a, const AxisPose& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                    (a[2] - b[2]) * (a[2] - b[2]));
@@ -73,7 +81,16 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
       add_sync(piece.sync, pending_sync_);
       pending_sync_ = {};
     }
-    if (held_) tcp_join(piece, std::min(mode, held_->mode));
+    if (held_) {
+      Move::PathMode join = std::min(mode, held_->mode);
+      // Exact path (canned cycles) goes on at speed only into a tangent move of the same kind,
+      // as out of TCP: a cycle stops at R, where its traverse meets the feed, and at the bottom.
+      if (k == 0 && join == Move::PathMode::exact_path &&
+          !(held_->traverse == (move.kind == Move::Kind::traverse) &&
+            tangent(held_->segment, piece)))
+        join = Move::PathMode::exact_stop;
+      tcp_join(piece, join);
+    }
     const Move::PathMode end_mode = last ? move.path_mode : Move::PathMode::blend;
     if (end_mode == Move::PathMode::exact_stop) {
       output_.push_back(piece);

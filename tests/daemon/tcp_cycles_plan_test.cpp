@@ -7,8 +7,9 @@
 // every servo period's joints through the forward kinematics: each hole's bottom (and each
 // peck's) is the programmed point in the part's frame, the joints there its inverse
 // kinematics, within 1 um; in the hole the tip stays on its axis within 1 um; it feeds from the
-// R plane (R1 in the Numeryx dialect) and leaves at the retract level G98/G99 give; and every
-// period's tip lies on the programmed move under way.
+// R plane (R1 in the Numeryx dialect), where the path stops as at the bottom (exact path, as
+// out of TCP), and leaves at the retract level G98/G99 give; and every period's tip lies on the
+// programmed move under way.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -161,6 +162,17 @@ class TcpCycles : public TcpPlan {
     const motion::AxisPose bottom = joints_at(h.x, h.y, h.bottom, kTilt);
     f.joints = std::max(f.joints, pose_distance(deepest->joints, bottom));
     EXPECT_LE(pose_distance(deepest->joints, bottom), kMicron);
+    // The path stops at R, where the traverse meets the feed, and at the bottom, as exact path
+    // (G61, in which every cycle runs) stops out of TCP.
+    int stops = 0;
+    for (const motion::Segment& seg : run.segments) {
+      for (const double z : {h.r, h.bottom}) {
+        if (pose_distance(seg.end, joints_at(h.x, h.y, z, kTilt)) > 1e-9) continue;
+        EXPECT_FALSE(seg.continuous) << "at Z" << z;
+        ++stops;
+      }
+    }
+    EXPECT_GE(stops, 2);
     const motion::AxisPose untilted{h.x, h.y, h.bottom, kTilt, 0, 0, 0, 0, 0};
     EXPECT_GT(pose_distance(bottom, untilted), 1.0);
   }

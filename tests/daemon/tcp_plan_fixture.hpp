@@ -31,6 +31,7 @@ struct TcpRun {
   std::vector<TcpSample> samples;
   std::vector<motion::Segment> moves;  // programmed moves, as on_move gives them
   std::vector<double> move_start_s;
+  std::vector<motion::Segment> segments;  // what the planner hands the servo loop (joints)
 };
 
 class TcpPlan : public ::testing::Test {
@@ -58,6 +59,7 @@ class TcpPlan : public ::testing::Test {
       run.samples.push_back(s);
     };
     options.on_move = [&](const motion::Segment& m) { run.moves.push_back(m); };
+    options.on_segment = [&](const motion::Segment& m) { run.segments.push_back(m); };
     run.result = pipeline::simulate_plan(*loaded_.config, dir_.write(name, text), options);
     EXPECT_TRUE(run.result.complete())
         << (run.result.error ? run.result.error->to_string() : run.result.stopped->to_string());
