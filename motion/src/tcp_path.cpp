@@ -48,12 +48,13 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
     flush();
     return push(move, check_limits, error);
   }
-  if (move.probe != ProbeMode::none || move.spindle_sync != SpindleSync::none) {
-    error = "probing and spindle-synchronized moves are not available under TCP (M428); M429 first";
-    return false;
-  }
   AxisPose part_start{};
   kins_->tcp_forward(end_, part_start);
+  if (auto why = tcp_refusal(move, part_start)) {
+    error = *why;
+    return false;
+  }
+  if (move.spindle_sync != SpindleSync::none) return push_tcp_sync(move, check_limits, error);
   // The tip's path within the axes' soft limits, in the part's frame.
   auto tip = plan(move, part_start, check_limits, error);
   if (!tip) return false;
@@ -101,6 +102,40 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
              0,     true};
   }
   return true;
+}
+
+bool Planner::push_tcp_sync(const Move& move, bool check_limits, std::string& error) {
+  AxisPose part_start{};
+  kins_->tcp_forward(end_, part_start);
+  auto tip = plan(move, part_start, check_limits, error);
+  if (!tip) return false;
+  // With the rotaries still the part's frame is the machine's turned and moved: the tip's line
+  // is one joint-space line of the same length, and the spindle's revolutions map onto it at
+  // the same distance per revolution.
+  Segment line = *tip;
+  kins_->tcp_inverse(tip->start, line.start);
+  kins_->tcp_inverse(tip->end, line.end);
+  if (line.length > 0) set_limits(line);
+  if (check_limits && !tcp_within_joint_limits({line}, error)) return false;
+  flush();
+  // A tap goes down its line and back: the next move starts where it started.
+  if (line.spindle_sync != SpindleSync::tap) end_ = line.end;
+  take(line, move);
+  return true;
+}
+
+std::optional<std::string> tcp_refusal(const Move& move, const AxisPose& start) {
+  if (move.probe != ProbeMode::none)
+    return "probing (G38.n) is not available under TCP (M428): the probe's trip point is known "
+           "in the machine's frame only; M429 first";
+  if (move.spindle_sync == SpindleSync::none) return std::nullopt;
+  for (const int axis : {3, 4, 5}) {
+    if (move.end[static_cast<std::size_t>(axis)] == start[static_cast<std::size_t>(axis)]) continue;
+    const char letter = config::kAxisLetters[static_cast<std::size_t>(axis)];
+    return std::string("a move in step with the spindle (G33, G33.1, rigid tapping) turns ") +
+           letter + " under TCP (M428): under TCP it runs with the rotary axes held still";
+  }
+  return std::nullopt;
 }
 
 void Planner::tcp_join(Segment& next, Move::PathMode mode) {

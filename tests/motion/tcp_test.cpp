@@ -171,5 +171,41 @@ TEST(TcpTest, AJointPastItsLimitIsRefusedThoughTheTipStaysInTheBox) {
       << error;
 }
 
+TEST(TcpTest, ATapWithTheRotariesStillIsOneJointLineOfTheSameLength) {
+  // At A-30 the tip's line down the part's Z is a line in joint space along the tilted Z,
+  // as long, in step with the spindle at the same distance per revolution; turning C in step
+  // with the spindle is refused.
+  const config::MachineConfig config = trunnion();
+  const auto kins = motion::make_kinematics(config);
+  motion::Planner planner(config);
+  AxisPose start{};
+  kins->tcp_inverse(pose(10, 5, 5, -30, 0), start);
+  planner.reset(start);
+  Move tap = tcp_move(Move::Kind::feed, pose(10, 5, -10, -30, 0), 12.5);
+  tap.path_mode = Move::PathMode::exact_stop;
+  tap.spindle_sync = motion::SpindleSync::tap;
+  tap.per_rev = 1.25;
+  std::string error;
+  ASSERT_TRUE(planner.push(tap, true, error)) << error;
+  planner.flush();
+  ASSERT_EQ(planner.output().size(), 1u);
+  const motion::Segment& line = planner.output().front();
+  AxisPose bottom{};
+  kins->tcp_inverse(pose(10, 5, -10, -30, 0), bottom);
+  for (int i = 0; i < motion::kAxes; ++i) {
+    EXPECT_NEAR(line.start[i], start[i], 1e-12) << i;
+    EXPECT_NEAR(line.end[i], bottom[i], 1e-12) << i;
+  }
+  EXPECT_NEAR(line.length, 15, 1e-12);
+  EXPECT_NEAR(std::hypot(line.end[1] - line.start[1], line.end[2] - line.start[2]), 15, 1e-12);
+  EXPECT_NEAR(line.end[1] - line.start[1], -15 * std::sin(30 * M_PI / 180), 1e-12);
+  EXPECT_EQ(line.spindle_sync, motion::SpindleSync::tap);
+  EXPECT_EQ(line.per_rev, 1.25);
+  Move turning = tap;
+  turning.end = pose(10, 5, -10, -30, 20);
+  EXPECT_FALSE(planner.push(turning, true, error));
+  EXPECT_NE(error.find("turns C under TCP (M428)"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace cncd::test

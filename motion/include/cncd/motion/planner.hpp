@@ -29,6 +29,13 @@ namespace cncd::motion {
 // the interpreter puts on offsets too (docs/motion.md).
 inline constexpr double kMaxCoordinate = 1e9;
 
+// Why `move`, from the tool tip at `start` (the part's frame), cannot run under TCP (M428): a
+// probing move, or a move in step with the spindle that turns a rotary axis (with the rotaries
+// still, the tip's map is a rotation and a translation, and such a move runs as the same line
+// in joint space); nullopt when it can. The planner refuses these, and the program's check
+// refuses them at their line before anything runs.
+std::optional<std::string> tcp_refusal(const Move& move, const AxisPose& start);
+
 class Planner {
  public:
   explicit Planner(const config::MachineConfig& config);
@@ -159,6 +166,9 @@ class Planner {
   // frame and cut into pieces straight in joint space, within TCP_TOLERANCE of it and short
   // enough that the turns between them fit in the joints' acceleration.
   bool push_tcp(const Move& move, bool check_limits, std::string& error);
+  // A move in step with the spindle under TCP, the rotaries still: the tip's line as one line
+  // in joint space, of the same length, run at rest at both ends as any such move.
+  bool push_tcp_sync(const Move& move, bool check_limits, std::string& error);
   // The pieces of the tip's path `tip` (planned from the part pose of end_), in joint space.
   bool tcp_pieces(const Segment& tip, std::vector<Segment>& pieces, std::string& error) const;
   // `n` equal pieces of `tip`; the largest distance of their tool tip from the path.
