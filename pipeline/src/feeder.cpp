@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <variant>
 
+#include "cncd/motion/kinematics.hpp"
+#include "cncd/motion/planner.hpp"
 #include "cncd/pipeline/machine.hpp"
 
 namespace cncd::pipeline {
@@ -96,6 +98,9 @@ void ProgramFeeder::begin_move(motion::Move& next, int line) {
   if (!unsupported_ && machine_ != nullptr) {
     if (auto why = axis_missing(*machine_, end_, next.end)) unsupported_ = Unsupported{line, *why};
   }
+  if (!unsupported_ && tcp_) {
+    if (auto why = motion::tcp_refusal(next, end_)) unsupported_ = Unsupported{line, *why};
+  }
   next.sync = sync_;
   sync_ = {};
   next.tcp = tcp_;
@@ -156,7 +161,14 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
               if (!unsupported_ && machine_ != nullptr) {
                 // G96 turns fastest at the end nearer the spindle's axis.
                 const double rpm = std::max(nominal_rpm(end_[0]), nominal_rpm(move.end[0]));
-                if (auto why = thread_too_fast(*machine_, end_, move.end, per_rev_, rpm,
+                // Under TCP the joints move along the line the tip's makes in their space.
+                motion::AxisPose from = end_, to = move.end;
+                if (tcp_) {
+                  const auto kins = motion::make_kinematics(*machine_);
+                  kins->tcp_inverse(end_, from);
+                  kins->tcp_inverse(move.end, to);
+                }
+                if (auto why = thread_too_fast(*machine_, from, to, per_rev_, rpm,
                                                spindle_direction_, spindle_speed_))
                   unsupported_ = Unsupported{m.line, *why};
               }

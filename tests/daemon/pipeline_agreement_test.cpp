@@ -133,7 +133,8 @@ TEST_F(PipelineAgreementTest, EveryPathGivesTheSameVerdictAtTheSameLine) {
 // limits, but the table's turn carries the X joint past its own (the tip at X 180 Y 90 is
 // 201.2 mm from the C axis, beyond X 200 between C -20 and C -33); the ends of the move are
 // within them. Refused at that line three ways; a program that keeps its joints within
-// their limits runs, and so does M428 with a rotary off 0.
+// their limits runs, and so does M428 with a rotary off 0. A rigid tap with the table tilted
+// runs; a thread that turns A, and a probing move, are refused at their line.
 class TrunnionAgreementTest : public PipelineAgreementTest {
  protected:
   std::string example() const override { return "sim_xyzac_trt"; }
@@ -147,6 +148,10 @@ TEST_F(TrunnionAgreementTest, AJointSwungPastItsLimitIsRefusedAtItsLine) {
       {"swing_within_joints", head + "G0 X150 Y90\nG1 C-50 F600\nG0 X0 Y0 C0\nM429\nM2\n", 0,
        false},
       {"switch_off_zero", "G21 G90\nG0 X0 Y0 Z0 A-10 C0\nM428\nG1 X1 F600\nM429\nM2\n", 0, false},
+      {"tap_tilted", head + "G0 A30\nG0 X5 Y5 Z5\nS600 M3\nG33.1 Z-5 K1.25\nG0 A0\nM429\nM2\n", 0,
+       false},
+      {"thread_turning_a", head + "G0 X5 Y5 Z5\nS600 M3\nG33 Z-5 A20 K1.25\nM429\nM2\n", 6, false},
+      {"probe_under_tcp", head + "G0 X5 Y5 Z5\nG38.2 Z-5 F100\nM429\nM2\n", 5, false},
   };
   expect_same_verdicts(cases);
 }
