@@ -1,15 +1,16 @@
 // Canned cycles under TCP on the trunnion (config/examples/sim_xyzac_trt.ini), in the plan
 // simulation: the seed G81 examples (tests/golden/seed_*: the LinuxCNC and PathPilot manuals'
 // two examples and the G80 section's eight holes), the Numeryx note's cycle in one block
-// (examples/numeryx/one_block.ngc), a G83 peck with G99 and the other cycles, each run with the
-// table tilted 30 degrees about A under M428. The programmed X Y Z are the tool tip in the
-// part's frame, so every cycle drills along the part's Z, which the tilted table turns. From
-// every servo period's joints through the forward kinematics: each hole's bottom (and each
-// peck's) is the programmed point in the part's frame, the joints there its inverse
-// kinematics, within 1 um; in the hole the tip stays on its axis within 1 um; it feeds from the
-// R plane (R1 in the Numeryx dialect), where the path stops as at the bottom (exact path, as
-// out of TCP), and leaves at the retract level G98/G99 give; and every period's tip lies on the
-// programmed move under way.
+// (examples/numeryx/one_block.ngc), a G83 peck with G99, the other cycles (G87 and G88 for
+// their path alone), each run with the table tilted 30 degrees about A under M428, and
+// examples/xyzac_trt_cycles.ngc. The programmed X Y Z are the tool tip in the part's frame, so
+// every cycle drills along the part's Z, which the tilted table turns. From every servo
+// period's joints through the forward kinematics: each hole's bottom (and each peck's) is the
+// programmed point in the part's frame, the joints there its inverse kinematics, within 1 um;
+// in the hole the tip stays on its axis within 1 um; it feeds from the R plane (R1 in the
+// Numeryx dialect), where the path stops as at the bottom (exact path, as out of TCP), and
+// leaves at the retract level G98/G99 give; and every period's tip lies on the programmed move
+// under way.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -165,10 +166,14 @@ class TcpCycles : public TcpPlan {
     // The path stops at R, where the traverse meets the feed, and at the bottom, as exact path
     // (G61, in which every cycle runs) stops out of TCP.
     int stops = 0;
-    for (const motion::Segment& seg : run.segments) {
-      for (const double z : {h.r, h.bottom}) {
-        if (pose_distance(seg.end, joints_at(h.x, h.y, z, kTilt)) > 1e-9) continue;
-        EXPECT_FALSE(seg.continuous) << "at Z" << z;
+    const motion::AxisPose at_r = joints_at(h.x, h.y, h.r, kTilt);
+    const motion::AxisPose at_bottom = joints_at(h.x, h.y, h.bottom, kTilt);
+    for (std::size_t k = 0; k + 1 < run.segments.size(); ++k) {
+      const motion::Segment& seg = run.segments[k];
+      const bool into_feed = seg.feed == 0 && run.segments[k + 1].feed > 0;
+      if ((into_feed && pose_distance(seg.end, at_r) < 1e-9) ||
+          (seg.feed > 0 && pose_distance(seg.end, at_bottom) < 1e-9)) {
+        EXPECT_FALSE(seg.continuous) << "at Z" << seg.end[2];
         ++stops;
       }
     }
@@ -251,6 +256,27 @@ TEST_F(TcpCycles, TheOtherCyclesDrillAlongTheTiltedZ) {
   for (const double x : {30.0, 40.0, 50.0, 60.0})
     holes.push_back({x, 0, 1, -4, 10, 10, feed});
   expect_holes("cycles.ngc", tilted(program), holes);
+}
+
+TEST_F(TcpCycles, G87AndG88StayOnTheirMovesInThePartsFrame) {
+  // G87 backs out of the hole's axis by I, goes down, comes back and bores up to K; G88 stops
+  // the program at the bottom (the operator's hold takes no time here). Each period's tip lies
+  // on the move under way, in the part's frame.
+  expect_holes("g87_g88.ngc",
+               tilted("S1000 M3\nG0 X10 Y0 Z10\nF120\nG98 G87 X10 Y0 Z-5 R1 I2 J0 K-2\n"
+                      "G88 X20 Z-4 R1 P0.2\n"),
+               {});
+}
+
+TEST_F(TcpCycles, TheTrunnionCyclesExample) {
+  // examples/xyzac_trt_cycles.ngc: four G81 holes from R1 to -5 at F120, G98 to Z10; a G83
+  // peck of 3 from R1 to -12 (G99); a G33.1 tap of the first hole to -4 from Z5, out to Z30.
+  std::vector<Hole> holes{{10, 0, 1, -5, 30, 30, 0, {-5, -4}}};
+  for (const auto& [x, y] : {std::pair{20.0, 0.0}, {20.0, 10.0}, {10.0, 10.0}})
+    holes.push_back({x, y, 1, -5, 10, 10, 2});
+  holes.push_back({15, 5, 1, -12, 10, 10, 0, {-2, -5, -8, -11, -12}});
+  expect_holes("xyzac_trt_cycles.ngc",
+               slurp(std::string(CNCD_SOURCE_DIR) + "/examples/xyzac_trt_cycles.ngc"), holes);
 }
 
 }  // namespace
