@@ -3,8 +3,9 @@
 // Numeryx g74 (examples/numeryx/rigid_tap.ngc) and a rigid G84 cycle tap along the part's Z,
 // which the tilted table turns: the tool tip (the joints through the forward kinematics) stays
 // on the hole's axis and on the helix the spindle's position gives, reaches the bottom and
-// comes back to where it started. A move in step with the spindle that turns a rotary, and a
-// probing move, are refused under TCP at their line, before anything runs.
+// comes back to where it started. A move in step with the spindle that turns a rotary, a probing
+// move and a thread too fast for a joint are refused under TCP at their line, before anything
+// runs.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -184,6 +185,23 @@ TEST_F(TcpTap, TurningARotaryInStepWithTheSpindleAndProbingAreRefusedAtTheirLine
   options.start_machine = interp::Pose{};
   const auto r = pipeline::simulate_plan(*loaded_.config, plain, options);
   EXPECT_TRUE(r.complete()) << (r.error ? r.error->to_string() : "");
+}
+
+// G33's check that the axes keep up with the thread takes the joints' speeds under TCP: at A45
+// a thread down the part's Y-Z diagonal at 25 mm/s moves each of the tip's Y and Z at 17.7 mm/s,
+// within their 20, but the joints along Z alone, at 25.
+TEST_F(TcpTap, AThreadTooFastForAJointIsRefusedAtItsLine) {
+  const auto program = dir_.write("fast.ngc",
+                                  "G21 G90 G94 G17\nG0 X0 Y0 Z30 A0 C0\nM428\nG0 A45\n"
+                                  "G0 X0 Y0 Z10\nS1000 M3\nG33 X0 Y-10 Z0 K1.5\n" +
+                                      kTail);
+  const auto checked = run_command({CNCD_CHECK_BINARY, "--ini", ini_.string(), program.string()});
+  EXPECT_EQ(checked.exit_status, 1);
+  EXPECT_NE(checked.err.find(program.string() +
+                             ":7: G33 at S1000 with 1.5 mm per revolution needs Z at 25 mm/s; "
+                             "[AXIS_Z] MAX_VELOCITY is 20 mm/s"),
+            std::string::npos)
+      << checked.err;
 }
 
 }  // namespace
