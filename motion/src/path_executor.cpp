@@ -201,6 +201,7 @@ void PathExecutor::fill_window() noexcept {
 }
 
 void PathExecutor::activate(const Segment& segment) noexcept {
+  tcp_ = segment.tcp;
   if (gate_ != nullptr && segment.sync.any()) gate_->started(segment.sync);
 }
 

@@ -22,6 +22,12 @@ void ServoLoop::publish() noexcept {
   status_.input_result = io_.input_result();
   status_.input_waits = io_.input_waits();
   kins_->forward(joints_.feedback, status_.actual);
+  status_.tcp = path_.tcp();
+  if (kins_->has_tcp()) {
+    status_.has_tcp = true;
+    kins_->tcp_forward(status_.commanded, status_.tip_commanded);
+    kins_->tcp_forward(status_.actual, status_.tip_actual);
+  }
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);
     status_.joint_commanded[k] = joints_.command[k];

@@ -58,6 +58,7 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
   // The tip's path within the axes' soft limits, in the part's frame.
   auto tip = plan(move, part_start, check_limits, error);
   if (!tip) return false;
+  tip->tcp = true;  // and so every piece cut from it
   std::vector<Segment> pieces;
   if (tip->kind != Segment::Kind::dwell && tip->length > 0 && !tcp_pieces(*tip, pieces, error))
     return false;

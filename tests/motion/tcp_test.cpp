@@ -99,6 +99,42 @@ TEST(TcpTest, TiltingAWithXyzHeldKeepsTheToolTipOnItsPoint) {
   expect_joints_within_limits(m, "G1 A-90 under TCP");
 }
 
+// What status publishes: the tip in the part's frame from the commanded and the actual joints
+// every period, and the TCP state of the segment under way, kept once it is done.
+TEST(TcpTest, TheStatusShowsTheTipAndWhetherThePathRunsUnderTcp) {
+  VirtualMachine m(trunnion());
+  const AxisPose point = pose(30, 40, 20, 0, 0);
+  ready_at(m, point);
+  motion::Status s = m.status();
+  EXPECT_TRUE(s.has_tcp);
+  EXPECT_FALSE(s.tcp);
+  EXPECT_EQ(s.tip_commanded, s.commanded);  // every rotary at 0
+  m.queue(tcp_move(Move::Kind::feed, pose(30, 40, 20, -90, 0), 30));
+  m.flush();
+  double worst = 0;
+  int periods = 0;
+  for (int k = 0; k < 100000; ++k) {
+    m.cycles(1);
+    s = m.status();
+    if (s.motion == motion::MotionState::idle && s.queued == 0) break;
+    ++periods;
+    EXPECT_TRUE(s.tcp) << "period " << k;
+    worst = std::max(
+        {worst, from_line(s.tip_commanded, point, point), from_line(s.tip_actual, point, point)});
+  }
+  std::printf("status under TCP, %d periods: the tip within %.6f mm of its point\n", periods,
+              worst);
+  EXPECT_GT(periods, 1000);
+  EXPECT_LE(worst, kTolerance);
+  EXPECT_TRUE(s.tcp);  // the last segment's, at rest
+  EXPECT_NEAR(s.commanded[1], 30, 1e-9);
+  EXPECT_NEAR(s.tip_commanded[1], 40, 1e-9);
+  EXPECT_NEAR(s.tip_commanded[kA], -90, 1e-9);
+  m.queue(tcp_move(Move::Kind::feed, pose(30, 30, 10, -90, 0), 30, false));
+  m.run_until_idle();
+  EXPECT_FALSE(m.status().tcp);
+}
+
 TEST(TcpTest, WithTcpOffTheSameMoveTurnsTheTableAlone) {
   VirtualMachine m(trunnion());
   ready_at(m, pose(30, 40, 20, 0, 0));

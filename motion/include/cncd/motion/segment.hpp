@@ -62,6 +62,9 @@ struct Segment {
   SpindleSync spindle_sync = SpindleSync::none;
   double per_rev = 0;
   double retract_scale = 1;
+  // A piece of a move planned under TCP (Move::tcp on a table-rotary machine): the status
+  // shows it while the segment runs and after, until the next one starts.
+  bool tcp = false;
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
   AxisPose start_direction{};

@@ -156,6 +156,14 @@ struct ServoStatus {
   AxisPose actual{};
   JointArray joint_commanded{};
   JointArray joint_actual{};
+  // Tool centre point control (Kinematics::has_tcp(), a table-rotary machine): the tool tip
+  // in the part's frame for the commanded and the actual position (Kinematics::tcp_forward()
+  // of the axes above, whatever the TCP state), and whether the path segment under way, or
+  // the last one run, was planned under TCP (M428). All false or zero without it.
+  bool has_tcp = false;
+  bool tcp = false;
+  AxisPose tip_commanded{};
+  AxisPose tip_actual{};
   double velocity = 0;              // units/s along the path
   double distance_to_go = 0;        // path distance left in the segment being executed
   AxisPose axes_to_go{};            // that segment's end less the commanded position, per axis
