@@ -163,6 +163,17 @@ json panel_object(const std::optional<PanelReport>& panel) {
               {"lights", flags_object(panel->lights)}};
 }
 
+json tcp_object(const std::optional<TcpReport>& tcp) {
+  if (!tcp) return nullptr;
+  return json{{"programmed", tcp->programmed}, {"motion", tcp->motion}};
+}
+
+json tool_tip_object(const config::MachineConfig& config, const std::optional<TcpReport>& tcp) {
+  if (!tcp) return nullptr;
+  return json{{"commanded", axes_object(config, tcp->tip_commanded)},
+              {"actual", axes_object(config, tcp->tip_actual)}};
+}
+
 }  // namespace
 
 json optional_number(const std::optional<double>& value) {
@@ -192,6 +203,8 @@ json status_json(const TaskStatus& s, const config::MachineConfig& config, std::
       {"position",
        {{"commanded", axes_object(config, s.commanded)},
         {"actual", axes_object(config, s.actual)}}},
+      {"tool_tip", tool_tip_object(config, s.tcp)},
+      {"tcp", tcp_object(s.tcp)},
       {"position_restored", s.position_restored},
       {"work_position",
        {{"commanded", axes_object(config, s.work_commanded)},

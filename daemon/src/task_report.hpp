@@ -150,6 +150,19 @@ struct PanelReport {
   bool block_delete = false;  // '/' lines are skipped
 };
 
+// Tool centre point control on a machine that has it (a table-rotary kinematics).
+struct TcpReport {
+  // M428 in force in the interpreter: the next move it reads (a program's, an MDI block's) is
+  // under TCP.
+  bool programmed = false;
+  // The path segment the servo thread runs now, or the last one it ran, is under TCP.
+  bool motion = false;
+  // The tool tip in the part's frame (what X Y Z mean under TCP; the rotaries as they stand),
+  // from the commanded and the actual joints: machine units.
+  motion::AxisPose tip_commanded{};
+  motion::AxisPose tip_actual{};
+};
+
 // Who has manual motion now (one hand on the machine): the panel's MPG or a jog button, or
 // the client that jogs, by the name its events carry.
 struct ManualHolder {
@@ -194,6 +207,7 @@ struct TaskStatus {
   double feed_rate = 0;  // program units per minute
   motion::RtStats rt;
   std::optional<PanelReport> panel;  // none without [PANEL]
+  std::optional<TcpReport> tcp;      // none on a machine without TCP
 };
 
 // offsets.get: every coordinate system's origin and the G92 offset.

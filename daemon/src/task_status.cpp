@@ -172,6 +172,7 @@ TaskStatus Task::status() const {
   out.manual_holder = manual_holder(s);
   out.commanded = s.commanded;
   out.actual = s.actual;
+  if (s.has_tcp) out.tcp = TcpReport{runner_->feeder().tcp(), s.tcp, s.tip_commanded, s.tip_actual};
   out.position_restored = position_restored_;
   out.velocity = s.velocity;
   out.distance_to_go = s.distance_to_go;

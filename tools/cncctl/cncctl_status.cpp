@@ -123,6 +123,20 @@ void print_status(const json& s) {
   std::printf("commanded %s  (%s)\n", axes_text(position.value("commanded", json())).c_str(),
               get<std::string>(s, "units", "").c_str());
   std::printf("actual    %s\n", axes_text(position.value("actual", json())).c_str());
+  // A machine with TCP: the tool tip in the part's frame, and the TCP state of the motion
+  // and of the next move the interpreter reads.
+  const json tip = s.value("tool_tip", json());
+  if (tip.is_object()) {
+    std::printf("tip       %s  (tool tip, part's frame)\n",
+                axes_text(tip.value("commanded", json())).c_str());
+    std::printf("tip act   %s\n", axes_text(tip.value("actual", json())).c_str());
+  }
+  const json tcp = s.value("tcp", json());
+  if (tcp.is_object()) {
+    std::printf("tcp       motion %s, next move %s\n",
+                get<bool>(tcp, "motion", false) ? "on" : "off",
+                get<bool>(tcp, "programmed", false) ? "on" : "off");
+  }
   if (get<std::string>(s, "position_restored", "") == "unclean") {
     std::printf("          (started from positions saved before an unclean shutdown)\n");
   }

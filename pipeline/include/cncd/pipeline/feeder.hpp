@@ -116,6 +116,9 @@ class ProgramFeeder final : public interp::CanonSink {
   const interp::MachineTracker& tracker() const { return tracker_; }
 
   bool has_pending() const { return !pending_.empty(); }
+  // Tool centre point control as the commands so far left it (M428 on, M429 off): the moves
+  // read next carry Move::tcp.
+  bool tcp() const { return tcp_; }
   std::size_t pending_count() const { return pending_.size(); }
   // Moves and actions the queue has taken since start_program().
   std::uint64_t moves_queued() const { return moves_queued_; }
