@@ -1,5 +1,6 @@
-// The DRO (work and machine position, distance to go), velocity, active codes, tool, spindle,
-// coolant, and the override sliders.
+// The DRO (work and machine position, on a machine with TCP the tool tip in the part's frame
+// and the TCP state, distance to go), velocity, active codes, tool, spindle, coolant, and the
+// override sliders.
 
 import {$, el, fmt, setText} from './ui.js';
 
@@ -21,6 +22,7 @@ function buildAxes(ctx, axes) {
         'tr', {class: 'dro-row', dataset: {axis: a}}, el('th', {class: 'dro-axis'}, letter),
         el('td', {id: `dro-${a}`, class: 'dro-work'}, '—'),
         el('td', {id: `dro-mach-${a}`, class: 'dro-mach'}, '—'),
+        el('td', {id: `dro-tip-${a}`, class: 'dro-tip'}, '—'),
         el('td', {
           id: `dro-dtg-${a}`,
           class: 'dro-dtg',
@@ -35,6 +37,9 @@ function showDro(ctx, status) {
   const mach = status.position?.actual ?? {};
   const toGo = status.axes_to_go ?? {};
   const digits = status.units === 'inch' ? 4 : 3;
+  // A machine with TCP: the tool tip in the part's frame, null elsewhere.
+  const tip = status.tool_tip?.actual ?? null;
+  $('.dro-table').classList.toggle('has-tip', tip !== null);
   for (const letter of ctx.droAxes) {
     const a = letter.toLowerCase();
     setText($(`#dro-${a}`), fmt(work[a], digits));
@@ -44,6 +49,7 @@ function showDro(ctx, status) {
       $('#dro-x')?.setAttribute('title', status.diameter_mode ? 'X as a diameter (G7)' : '');
     }
     setText($(`#dro-mach-${a}`), fmt(mach[a], digits));
+    if (tip) setText($(`#dro-tip-${a}`), fmt(tip[a], digits));
     setText($(`#dro-dtg-${a}`), fmt(toGo[a], digits));
   }
   const homed = status.homed ?? [];
@@ -55,6 +61,7 @@ function showDro(ctx, status) {
   setText($('#velocity'), `${fmt((status.velocity ?? NaN) * 60, 1)} ${units}/min`);
   setText($('#feed-rate'), `F ${fmt(status.feed_rate, 1)}`);
   setText($('#coord-system'), status.offsets?.coord_system ?? '');
+  showTcp(status.tcp);
   setText($('#active-codes'), [...(status.gcodes ?? []), ...(status.mcodes ?? [])].join(' '));
   const tool = status.tool ?? {};
   let toolText = tool.number ? `T${tool.number}` : 'T0 (none)';
@@ -78,6 +85,20 @@ function showDro(ctx, status) {
       [coolant.flood && 'flood', coolant.mist && 'mist'].filter(Boolean).join(' + ') || 'off');
   for (const name of ['feed', 'rapid', 'spindle'])
     showOverride(name, status.overrides?.[name]);
+}
+
+// TCP as the motion runs it; the interpreter's state for the next move when that differs
+// (after M428 or M429, before the next move runs).
+function showTcp(tcp) {
+  const box = $('#tcp-state');
+  box.hidden = !tcp;
+  if (!tcp) return;
+  const word = (on) => (on ? 'on' : 'off');
+  const next = tcp.programmed !== tcp.motion ? ` (next move: ${word(tcp.programmed)})` : '';
+  setText(box, `TCP ${word(tcp.motion)}${next}`);
+  box.classList.toggle('on', tcp.motion);
+  box.title = `tool centre point control: the motion runs with it ${word(tcp.motion)}, ` +
+      `the next move the interpreter reads ${word(tcp.programmed)} (M428 on, M429 off)`;
 }
 
 function setupOverride(ctx, name) {
