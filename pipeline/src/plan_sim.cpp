@@ -88,23 +88,28 @@ class Simulation final : motion::MoveQueue {
            ++i)
         result_.move_start_s[i] = begin_s;
       const double t = static_cast<double>(cycle) * result_.period_s;
-      if (options_.on_sample) {
+      if (options_.on_sample || options_.on_period) {
         // The spindle where it stands at the end of the period is what the next one reads.
-        if (sample_pending_) options_.on_sample(sample_t_, sample_pose_, s.spindle.revolutions);
+        if (sample_pending_) hand_on_sample(s.spindle.revolutions);
         sample_pending_ = true;
-        sample_t_ = t;
-        sample_pose_ = s.commanded;
+        sample_ = {t, s.commanded, s.joint_commanded, s.tip_commanded, s.tcp, 0.0};
         sample_revolutions_ = s.spindle.revolutions;
       }
       if (options_.measure) measure(s, done);
     }
     // The last period's spindle reading stands for its end: the program ends at rest.
-    if (sample_pending_) options_.on_sample(sample_t_, sample_pose_, sample_revolutions_);
+    if (sample_pending_) hand_on_sample(sample_revolutions_);
     result_.cycles = cycle;
     result_.cycle_time_s = static_cast<double>(cycle) * result_.period_s;
   }
 
  private:
+  void hand_on_sample(double revolutions) {
+    sample_.spindle = revolutions;
+    if (options_.on_sample) options_.on_sample(sample_.t, sample_.axes, revolutions);
+    if (options_.on_period) options_.on_period(sample_);
+  }
+
   // Machine on at the start position, all joints as if homed there: the planner checks the
   // soft limits as it does for a homed machine.
   bool start_machine() {
@@ -148,6 +153,8 @@ class Simulation final : motion::MoveQueue {
     programmed_end_ = status.commanded;
     planner_.reset(status.commanded);
     previous_ = status.commanded;
+    previous_joints_ = status.joint_commanded;
+    result_.joint_count = status.joint_count;
     return true;
   }
 
@@ -297,6 +304,15 @@ class Simulation final : motion::MoveQueue {
       velocity_[i] = v;
     }
     previous_ = s.commanded;
+    for (std::size_t j = 0; j < static_cast<std::size_t>(result_.joint_count); ++j) {
+      const double v = (s.joint_commanded[j] - previous_joints_[j]) / period;
+      const double a = (v - joint_velocity_[j]) / period;
+      result_.joint_peak_velocity[j] = std::max(result_.joint_peak_velocity[j], std::abs(v));
+      result_.joint_peak_acceleration[j] =
+          std::max(result_.joint_peak_acceleration[j], std::abs(a));
+      joint_velocity_[j] = v;
+    }
+    previous_joints_ = s.joint_commanded;
     // The sample lies on the move under way or, where the path blends, on a neighbour.
     while (!window_.empty() && window_first_ + 3 <= done) {
       window_.pop_front();
@@ -330,11 +346,12 @@ class Simulation final : motion::MoveQueue {
   std::uint64_t pushed_ = 0;            // segments queued by the program
   motion::AxisPose previous_{};
   motion::AxisPose velocity_{};
+  motion::JointArray previous_joints_{};
+  motion::JointArray joint_velocity_{};
   std::deque<motion::Segment> window_;  // queued segments from index window_first_ on
   // The sample of the last period, handed on with the spindle's next reading.
   bool sample_pending_ = false;
-  double sample_t_ = 0;
-  motion::AxisPose sample_pose_{};
+  PlanSample sample_;
   double sample_revolutions_ = 0;
   std::uint64_t window_first_ = 0;
 };

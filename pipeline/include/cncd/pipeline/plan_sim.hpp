@@ -23,6 +23,18 @@
 
 namespace cncd::pipeline {
 
+// One servo period of the simulated motion, as PlanSimOptions::on_period hands it on.
+struct PlanSample {
+  double t = 0;                 // s, from the program's start, at the end of the period
+  motion::AxisPose axes{};      // the commanded axes (machine coordinates), as on_sample's
+  motion::JointArray joints{};  // the joints' commanded positions, [JOINT_n] order
+  // On a machine with TCP (Kinematics::has_tcp()): the tool tip in the part's frame for those
+  // joints, and whether the segment under way (or the last one) was planned under TCP.
+  motion::AxisPose tip{};
+  bool tcp = false;
+  double spindle = 0;  // revolutions, as on_sample's
+};
+
 struct PlanSimOptions {
   interp::InterpOptions interp;
   // Where the machine stands when the program starts (machine coordinates and units); unset =
@@ -42,6 +54,8 @@ struct PlanSimOptions {
   // axis positions (machine coordinates) at the end of that period and the spindle's position
   // then (revolutions, signed: forward counts up), as the next period reads it.
   std::function<void(double, const motion::AxisPose&, double)> on_sample;
+  // The same period with the joints and the TCP state (the trajectory CSV).
+  std::function<void(const PlanSample&)> on_period;
   // Called with every programmed move, in order, as the planner plans it alone: the geometry
   // the bounds use, before a blend or a merge shortens it.
   std::function<void(const motion::Segment&)> on_move;
@@ -74,6 +88,12 @@ struct PlanSimResult {
   // servo period: the largest |velocity| (units/s) and |acceleration| (units/s^2).
   motion::AxisPose peak_velocity{};
   motion::AxisPose peak_acceleration{};
+  // The same per joint ([JOINT_n] order, joint units) from the joints' commanded positions:
+  // what the motors do where a joint is not an axis of its own (corexy's belts, a trunnion's
+  // X Y Z under TCP). The first joint_count entries are the machine's.
+  int joint_count = 0;
+  motion::JointArray joint_peak_velocity{};
+  motion::JointArray joint_peak_acceleration{};
   // Largest XYZ distance from a commanded position to the programmed path near the move under
   // way (units), and the program line where it happened.
   double max_deviation = 0;
