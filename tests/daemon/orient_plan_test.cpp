@@ -58,7 +58,7 @@ TEST_F(OrientPlan, TheSimSpindleStopsAtTheAngleTurningTheWayPAsks) {
   std::ifstream in(csv);
   std::string row;
   std::getline(in, row);
-  ASSERT_EQ(row, "t,x,y,z,spindle");
+  ASSERT_EQ(row, "t,x,y,z,spindle,j0,j1,j2");
   double t, x, y, z, turns;
   double highest = -1e9;  // where the spindle stood, at most, before X moved
   double at_move = 0;

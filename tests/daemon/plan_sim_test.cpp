@@ -236,9 +236,10 @@ TEST_F(PlanSimTest, CncdCheckPlanPrintsFiguresJsonAndTheTrajectory) {
   EXPECT_LE(report["axes"]["x"]["acceleration_ratio"].get<double>(), 1.001);
   const auto rows = lines_of(csv);
   ASSERT_EQ(rows.size(), report["cycles"].get<std::size_t>() + 1);
-  EXPECT_EQ(rows.front(), "t,x,y,z,spindle");
-  char last[80];
-  std::snprintf(last, sizeof last, "%.6f,15.000000,5.000000,0.000000,0.000000",
+  EXPECT_EQ(rows.front(), "t,x,y,z,spindle,j0,j1,j2");
+  char last[120];
+  std::snprintf(last, sizeof last,
+                "%.6f,15.000000,5.000000,0.000000,0.000000,15.000000,5.000000,0.000000",
                 report["cycle_time_s"].get<double>());
   EXPECT_EQ(rows.back(), last);
   EXPECT_FALSE(std::filesystem::exists(csv.string() + ".tmp"));

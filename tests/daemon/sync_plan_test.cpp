@@ -188,7 +188,7 @@ TEST_F(SyncPlan, CncdCheckTrajectoryHasTheSpindleColumn) {
   std::ifstream in(csv);
   std::string header;
   std::getline(in, header);
-  EXPECT_EQ(header, "t,x,y,z,spindle");
+  EXPECT_EQ(header, "t,x,y,z,spindle,j0,j1,j2");
   // Read back, the rows give the same helix.
   std::string row;
   while (std::getline(in, row)) {

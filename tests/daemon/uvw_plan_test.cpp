@@ -65,7 +65,7 @@ TEST_F(UvwPlan, ACycleInTheUvPlaneDrillsAlongWOnAMachineWithUvwAxes) {
   std::ifstream in(csv);
   std::string row;
   std::getline(in, row);
-  ASSERT_EQ(row, "t,x,y,z,u,v,w,spindle");
+  ASSERT_EQ(row, "t,x,y,z,u,v,w,spindle,j0,j1,j2,j3,j4,j5");
   double deepest = 1e9;
   std::array<double, 3> at_bottom{};  // U V Z
   double t, x, y, z, u, v, w, spindle;

@@ -12,6 +12,7 @@
 // Exit status: 0 good, 1 program problems, 2 usage, 78 invalid INI.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,7 @@
 
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/rs274_printer.hpp"
+#include "cncd/motion/kinematics.hpp"
 #include "cncd/pipeline/machine.hpp"
 #include "cncd/pipeline/plan_sim.hpp"
 #include "cncd/pipeline/program_check.hpp"
@@ -63,14 +65,16 @@ int usage(const std::string& why) {
          "  --max-seconds S  stop checking after S seconds (default 600, 0 = never)\n"
          "  --plan       run the planner and servo loop in virtual time: cycle time, its\n"
          "               feed-limited and exact-stop bounds, peak axis velocity and\n"
-         "               acceleration, largest deviation from the programmed path\n"
+         "               acceleration (beside them the joints', where the kinematics is not\n"
+         "               trivkins), largest deviation from the programmed path\n"
          "  --json       with --plan: print one JSON object instead\n"
          "  --preview    print the toolpath as program.preview answers it (one JSON object):\n"
          "               extents and polylines in machine coordinates, tagged with lines\n"
          "  --tolerance T  with --preview: how far the drawn path may pass from a point it\n"
          "               leaves out, machine units (default 0.01 mm, 0.0004 in)\n"
-         "  --trajectory FILE.csv  with --plan: write t, every axis and the spindle's\n"
-         "               position (revolutions) per servo period\n"
+         "  --trajectory FILE.csv  with --plan: write t, every axis, the spindle's\n"
+         "               position (revolutions) and every joint (j0 ...) per servo period;\n"
+         "               with TCP also the tool tip in the part's frame (tip_x ...) and tcp\n"
          "  --from-line N  run from line N as cncd does: check (or plan) from there on, and\n"
          "               print the state the lines before it leave and what is done before\n"
          "               it (tool, spindle, coolant, Z up, over the start, Z down) with\n"
@@ -80,30 +84,47 @@ int usage(const std::string& why) {
 }
 
 // Writes the commanded trajectory to `path` through a temporary file renamed into place at
-// the end, so that a reader never sees half of it.
+// the end, so that a reader never sees half of it: t, the axes (machine coordinates), the
+// spindle, the joints (j0 ...), and on a machine with TCP the tool tip in the part's frame
+// (tip_x ...) and whether the motion runs under TCP (tcp, 1 or 0).
 class TrajectoryFile {
  public:
   TrajectoryFile(const std::string& path, const cncd::config::MachineConfig& machine)
-      : path_(path), temp_(path + ".tmp." + std::to_string(::getpid())), out_(temp_) {
+      : path_(path),
+        temp_(path + ".tmp." + std::to_string(::getpid())),
+        out_(temp_),
+        joints_(std::min<std::size_t>(machine.joints.size(), cncd::motion::kJoints)),
+        tcp_(cncd::motion::make_kinematics(machine)->has_tcp()) {
     out_ << 't';
     for (std::size_t i = 0; i < cncd::config::kAxisLetters.size(); ++i) {
-      if (!machine.axes[i].present) continue;
-      axes_.push_back(i);
-      out_ << ',' << static_cast<char>(cncd::config::kAxisLetters[i] - 'A' + 'a');
+      if (machine.axes[i].present) axes_.push_back(i);
     }
-    out_ << ",spindle\n";
+    for (const std::size_t i : axes_)
+      out_ << ',' << letter(i);
+    out_ << ",spindle";
+    for (std::size_t j = 0; j < joints_; ++j)
+      out_ << ",j" << j;
+    if (tcp_) {
+      for (const std::size_t i : axes_)
+        out_ << ",tip_" << letter(i);
+      out_ << ",tcp";
+    }
+    out_ << '\n';
   }
   bool opened() const { return static_cast<bool>(out_); }
-  void add(double t, const cncd::motion::AxisPose& pose, double spindle) {
-    char text[40];
-    std::snprintf(text, sizeof text, "%.6f", t);
-    out_ << text;
-    for (const std::size_t i : axes_) {
-      std::snprintf(text, sizeof text, ",%.6f", pose[i]);
-      out_ << text;
+  void add(const cncd::pipeline::PlanSample& sample) {
+    number(sample.t, false);
+    for (const std::size_t i : axes_)
+      number(sample.axes[i]);
+    number(sample.spindle);
+    for (std::size_t j = 0; j < joints_; ++j)
+      number(sample.joints[j]);
+    if (tcp_) {
+      for (const std::size_t i : axes_)
+        number(sample.tip[i]);
+      out_ << (sample.tcp ? ",1" : ",0");
     }
-    std::snprintf(text, sizeof text, ",%.6f", spindle);
-    out_ << text << '\n';
+    out_ << '\n';
   }
   // "" or what went wrong; the temporary file is removed on failure.
   std::string finish() {
@@ -120,10 +141,21 @@ class TrajectoryFile {
   }
 
  private:
+  static char letter(std::size_t axis) {
+    return static_cast<char>(cncd::config::kAxisLetters[axis] - 'A' + 'a');
+  }
+  void number(double value, bool comma = true) {
+    char text[40];
+    std::snprintf(text, sizeof text, comma ? ",%.6f" : "%.6f", value);
+    out_ << text;
+  }
+
   std::string path_;
   std::string temp_;
   std::ofstream out_;
   std::vector<std::size_t> axes_;
+  std::size_t joints_;
+  bool tcp_;
 };
 
 // What chose the dialect a program was read in, for the summary.
@@ -144,9 +176,7 @@ int check_plan(const cncd::config::MachineConfig& machine, const std::string& pr
                 << '\n';
       return kExitProblems;
     }
-    options.on_sample = [&csv](double t, const cncd::motion::AxisPose& pose, double spindle) {
-      csv->add(t, pose, spindle);
-    };
+    options.on_period = [&csv](const cncd::pipeline::PlanSample& sample) { csv->add(sample); };
   }
   const auto result = cncd::pipeline::simulate_plan(machine, program, options);
   // A program that stopped before it moved has no figures worth a report (JSON always has one).
