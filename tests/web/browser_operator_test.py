@@ -134,6 +134,12 @@ def first_run(m, browser):
     assert all(near(a, b) for a, b in zip(work_xyz(done), (4, 5, 3))), work_xyz(done)
     browser.wait(lambda: [number(browser.text(f"#dro-{a}")) for a in "xyz"] == [4, 5, 3],
                  "the DRO at X4 Y5 Z3")
+    # The mill has no TCP: no tool tip column and no TCP state.
+    assert done.get("tool_tip") is None and done.get("tcp") is None, done.get("tcp")
+    shown = browser.driver.execute_script(
+        "return [getComputedStyle(document.querySelector('#dro-tip-x')).display,"
+        " document.querySelector('#tcp-state').hidden]")
+    assert shown == ["none", True], shown
     texts = seen(browser)
     zs = {number(t[2]) for t in texts}
     ratios = {float(t[4]) for t in texts if t[4] not in (None, "")}
