@@ -163,6 +163,32 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
   }
 }
 
+// The recording is of the joints, whatever the kinematics: the step/dir mill made a corexy
+// machine runs the example to X4 Y5 Z3, and its two belt motors' pulses add up to X + Y and
+// X - Y, not to X and Y (docs/kinematics.md).
+TEST(DriversEndToEnd, TheRecordingOfACorexyMachineHasItsMotorsSteps) {
+  TempDir dir;
+  const std::string vcd = (dir.path() / "steps.vcd").string();
+  const json s =
+      run_example(dir, adapt(dir, "gpio_vcd_mill.ini",
+                             {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
+                              {"KINEMATICS = trivkins coordinates=XYZ", "KINEMATICS = corexykins"},
+                              // The motors' ranges while X and Y keep within their limits.
+                              {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 300\n",
+                               "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -20\nMAX_LIMIT = 500\n"},
+                              {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 200\n",
+                               "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -210\nMAX_LIMIT = 310\n"},
+                              {"FERROR = 1\n", "FERROR = 10\n"},
+                              {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
+  expect_end(s, "gpio corexy");
+  EXPECT_EQ(s["joints"][0]["commanded"], 9.0) << s["joints"].dump();
+  EXPECT_EQ(s["joints"][1]["commanded"], -1.0);
+  const auto changes = read_vcd(vcd);
+  EXPECT_EQ(step_stats(changes, 0).net_steps, 9 * 320);   // X + Y
+  EXPECT_EQ(step_stats(changes, 1).net_steps, -1 * 320);  // X - Y
+  EXPECT_EQ(step_stats(changes, 2).net_steps, 3 * 320);
+}
+
 // The first time `signal` goes to `level` at or after `from`, or -1.
 std::int64_t first_edge(const std::vector<VcdChange>& changes, const std::string& signal, int level,
                         std::int64_t from = 0) {
