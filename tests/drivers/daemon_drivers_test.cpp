@@ -122,6 +122,17 @@ std::vector<std::pair<std::string, std::string>> modbus_changes(int port) {
   return {{"PORT = 1502", "PORT = " + std::to_string(port)}};
 }
 
+// The step/dir mill recording to `vcd`, with `more` changes. A base thread stalled by a busy
+// shared machine catches up afterwards, which the example's tight following-error limits
+// would call a fault: they are widened.
+std::string recorded_mill(const TempDir& dir, const std::string& vcd,
+                          std::vector<std::pair<std::string, std::string>> more = {}) {
+  more.insert(more.begin(), {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
+                             {"FERROR = 1\n", "FERROR = 10\n"},
+                             {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}});
+  return adapt(dir, "gpio_vcd_mill.ini", more);
+}
+
 void expect_end(const json& s, const char* driver) {
   SCOPED_TRACE(driver);
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
@@ -139,13 +150,7 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
   {
     TempDir dir;
     const std::string vcd = (dir.path() / "steps.vcd").string();
-    const json s =
-        run_example(dir, adapt(dir, "gpio_vcd_mill.ini",
-                               {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
-                                // A base thread stalled by a busy shared machine catches up
-                                // afterwards, which the example's tight limits would call a fault.
-                                {"FERROR = 1\n", "FERROR = 10\n"},
-                                {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
+    const json s = run_example(dir, recorded_mill(dir, vcd));
     expect_end(s, "gpio");
     // cncd has stopped and flushed the recording: the pulses add up to the end position.
     const auto changes = read_vcd(vcd);
@@ -169,17 +174,14 @@ TEST(DriversEndToEnd, SimGpioAndModbusRunTheExampleToTheSameEnd) {
 TEST(DriversEndToEnd, TheRecordingOfACorexyMachineHasItsMotorsSteps) {
   TempDir dir;
   const std::string vcd = (dir.path() / "steps.vcd").string();
-  const json s =
-      run_example(dir, adapt(dir, "gpio_vcd_mill.ini",
-                             {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
-                              {"KINEMATICS = trivkins coordinates=XYZ", "KINEMATICS = corexykins"},
-                              // The motors' ranges while X and Y keep within their limits.
-                              {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 300\n",
-                               "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -20\nMAX_LIMIT = 500\n"},
-                              {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 200\n",
-                               "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -210\nMAX_LIMIT = 310\n"},
-                              {"FERROR = 1\n", "FERROR = 10\n"},
-                              {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}));
+  const json s = run_example(
+      dir, recorded_mill(dir, vcd,
+                         {{"KINEMATICS = trivkins coordinates=XYZ", "KINEMATICS = corexykins"},
+                          // The motors' ranges while X and Y keep within their limits.
+                          {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 300\n",
+                           "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -20\nMAX_LIMIT = 500\n"},
+                          {"STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -10\nMAX_LIMIT = 200\n",
+                           "STEPGEN_MAXACCEL = 600\nMIN_LIMIT = -210\nMAX_LIMIT = 310\n"}}));
   expect_end(s, "gpio corexy");
   EXPECT_EQ(s["joints"][0]["commanded"], 9.0) << s["joints"].dump();
   EXPECT_EQ(s["joints"][1]["commanded"], -1.0);
@@ -215,12 +217,7 @@ TEST(DriversEndToEnd, TheRecordingShowsTheSpindleCoolantAndOutputsAgainstTheStep
                                  "M9\n"
                                  "M5\n"
                                  "M2\n");
-  const json s = run_example(dir,
-                             adapt(dir, "gpio_vcd_mill.ini",
-                                   {{"CHIP = vcd:/tmp/cncd-steps.vcd", "CHIP = vcd:" + vcd},
-                                    {"FERROR = 1\n", "FERROR = 10\n"},
-                                    {"MIN_FERROR = 0.25\n", "MIN_FERROR = 2\n"}}),
-                             program.string());
+  const json s = run_example(dir, recorded_mill(dir, vcd), program.string());
   EXPECT_EQ(s["program"]["result"], "done") << s.dump();
   const auto changes = read_vcd(vcd);
   const std::int64_t enabled = first_edge(changes, "spindle_enable", 1);
