@@ -1,14 +1,14 @@
 # The page in a real headless Chromium (Debian's chromium and chromium-driver, driven by
-# python3-selenium) against the real cncd on the simulated mill and the real cncd-web. Without
-# them the tests say what is missing and are skipped (exit 77); scripts/setup.sh
-# --with-browser installs them. Debian's selenium lives in the system Python, so /usr/bin's
-# python3 is preferred to another one earlier in PATH.
+# python3-selenium) against the real cncd on the simulated mill (the trunnion for TCP) and the
+# real cncd-web. Without them the tests say what is missing and are skipped (exit 77);
+# scripts/setup.sh --with-browser installs them. Debian's selenium lives in the system Python,
+# so /usr/bin's python3 is preferred to another one earlier in PATH.
 find_program(CNCD_SYSTEM_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(NOT CNCD_SYSTEM_PYTHON3)
   find_program(CNCD_SYSTEM_PYTHON3 NAMES python3)
 endif()
 
-foreach(name operator access)
+foreach(name operator access tcp)
   set(test web.browser.${name})
   if(CNCD_SYSTEM_PYTHON3 AND TARGET cncd-web)
     add_test(NAME ${test}

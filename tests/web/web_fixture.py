@@ -176,11 +176,13 @@ def work_xyz(status):
 
 
 class Machine:
-    """cncd on a copy of config/examples/sim_mm.ini and cncd-web in front of it."""
+    """cncd on a copy of config/examples/sim_mm.ini (or another example, `example`) and
+    cncd-web in front of it."""
 
-    def __init__(self, args, web_keys=None):
+    def __init__(self, args, web_keys=None, example="sim_mm"):
         self.args = args
         self.web_keys = web_keys or {}
+        self.example = example
         self.dir = tempfile.mkdtemp(prefix="cncd-web-test-")
         self.programs = os.path.join(self.dir, "programs")
         self.state = os.path.join(self.dir, "state")
@@ -188,7 +190,7 @@ class Machine:
         self.sock = os.path.join(self.dir, "cncd.sock")
         self.port = free_port()
         self.base = f"http://127.0.0.1:{self.port}"
-        self.ini = os.path.join(self.dir, "sim_mm.ini")
+        self.ini = os.path.join(self.dir, example + ".ini")
         self.users_file = os.path.join(self.dir, "web-users")
         self.procs = []
         self._write_ini()
@@ -196,9 +198,9 @@ class Machine:
     def _write_ini(self):
         examples = os.path.join(self.args.source_dir, "config", "examples")
         for name in os.listdir(examples):
-            if name.startswith("sim_mm.") and not name.endswith(".ini"):
+            if name.startswith(self.example + ".") and not name.endswith(".ini"):
                 shutil.copy(os.path.join(examples, name), self.dir)
-        with open(os.path.join(examples, "sim_mm.ini")) as f:
+        with open(os.path.join(examples, self.example + ".ini")) as f:
             text = f.read()
         text = re.sub(r"(?m)^PROGRAM_PREFIX = .*$", f"PROGRAM_PREFIX = {self.programs}", text)
         text = re.sub(r"(?m)^SOCKET = .*$", f"SOCKET = {self.sock}", text)
