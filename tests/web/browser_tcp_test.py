@@ -9,7 +9,6 @@ after a move, off.
 
 import math
 import re
-import sys
 
 from browser_fixture import Browser, require_browser
 from web_fixture import Machine, parse_args
@@ -26,43 +25,42 @@ def column(browser, kind, axes="xyz"):
     return [number(browser.text(f"#dro-{kind}-{a}")) for a in axes]
 
 
-def main():
-    args = parse_args()
-    require_browser()
-    m = Machine(args, example="sim_xyzac_trt")
-    browser = None
-    try:
-        m.add_user(USER, "operator", PASSWORD)
-        m.start()
-        m.ready_machine()
-        browser = Browser()
-        browser.login(m.base, USER, PASSWORD)
-        browser.wait(lambda: browser.text("#tcp-state") == "TCP off", "the TCP label, off")
-        shown = browser.driver.execute_script(
-            "return getComputedStyle(document.querySelector('#dro-tip-x')).display")
-        assert shown != "none", shown
-        for line in ("G0 X40 Y0 Z20", "M428", "G1 A-90 F1800"):
-            m.rpc.call("mdi.execute", {"line": line})
-        browser.wait(lambda: column(browser, "mach", "yza") == [30, 30, -90],
-                     "the machine column at Y30 Z30 A-90")
-        browser.wait(lambda: column(browser, "tip") == [40, 0, 20], "the tip column at X40 Y0 Z20")
-        browser.wait(lambda: browser.text("#tcp-state") == "TCP on", "the TCP label, on")
-        print(f"under TCP at A-90: machine {column(browser, 'mach')}, tip "
-              f"{column(browser, 'tip')}, label '{browser.text('#tcp-state')}'")
-        m.rpc.call("mdi.execute", {"line": "G1 A0 F1800"})
-        m.rpc.call("mdi.execute", {"line": "M429"})
-        browser.wait(lambda: browser.text("#tcp-state") == "TCP on (next move: off)",
-                     "the TCP label after M429")
-        m.rpc.call("mdi.execute", {"line": "G0 Z25"})
-        browser.wait(lambda: browser.text("#tcp-state") == "TCP off", "the TCP label, off again")
-        assert column(browser, "tip") == column(browser, "mach"), "A at 0: the tip is the axes"
-    finally:
-        if browser is not None:
-            browser.quit()
-        m.stop()
-    print("browser TCP test: passed")
-    return 0
+def tcp_dro(m, browser):
+    browser.login(m.base, USER, PASSWORD)
+    browser.wait(lambda: browser.text("#tcp-state") == "TCP off", "the TCP label, off")
+    shown = browser.driver.execute_script(
+        "return getComputedStyle(document.querySelector('#dro-tip-x')).display")
+    assert shown != "none", shown
+    for line in ("G0 X40 Y0 Z20", "M428", "G1 A-90 F1800"):
+        m.rpc.call("mdi.execute", {"line": line})
+    browser.wait(lambda: column(browser, "mach", "yza") == [30, 30, -90],
+                 "the machine column at Y30 Z30 A-90")
+    browser.wait(lambda: column(browser, "tip") == [40, 0, 20], "the tip column at X40 Y0 Z20")
+    browser.wait(lambda: browser.text("#tcp-state") == "TCP on", "the TCP label, on")
+    print(f"under TCP at A-90: machine {column(browser, 'mach')}, tip "
+          f"{column(browser, 'tip')}, label '{browser.text('#tcp-state')}'")
+    m.rpc.call("mdi.execute", {"line": "G1 A0 F1800"})
+    m.rpc.call("mdi.execute", {"line": "M429"})
+    browser.wait(lambda: browser.text("#tcp-state") == "TCP on (next move: off)",
+                 "the TCP label after M429")
+    m.rpc.call("mdi.execute", {"line": "G0 Z25"})
+    browser.wait(lambda: browser.text("#tcp-state") == "TCP off", "the TCP label, off again")
+    assert column(browser, "tip") == column(browser, "mach"), "A at 0: the tip is the axes"
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    ARGS = parse_args()
+    require_browser()
+    MACHINE = Machine(ARGS, example="sim_xyzac_trt")
+    try:
+        MACHINE.add_user(USER, "operator", PASSWORD)
+        MACHINE.start()
+        MACHINE.ready_machine()
+        PAGE = Browser()
+        try:
+            tcp_dro(MACHINE, PAGE)
+        finally:
+            PAGE.quit()
+    finally:
+        MACHINE.stop()
+    print("browser TCP test: passed")
