@@ -11,8 +11,9 @@
 // path_floor.hpp: the time from the start of its first move to the end of its last within the
 // whole program (from the simulation's per-move start times), and the path run alone from
 // rest where it starts (a program of its lines after G92), on cncd and LinuxCNC, and the
-// time-optimal reference of path_reference.hpp on its exact path and within its G64 P; for
-// 3D_Chips and the surface finish, where the time goes (path_diagnosis.hpp).
+// time-optimal reference of path_reference.hpp on its exact path and within its G64 P (and the
+// other geometries within P of path_smooth.hpp); for 3D_Chips and the surface finish, where the
+// time goes (path_diagnosis.hpp).
 //
 //   cncd_planner_bench [--no-linuxcnc] [--keep] [--run-sh PATH] [--jerk J] [--only TEXT]
 //                      [--speed-svg FILE [--speed-window FROM,TO]]
@@ -49,6 +50,7 @@
 #include "path_diagnosis.hpp"
 #include "path_floor.hpp"
 #include "path_reference.hpp"
+#include "path_smooth.hpp"
 #include "planner_programs.hpp"
 #include "speed_svg.hpp"
 
@@ -228,6 +230,8 @@ struct Bench {
         program.merge_tolerance, ref.time_s, ref.time_s / floors.bound_s, ref.blends,
         ref_exact.steps, ref_within.steps, ref.steps, took.count(), change(exact, ref_exact),
         change(within, ref_within), change(merged, ref));
+    cncd::bench::print_smoothed(machine, moves, program.tolerance, program.merge_tolerance,
+                                floors.bound_s);
     const auto ratios = [&floors, &ref](const char* who, const char* how, double s) {
       std::printf(
           "    %-9s %-18s %.3f s  ratio %.4f  over start/stop floor %.4f  "

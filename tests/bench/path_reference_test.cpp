@@ -1,5 +1,6 @@
 // The planner benchmark's time-optimal reference: paths whose least time is known in closed
-// form, and how it stands against the floors and against cncd's own plan.
+// form, and how it stands against the floors and against cncd's own plan; the references
+// within P of path_smooth.hpp.
 #include "path_reference.hpp"
 
 #include <gtest/gtest.h>
@@ -10,11 +11,13 @@
 #include <fstream>
 #include <iomanip>
 #include <numbers>
+#include <random>
 #include <sstream>
 
 #include "bench_mill.hpp"
 #include "cncd/pipeline/plan_sim.hpp"
 #include "path_floor.hpp"
+#include "path_smooth.hpp"
 #include "planner_programs.hpp"
 
 namespace cncd::bench {
@@ -288,6 +291,110 @@ TEST_F(PlannedPath, PlannerSegmentsTimedWholeLieBetweenTheReferenceAndCncd) {
   // cncd runs those segments period by period: no faster than timed whole, and close to it.
   EXPECT_LE(planned.time_s, cncd);
   EXPECT_LT(cncd, 1.02 * planned.time_s);
+}
+
+// The reference smoothed within P (path_smooth.hpp): the moved polyline stays within the shift
+// of the programmed one over randomized dense polylines, leaves straight runs, arcs and the
+// runs' ends where they are, and is no slower than the corner blends alone.
+std::vector<Segment> polyline(const std::vector<AxisPose>& points, double feed = 100) {
+  std::vector<Segment> out;
+  for (std::size_t i = 1; i < points.size(); ++i)
+    out.push_back(line(points[i - 1], points[i], feed));
+  return out;
+}
+
+// Random dense polylines: a wandering 3D curve sampled at 0.05 to 2 mm with noise, zigzags,
+// spikes, collinear stretches and repeated points.
+std::vector<AxisPose> random_points(std::mt19937& rng, int kind) {
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<AxisPose> p{at(0, 0, 0)};
+  double heading = 0;
+  for (int i = 0; i < 400; ++i) {
+    const AxisPose& last = p.back();
+    const double step = 0.05 + 1.95 * u(rng);
+    if (kind == 0) heading += 0.4 * (u(rng) - 0.5);
+    if (kind == 1) heading = (i % 2 ? 0.6 : -0.6);                                     // zigzag
+    if (kind == 2 && i % 37 == 0) heading += std::numbers::pi * (0.8 + 0.2 * u(rng));  // spike
+    const bool straight = kind == 3 && (i / 20) % 2 == 0;
+    const double z = straight ? last[2] : last[2] + 0.2 * (u(rng) - 0.5);
+    p.push_back(at(last[0] + step * std::cos(heading), last[1] + step * std::sin(heading), z));
+    if (kind == 3 && i % 53 == 0) p.push_back(p.back());  // a repeated point: a zero line
+  }
+  return p;
+}
+
+TEST(PathSmooth, MovedPolylineStaysWithinTheShiftOfTheProgrammedOne) {
+  std::mt19937 rng(28);
+  for (int kind = 0; kind < 4; ++kind) {
+    for (double shift : {0.005, 0.05, 0.3}) {
+      const auto moves = polyline(random_points(rng, kind));
+      SmoothOptions options;
+      options.shift = shift;
+      const auto smoothed = smoothed_lines(moves, options);
+      ASSERT_EQ(smoothed.size(), moves.size());
+      // Sampled every 2 um (the bound holds at every point: a moved point is the programmed one
+      // at the same fraction plus at most the shift). The flow uses the room it has.
+      const double deviation = polyline_deviation(moves, smoothed, 2e-3, 0);
+      EXPECT_LE(deviation, shift + 1e-9) << "kind " << kind << " shift " << shift;
+      EXPECT_GT(deviation, 0.5 * shift) << "kind " << kind << " shift " << shift;
+      for (std::size_t i = 0; i < moves.size(); ++i) {
+        EXPECT_NEAR(smoothed[i].length,
+                    std::hypot(smoothed[i].end[0] - smoothed[i].start[0],
+                               smoothed[i].end[1] - smoothed[i].start[1],
+                               smoothed[i].end[2] - smoothed[i].start[2]),
+                    1e-12);
+        if (i > 0) {
+          EXPECT_EQ(smoothed[i].start, smoothed[i - 1].end);
+        }
+      }
+      EXPECT_EQ(smoothed.front().start, moves.front().start);
+      EXPECT_EQ(smoothed.back().end, moves.back().end);
+    }
+  }
+}
+
+TEST(PathSmooth, StraightRunsArcsAndOtherFeedsStay) {
+  // A straight run unevenly spaced, then a line of another feed, a rapid and an arc.
+  std::vector<Segment> moves = polyline({at(0, 0), at(0.3, 0), at(1.7, 0), at(2, 0), at(4, 0)});
+  moves.push_back(line(at(4, 0), at(4, 1), 50));
+  Segment rapid = line(at(4, 1), at(5, 1), 0);
+  moves.push_back(rapid);
+  Segment arc = line(at(5, 1), at(5, 3), 100);
+  arc.kind = Segment::Kind::arc;
+  moves.push_back(arc);
+  SmoothOptions options;
+  options.shift = 0.05;
+  const auto smoothed = smoothed_lines(moves, options);
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(smoothed[i].start[a], moves[i].start[a], 1e-12) << i;
+      EXPECT_NEAR(smoothed[i].end[a], moves[i].end[a], 1e-12) << i;
+    }
+  }
+}
+
+TEST(PathSmooth, NoisyCurveRunsFasterSmoothedThanBlendedWithinTheSameTolerance) {
+  // A circle of radius 20 in 0.5 mm chords whose points are off by up to 0.04 mm: the blends
+  // follow the noise, the smoothed polyline much less of it.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> noise(-0.04, 0.04);
+  std::vector<AxisPose> points;
+  for (int i = 0; i <= 250; ++i) {
+    const double t = i * 0.5 / 20;
+    points.push_back(at(20 * std::cos(t) + noise(rng), 20 * std::sin(t) + noise(rng)));
+  }
+  const auto moves = polyline(points, 200);
+  const auto machine = three_axis_mill();
+  ReferenceOptions within;
+  within.blend_corners = true;
+  within.tolerance = 0.1;
+  const double blended = time_optimal(machine, moves, within).time_s;
+  SmoothOptions options;
+  options.shift = 0.05;
+  ReferenceOptions rest = within;
+  rest.tolerance = 0.05;
+  const double smoothed = time_optimal(machine, smoothed_lines(moves, options), rest).time_s;
+  EXPECT_LT(smoothed, 0.8 * blended);
 }
 
 }  // namespace
