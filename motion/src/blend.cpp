@@ -45,8 +45,9 @@ void Planner::reset(const AxisPose& start) {
 }
 
 bool Planner::push(const Move& move, bool check_limits, std::string& error) {
-  if ((move.tcp && kins_->has_tcp()) || (held_ && held_->tcp))
-    return push_tcp(move, check_limits, error);
+  const bool tcp = move.tcp && kins_->has_tcp();
+  if (!tcp) tcp_tool_length_.reset();  // out of TCP the joints are the axes, any tool
+  if (tcp || (held_ && held_->tcp)) return push_tcp(move, check_limits, error);
   auto planned = plan(move, end_, check_limits, error);
   if (!planned) return false;
   const AxisPose start = end_;

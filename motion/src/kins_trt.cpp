@@ -7,9 +7,10 @@
 //
 // R is the point where the C axis crosses ([KINS] X/Y/Z_ROT_POINT), P = R + the offsets from
 // the C axis to the tilting axis (Y_OFFSET and Z_OFFSET for A, X_OFFSET and Z_OFFSET for B), t
-// TOOL_OFFSET along Z, C(c) the table's turn by c about +Z and T the cradle's by the tilt
-// angle about +X (+Y for B), counterclockwise seen from the axis's positive end. At every
-// rotary at 0 the two frames are the same.
+// the tool's length along Z (the G43 length in force, as LinuxCNC nets motion.tooloffset.z to
+// the module's tool-offset pin; [KINS] TOOL_OFFSET while that is 0), C(c) the table's turn by
+// c about +Z and T the cradle's by the tilt angle about +X (+Y for B), counterclockwise seen
+// from the axis's positive end. At every rotary at 0 the two frames are the same, whatever t.
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -69,7 +70,7 @@ class TableRotaryKinematics final : public Kinematics {
     c_point_ = {t.x_rot_point, t.y_rot_point, t.z_rot_point};
     tilt_point_ = c_point_ + (tilt_axis_ == kA ? Vec{0, t.y_offset, t.z_offset}
                                                : Vec{t.x_offset, 0, t.z_offset});
-    tool_ = {0, 0, t.tool_offset};
+    tool_offset_ = t.tool_offset;
     // Each joint moves as its axis and within its own limits too.
     for (std::size_t j = 0; j < config.joints.size() && j < static_cast<std::size_t>(kJoints);
          ++j) {
@@ -94,27 +95,35 @@ class TableRotaryKinematics final : public Kinematics {
 
   bool has_tcp() const noexcept override { return true; }
 
-  void tcp_forward(const AxisPose& machine, AxisPose& part) const noexcept override {
+  void tcp_forward(const AxisPose& machine, double tool_length,
+                   AxisPose& part) const noexcept override {
     part = machine;
-    const Vec tip = Vec{machine[kX], machine[kY], machine[kZ]} - tool_;
+    const Vec tool = tool_along_z(tool_length);
+    const Vec tip = Vec{machine[kX], machine[kY], machine[kZ]} - tool;
     const Vec on_cradle = turn(tip - tilt_point_, tilt_index(), -tilt(machine)) + tilt_point_;
-    const Vec p = turn(on_cradle - c_point_, 2, -c(machine)) + c_point_ + tool_;
+    const Vec p = turn(on_cradle - c_point_, 2, -c(machine)) + c_point_ + tool;
     part[kX] = p.x;
     part[kY] = p.y;
     part[kZ] = p.z;
   }
 
-  void tcp_inverse(const AxisPose& part, AxisPose& machine) const noexcept override {
+  void tcp_inverse(const AxisPose& part, double tool_length,
+                   AxisPose& machine) const noexcept override {
     machine = part;
-    const Vec tip = Vec{part[kX], part[kY], part[kZ]} - tool_;
+    const Vec tool = tool_along_z(tool_length);
+    const Vec tip = Vec{part[kX], part[kY], part[kZ]} - tool;
     const Vec on_cradle = turn(tip - c_point_, 2, c(part)) + c_point_;
-    const Vec m = turn(on_cradle - tilt_point_, tilt_index(), tilt(part)) + tilt_point_ + tool_;
+    const Vec m = turn(on_cradle - tilt_point_, tilt_index(), tilt(part)) + tilt_point_ + tool;
     machine[kX] = m.x;
     machine[kY] = m.y;
     machine[kZ] = m.z;
   }
 
  private:
+  // t z: the G43 length in force, or TOOL_OFFSET without one.
+  Vec tool_along_z(double tool_length) const noexcept {
+    return {0, 0, tool_length != 0 ? tool_length : tool_offset_};
+  }
   int tilt_index() const noexcept { return tilt_axis_ == kA ? 0 : 1; }
   double tilt(const AxisPose& pose) const noexcept {
     return pose[static_cast<std::size_t>(tilt_axis_)] * to_radians_;
@@ -126,7 +135,7 @@ class TableRotaryKinematics final : public Kinematics {
   double to_radians_;                           // per machine angular unit
   Vec c_point_;                                 // R
   Vec tilt_point_;                              // P
-  Vec tool_;                                    // t z
+  double tool_offset_ = 0;                      // [KINS] TOOL_OFFSET
   std::vector<RateLimit> limits_;
 };
 

@@ -202,6 +202,7 @@ void PathExecutor::fill_window() noexcept {
 
 void PathExecutor::activate(const Segment& segment) noexcept {
   tcp_ = segment.tcp;
+  tcp_tool_length_ = segment.tool_length;
   if (gate_ != nullptr && segment.sync.any()) gate_->started(segment.sync);
 }
 

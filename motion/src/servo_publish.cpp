@@ -25,8 +25,8 @@ void ServoLoop::publish() noexcept {
   status_.tcp = path_.tcp();
   if (kins_->has_tcp()) {
     status_.has_tcp = true;
-    kins_->tcp_forward(status_.commanded, status_.tip_commanded);
-    kins_->tcp_forward(status_.actual, status_.tip_actual);
+    kins_->tcp_forward(status_.commanded, path_.tcp_tool_length(), status_.tip_commanded);
+    kins_->tcp_forward(status_.actual, path_.tcp_tool_length(), status_.tip_actual);
   }
   for (int j = 0; j < joint_count_; ++j) {
     const auto k = static_cast<std::size_t>(j);

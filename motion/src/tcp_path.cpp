@@ -48,23 +48,28 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
     flush();
     return push(move, check_limits, error);
   }
+  // Where the last TCP move left the tool, in the part's frame, with the length it ran with.
   AxisPose part_start{};
-  kins_->tcp_forward(end_, part_start);
+  kins_->tcp_forward(end_, tcp_tool_length_.value_or(move.tool_length), part_start);
   if (auto why = tcp_refusal(move, part_start)) {
     error = *why;
     return false;
   }
+  if (!same_joints_with_length(part_start, move.tool_length, error)) return false;
   if (move.spindle_sync != SpindleSync::none) return push_tcp_sync(move, check_limits, error);
   // The tip's path within the axes' soft limits, in the part's frame.
   auto tip = plan(move, part_start, check_limits, error);
   if (!tip) return false;
   tip->tcp = true;  // and so every piece cut from it
+  tip->tool_length = move.tool_length;
   std::vector<Segment> pieces;
-  if (tip->kind != Segment::Kind::dwell && tip->length > 0 && !tcp_pieces(*tip, pieces, error))
+  if (tip->kind != Segment::Kind::dwell && tip->length > 0 &&
+      !tcp_pieces(*tip, move.tool_length, pieces, error))
     return false;
   if (check_limits && !tcp_within_joint_limits(pieces, error)) return false;
   // Into TCP (M428): what is held back before it ends at rest.
   if (!(held_ && held_->tcp)) flush();
+  tcp_tool_length_ = move.tool_length;
   if (pieces.empty()) {
     // Nothing moves (a dwell, or an end where the move starts).
     Segment rest = *tip;
@@ -107,18 +112,21 @@ bool Planner::push_tcp(const Move& move, bool check_limits, std::string& error) 
 
 bool Planner::push_tcp_sync(const Move& move, bool check_limits, std::string& error) {
   AxisPose part_start{};
-  kins_->tcp_forward(end_, part_start);
+  kins_->tcp_forward(end_, move.tool_length, part_start);
   auto tip = plan(move, part_start, check_limits, error);
   if (!tip) return false;
   // With the rotaries still the part's frame is the machine's turned and moved: the tip's line
   // is one joint-space line of the same length, and the spindle's revolutions map onto it at
   // the same distance per revolution.
   Segment line = *tip;
-  kins_->tcp_inverse(tip->start, line.start);
-  kins_->tcp_inverse(tip->end, line.end);
+  kins_->tcp_inverse(tip->start, move.tool_length, line.start);
+  kins_->tcp_inverse(tip->end, move.tool_length, line.end);
+  line.tcp = true;
+  line.tool_length = move.tool_length;
   if (line.length > 0) set_limits(line);
   if (check_limits && !tcp_within_joint_limits({line}, error)) return false;
   flush();
+  tcp_tool_length_ = move.tool_length;
   // A tap goes down its line and back: the next move starts where it started.
   if (line.spindle_sync != SpindleSync::tap) end_ = line.end;
   take(line, move);
@@ -137,6 +145,28 @@ std::optional<std::string> tcp_refusal(const Move& move, const AxisPose& start) 
            letter + " under TCP (M428): under TCP it runs with the rotary axes held still";
   }
   return std::nullopt;
+}
+
+
+bool Planner::same_joints_with_length(const AxisPose& part_start, double tool_length,
+                                      std::string& error) const {
+  if (!tcp_tool_length_ || *tcp_tool_length_ == tool_length) return true;
+  // With the tilting axis off 0 the new length puts the same tip elsewhere in the machine: the
+  // joints would have to jump there, as LinuxCNC's would when its tool-offset pin changes.
+  AxisPose there{};
+  kins_->tcp_inverse(part_start, tool_length, there);
+  for (int i = 0; i < kAxes; ++i) {
+    if (std::abs(there[i] - end_[i]) <= kTcpSameJoint) continue;
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the tool length changes from %.4f to %.4f under TCP (M428) with the table "
+                  "tilted: the joints would jump to keep the tip; change it with the tilting "
+                  "axis at 0",
+                  *tcp_tool_length_, tool_length);
+    error = text;
+    return false;
+  }
+  return true;
 }
 
 void Planner::tcp_join(Segment& next, Move::PathMode mode) {
@@ -167,17 +197,18 @@ void Planner::tcp_join(Segment& next, Move::PathMode mode) {
   output_.push_back(prev);
 }
 
-double Planner::cut_tcp(const Segment& tip, int n, std::vector<Segment>& pieces) const {
+double Planner::cut_tcp(const Segment& tip, double tool_length, int n,
+                        std::vector<Segment>& pieces) const {
   pieces.clear();
   const double step = tip.length / n;
   AxisPose from{};
-  kins_->tcp_inverse(tip.point_at(0), from);
+  kins_->tcp_inverse(tip.point_at(0), tool_length, from);
   double worst = 0;
   for (int k = 0; k < n; ++k) {
     const double s0 = step * k;
     const double s1 = k + 1 == n ? tip.length : step * (k + 1);
     AxisPose to{};
-    kins_->tcp_inverse(k + 1 == n ? tip.end : tip.point_at(s1), to);
+    kins_->tcp_inverse(k + 1 == n ? tip.end : tip.point_at(s1), tool_length, to);
     // The tip where the straight joint move puts it, against the path at the same share of
     // the way (which is no nearer to it than the path's nearest point).
     for (const double f : {0.25, 0.5, 0.75}) {
@@ -185,7 +216,7 @@ double Planner::cut_tcp(const Segment& tip, int n, std::vector<Segment>& pieces)
       for (int i = 0; i < kAxes; ++i)
         joints[i] = from[i] + (to[i] - from[i]) * f;
       AxisPose part{};
-      kins_->tcp_forward(joints, part);
+      kins_->tcp_forward(joints, tool_length, part);
       worst = std::max(worst, tip_distance(part, tip.point_at(s0 + (s1 - s0) * f)));
     }
     Segment piece = tip;
@@ -203,13 +234,13 @@ double Planner::cut_tcp(const Segment& tip, int n, std::vector<Segment>& pieces)
   return worst;
 }
 
-bool Planner::tcp_pieces(const Segment& tip, std::vector<Segment>& pieces,
+bool Planner::tcp_pieces(const Segment& tip, double tool_length, std::vector<Segment>& pieces,
                          std::string& error) const {
   const double tolerance = config_.table_rotary.tcp_tolerance;
   // The tip's error on a piece goes with the square of its length: cut finer until it fits.
   int n = 1;
   for (;;) {
-    const double worst = cut_tcp(tip, n, pieces);
+    const double worst = cut_tcp(tip, tool_length, n, pieces);
     if (worst <= tolerance) break;
     const double more = std::ceil(n * 1.2 * std::sqrt(worst / tolerance));
     if (n >= kMaxTcpPieces || !std::isfinite(more)) {
@@ -250,7 +281,7 @@ bool Planner::tcp_pieces(const Segment& tip, std::vector<Segment>& pieces,
     wanted = std::max(wanted, std::min(n * top / v, finest));
   }
   const int more = static_cast<int>(std::min<double>(kMaxTcpPieces, std::ceil(wanted)));
-  if (more > n) cut_tcp(tip, more, pieces);
+  if (more > n) cut_tcp(tip, tool_length, more, pieces);
   return true;
 }
 
@@ -261,7 +292,8 @@ bool Planner::tcp_joints_within_limits(const Move& move, const AxisPose& start,
   const auto tip = plan(move, start, false, unplanned);  // a move that cannot be is not ours
   if (!tip || tip->kind == Segment::Kind::dwell || tip->length <= 0) return true;
   std::vector<Segment> pieces;
-  return tcp_pieces(*tip, pieces, error) && tcp_within_joint_limits(pieces, error);
+  return tcp_pieces(*tip, move.tool_length, pieces, error) &&
+         tcp_within_joint_limits(pieces, error);
 }
 
 bool Planner::tcp_within_joint_limits(const std::vector<Segment>& pieces,

@@ -67,20 +67,20 @@ TEST(TableRotaryKinsTest, KnownPosesOfXyzac) {
   const auto kins = motion::make_kinematics(trunnion("xyzac-trt-kins", g));
   AxisPose m{};
   // Every rotary at 0: the part's frame is the machine's.
-  kins->tcp_inverse(pose(12, -7, 3, 0, 0, 0), m);
+  kins->tcp_inverse(pose(12, -7, 3, 0, 0, 0), 0, m);
   expect_pose(m, pose(12, -7, 3, 0, 0, 0));
   // C 90: the table turns a point on +X to +Y about the C axis (through the origin).
-  kins->tcp_inverse(pose(10, 0, 0, 0, 0, 90), m);
+  kins->tcp_inverse(pose(10, 0, 0, 0, 0, 90), 0, m);
   expect_pose(m, pose(0, 10, 0, 0, 0, 90));
   // A 90: a point 10 mm above the A axis (Y 20, Z 10) swings to 10 mm before it (-Y).
-  kins->tcp_inverse(pose(0, 20, 20, 90, 0, 0), m);
+  kins->tcp_inverse(pose(0, 20, 20, 90, 0, 0), 0, m);
   expect_pose(m, pose(0, 10, 10, 90, 0, 0));
   // A point on the A axis stays where it is, whatever A.
-  kins->tcp_inverse(pose(5, 20, 10, -37, 0, 0), m);
+  kins->tcp_inverse(pose(5, 20, 10, -37, 0, 0), 0, m);
   expect_pose(m, pose(5, 20, 10, -37, 0, 0));
   // C then A: (10, 0, 0) goes to (0, 10, 0) by C, then about the A axis: 10 mm before it and
   // 10 mm below, turned 90 degrees: 10 mm below and 10 mm behind.
-  kins->tcp_inverse(pose(10, 0, 0, 90, 0, 90), m);
+  kins->tcp_inverse(pose(10, 0, 0, 90, 0, 90), 0, m);
   expect_pose(m, pose(0, 30, 0, 90, 0, 90));
 }
 
@@ -92,11 +92,46 @@ TEST(TableRotaryKinsTest, KnownPosesOfXyzbcAndTheToolOffset) {
   AxisPose m{};
   // B 90 about the B axis (X -5, Z 0): the tool tip at (5, 0, 0) in the part (the controlled
   // point 50 above it) goes to 10 mm below the axis, the controlled point 50 above that.
-  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), m);
+  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 0, m);
   expect_pose(m, pose(-5, 0, 40, 0, 90, 0));
   // The tip on the B axis stays there.
-  kins->tcp_inverse(pose(-5, 3, 50, 0, 33, 0), m);
+  kins->tcp_inverse(pose(-5, 3, 50, 0, 33, 0), 0, m);
   expect_pose(m, pose(-5, 3, 50, 0, 33, 0));
+}
+
+TEST(TableRotaryKinsTest, TheG43LengthInForceIsTheToolsLengthElseToolOffset) {
+  // LinuxCNC nets motion.tooloffset.z to the module's tool-offset pin: the G43 length in force
+  // is the length the tip is turned with; [KINS] TOOL_OFFSET only stands in while none is.
+  config::TableRotaryConfig g;
+  g.x_offset = -5;
+  g.tool_offset = 80;
+  const auto kins = motion::make_kinematics(trunnion("xyzbc-trt-kins", g));
+  AxisPose m{};
+  // G43 with 50 mm: as TOOL_OFFSET 50 above, the tip (5, 0, 0) 10 mm below the B axis.
+  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 50, m);
+  expect_pose(m, pose(-5, 0, 40, 0, 90, 0));
+  // G49: TOOL_OFFSET's 80 mm; the tip at (5, 0, -30), 10 mm right of and 30 below the axis,
+  // turned to 30 mm left of it and 10 below.
+  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 0, m);
+  expect_pose(m, pose(-35, 0, 70, 0, 90, 0));
+  AxisPose back{};
+  kins->tcp_forward(m, 0, back);
+  expect_pose(back, pose(5, 0, 50, 0, 90, 0));
+  // With the tilting axis at 0 the length moves no joint, whatever C: G43 changes nothing
+  // there but the program's Z.
+  for (const double length : {0.0, 30.0, 50.0, -12.5}) {
+    kins->tcp_inverse(pose(12, -7, 3, 0, 0, 77), length, m);
+    AxisPose none{};
+    kins->tcp_inverse(pose(12, -7, 3, 0, 0, 77), 80, none);
+    expect_pose(m, none);
+  }
+  // Tilted, it does: the tip is length below the controlled point, and the cradle swings it.
+  AxisPose longer{};
+  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 60, longer);
+  kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 50, m);
+  // 10 mm longer: the controlled point stays 10 mm higher, the tip swung 10 mm toward -X.
+  EXPECT_NEAR(longer[0] - m[0], -10, 1e-9);
+  EXPECT_NEAR(longer[2] - m[2], 10, 1e-9);
 }
 
 TEST(TableRotaryKinsTest, ForwardUndoesInverseEverywhere) {
@@ -111,15 +146,18 @@ TEST(TableRotaryKinsTest, ForwardUndoesInverseEverywhere) {
   std::mt19937 random(29);
   std::uniform_real_distribution<double> place(-300, 300);
   std::uniform_real_distribution<double> angle(-720, 720);
+  std::uniform_real_distribution<double> tool(-20, 150);
   for (const char* module : {"xyzac-trt-kins", "xyzbc-trt-kins"}) {
     const auto kins = motion::make_kinematics(trunnion(module, g));
     double worst = 0;
     for (int k = 0; k < 10000; ++k) {
       const AxisPose part = pose(place(random), place(random), place(random), angle(random),
                                  angle(random), angle(random));
+      // Every other pose with a G43 length, the others with TOOL_OFFSET.
+      const double length = k % 2 == 0 ? tool(random) : 0.0;
       AxisPose machine{}, back{};
-      kins->tcp_inverse(part, machine);
-      kins->tcp_forward(machine, back);
+      kins->tcp_inverse(part, length, machine);
+      kins->tcp_forward(machine, length, back);
       for (std::size_t i = 0; i < part.size(); ++i)
         worst = std::max(worst, std::abs(back[i] - part[i]));
     }
@@ -133,7 +171,7 @@ TEST(TableRotaryKinsTest, TrivkinsHasNoTcp) {
   const auto kins = motion::make_kinematics(c);
   EXPECT_FALSE(kins->has_tcp());
   AxisPose m{};
-  kins->tcp_inverse(pose(1, 2, 3, 40, 0, 50), m);
+  kins->tcp_inverse(pose(1, 2, 3, 40, 0, 50), 0, m);
   expect_pose(m, pose(1, 2, 3, 40, 0, 50), 0);
 }
 

@@ -50,13 +50,14 @@ void ready_at(VirtualMachine& m, const AxisPose& at) {
   m.clear_trajectory();
 }
 
-// The tool tip (part's frame) of every recorded period.
-std::vector<AxisPose> tips(const VirtualMachine& m) {
+// The tool tip (part's frame) of every recorded period, for a tool `tool_length` long (the G43
+// length; the example's TOOL_OFFSET is 0).
+std::vector<AxisPose> tips(const VirtualMachine& m, double tool_length = 0) {
   const auto kins = motion::make_kinematics(m.config());
   std::vector<AxisPose> out;
   for (const AxisPose& joints : m.trajectory()) {
     AxisPose part{};
-    kins->tcp_forward(joints, part);
+    kins->tcp_forward(joints, tool_length, part);
     out.push_back(part);
   }
   return out;
@@ -184,6 +185,83 @@ TEST(TcpTest, ALargeCSwingAtANearZeroKeepsEveryJointWithinItsLimits) {
   EXPECT_GT(static_cast<double>(m.trajectory().size()) * m.period_s(), 9.0);
   const auto path = tips(m);
   EXPECT_LE(from_line(path.back(), pose(0, 61, 0, 0, 90), pose(0, 61, 0, 0, 90)), 1e-9);
+}
+
+TEST(TcpTest, EachMoveTurnsTheTipOfTheToolLengthItCarries) {
+  // G43 with a 50 mm tool: the program's tip at (30, 40, -30) puts the controlled point at
+  // Z 20; tilting A keeps that tool's tip, 50 mm below the controlled point, where it is.
+  VirtualMachine m(trunnion());
+  const AxisPose point = pose(30, 40, 20, 0, 0);
+  ready_at(m, point);
+  Move tilt = tcp_move(Move::Kind::feed, pose(30, 40, 20, -90, 0), 30);
+  tilt.tool_length = 50;
+  m.queue(tilt);
+  m.run_until_idle();
+  double worst = 0;
+  for (const AxisPose& tip : tips(m, 50))
+    worst = std::max(worst, from_line(tip, point, point));
+  std::printf("G43 50 mm, G1 A-90 under TCP: the tip within %.6f mm of its point\n", worst);
+  EXPECT_LE(worst, kTolerance);
+  // The tip 20 mm behind the A axis (Y 20, Z 10) and 40 below it, turned -90 degrees: 40 mm
+  // before it and 20 below, the controlled point 50 above that.
+  const AxisPose end = m.trajectory().back();
+  EXPECT_NEAR(end[0], 30, 1e-9);
+  EXPECT_NEAR(end[1], -20, 1e-9);
+  EXPECT_NEAR(end[2], 40, 1e-9);
+  // A tool of another length would have its tip elsewhere: the length is no detail.
+  EXPECT_GT(from_line(tips(m, 0).back(), point, point), 50);
+  expect_joints_within_limits(m, "G1 A-90 under TCP with a 50 mm tool");
+}
+
+TEST(TcpTest, AToolLengthChangeAtATiltOfZeroMovesNoJoint) {
+  // C turns with a 30 mm tool, then A tilts with a 50 mm one: at A 0 the length moves no
+  // joint, so the two moves meet without a jump and the new tool's tip is held.
+  VirtualMachine m(trunnion());
+  const AxisPose point = pose(30, 40, 20, 0, 0);
+  ready_at(m, point);
+  Move turn = tcp_move(Move::Kind::feed, pose(30, 40, 20, 0, 90), 30);
+  turn.tool_length = 30;
+  Move tilt = tcp_move(Move::Kind::feed, pose(30, 40, 20, -90, 90), 30);
+  tilt.tool_length = 50;
+  m.queue(turn);
+  m.queue(tilt);
+  m.run_until_idle();
+  double worst = 0;
+  for (const AxisPose& tip : tips(m, 50))  // at A 0 any length gives the same tip
+    worst = std::max(worst, from_line(tip, point, point));
+  std::printf("C 90 with 30 mm, then A -90 with 50 mm: the tip within %.6f mm\n", worst);
+  EXPECT_LE(worst, kTolerance);
+  // C 90 takes the tip (30, 40, -30) to (-40, 30, -30); A -90 swings it about the A axis to
+  // (-40, -20, 0), the controlled point 50 mm above.
+  const AxisPose end = m.trajectory().back();
+  EXPECT_NEAR(end[0], -40, 1e-9);
+  EXPECT_NEAR(end[1], -20, 1e-9);
+  EXPECT_NEAR(end[2], 50, 1e-9);
+  expect_joints_within_limits(m, "a tool length change at A 0 under TCP");
+}
+
+TEST(TcpTest, AToolLengthChangeWithTheTableTiltedIsRefused) {
+  // Tilted, the new length puts the tip elsewhere in the machine: the joints would jump.
+  const config::MachineConfig config = trunnion();
+  motion::Planner planner(config);
+  planner.reset(pose(30, 40, 20, 0, 0));
+  std::string error;
+  Move move = tcp_move(Move::Kind::feed, pose(30, 40, 20, -30, 0), 30);
+  move.tool_length = 50;
+  ASSERT_TRUE(planner.push(move, true, error)) << error;
+  move.end = pose(31, 40, 20, -30, 0);
+  move.tool_length = 30;
+  EXPECT_FALSE(planner.push(move, true, error));
+  EXPECT_EQ(error.rfind("the tool length changes from 50.0000 to 30.0000 under TCP", 0), 0u)
+      << error;
+  move.tool_length = 50;  // nothing changed: the same tool goes on
+  EXPECT_TRUE(planner.push(move, true, error)) << error;
+  move.end = pose(31, 40, 20, 0, 45);
+  EXPECT_TRUE(planner.push(move, true, error)) << error;
+  // Level again, C anywhere: the change moves no joint.
+  move.end = pose(32, 40, 20, 0, 45);
+  move.tool_length = 30;
+  EXPECT_TRUE(planner.push(move, true, error)) << error;
 }
 
 TEST(TcpTest, AJointPastItsLimitIsRefusedThoughTheTipStaysInTheBox) {

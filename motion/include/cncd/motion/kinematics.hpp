@@ -84,15 +84,23 @@ class Kinematics {
 
   // Tool centre point control (the table-rotary modules). `machine`: the pose the joints
   // give (forward()'s axes: where the tool's controlled point stands and the rotaries'
-  // angles); `part`: the tool tip in the part's frame, the coordinates the part would have
-  // with every rotary at 0, the rotaries' angles the same. Without TCP both are the identity.
+  // angles); `part`: the same point in the part's frame, the coordinates it would have with
+  // every rotary at 0, the rotaries' angles the same. The tool tip, `tool_length` below the
+  // controlled point along Z, is the point the table's turns carry: `tool_length` is the Z of
+  // the tool length offset in force (G43, machine units), as LinuxCNC nets motion.tooloffset.z
+  // to the module's tool-offset pin; 0 (G49) stands for [KINS] TOOL_OFFSET. Without TCP both
+  // are the identity.
   virtual bool has_tcp() const noexcept { return false; }
   // RT. The part pose of a machine pose.
-  CNCD_RT virtual void tcp_forward(const AxisPose& machine, AxisPose& part) const noexcept {
+  CNCD_RT virtual void tcp_forward(const AxisPose& machine, double tool_length,
+                                   AxisPose& part) const noexcept {
+    (void)tool_length;
     part = machine;
   }
-  // RT. The machine pose that puts the tool tip at a part pose.
-  CNCD_RT virtual void tcp_inverse(const AxisPose& part, AxisPose& machine) const noexcept {
+  // RT. The machine pose that puts the tool at a part pose.
+  CNCD_RT virtual void tcp_inverse(const AxisPose& part, double tool_length,
+                                   AxisPose& machine) const noexcept {
+    (void)tool_length;
     machine = part;
   }
 };

@@ -84,6 +84,8 @@ class PathExecutor {
   CNCD_RT std::int32_t line() const noexcept { return line_; }
   // Whether the segment executed now, or the last one, was planned under TCP (Segment::tcp).
   CNCD_RT bool tcp() const noexcept { return tcp_; }
+  // The tool length that segment was planned with (Segment::tool_length).
+  CNCD_RT double tcp_tool_length() const noexcept { return tcp_tool_length_; }
   // Segments and programmed moves completed or dropped since the start.
   CNCD_RT std::uint64_t segments_done() const noexcept { return segments_done_; }
   CNCD_RT std::uint64_t moves_done() const noexcept { return moves_done_; }
@@ -196,6 +198,7 @@ class PathExecutor {
   MotionState motion_ = MotionState::idle;
   std::int32_t line_ = 0;
   bool tcp_ = false;
+  double tcp_tool_length_ = 0;
   std::uint64_t segments_done_ = 0;
   std::uint64_t moves_done_ = 0;
   std::uint64_t actions_done_ = 0;

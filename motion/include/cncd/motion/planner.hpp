@@ -169,10 +169,19 @@ class Planner {
   // A move in step with the spindle under TCP, the rotaries still: the tip's line as one line
   // in joint space, of the same length, run at rest at both ends as any such move.
   bool push_tcp_sync(const Move& move, bool check_limits, std::string& error);
-  // The pieces of the tip's path `tip` (planned from the part pose of end_), in joint space.
-  bool tcp_pieces(const Segment& tip, std::vector<Segment>& pieces, std::string& error) const;
+  // The pieces of the tip's path `tip` (planned from the part pose of end_), in joint space,
+  // for a tool `tool_length` long (Move::tool_length).
+  bool tcp_pieces(const Segment& tip, double tool_length, std::vector<Segment>& pieces,
+                  std::string& error) const;
   // `n` equal pieces of `tip`; the largest distance of their tool tip from the path.
-  double cut_tcp(const Segment& tip, int n, std::vector<Segment>& pieces) const;
+  double cut_tcp(const Segment& tip, double tool_length, int n, std::vector<Segment>& pieces) const;
+  // Whether the tool at `part_start` with `tool_length` stands where the joints are (end_),
+  // that is whether the tool length may change there; false with `error` when not.
+  bool same_joints_with_length(const AxisPose& part_start, double tool_length,
+                               std::string& error) const;
+  // The tool length the last TCP move was planned with (none since a move out of TCP): a
+  // change of it moves the joints unless the tilting axis is at 0.
+  std::optional<double> tcp_tool_length_;
   // Every piece's joints within their [JOINT_n] soft limits.
   bool tcp_within_joint_limits(const std::vector<Segment>& pieces, std::string& error) const;
   // Ends the held piece into `next` (a piece): at the speed at which the jump in every
@@ -181,6 +190,7 @@ class Planner {
   static constexpr double kTcpPathShare = 0.5;   // of each joint's acceleration, along a piece
   static constexpr double kTcpJumpShare = 0.25;  // at each junction, within one servo period
   static constexpr int kMaxTcpPieces = 20000;
+  static constexpr double kTcpSameJoint = 1e-6;  // units: a joint that does not move
 
   const config::MachineConfig& config_;
   std::shared_ptr<const Kinematics> kins_;

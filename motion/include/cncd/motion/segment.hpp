@@ -65,6 +65,7 @@ struct Segment {
   // A piece of a move planned under TCP (Move::tcp on a table-rotary machine): the status
   // shows it while the segment runs and after, until the next one starts.
   bool tcp = false;
+  double tool_length = 0;  // under TCP: Move::tool_length, the tip the table's turns carry
   // Unit tangents (over all axes) at the start and the end; zero for dwells and zero-length
   // moves.
   AxisPose start_direction{};

@@ -115,6 +115,9 @@ struct Move {
   // is the tool tip in the part's frame, and the planner cuts the move into pieces straight
   // in joint space whose tip stays within [TRAJ] TCP_TOLERANCE of the programmed path.
   bool tcp = false;
+  // The Z of the tool length offset in force (G43, machine units; 0 after G49): under TCP the
+  // tool's length the kinematics turns the tip with (Kinematics::tcp_inverse()).
+  double tool_length = 0;
   std::int32_t line = 0;              // source line of the program, 0 = none
   IoAction action;                    // Kind::action
   SyncOutputs sync;                   // set as this move starts (traverse, feed, arc)
