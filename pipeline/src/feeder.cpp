@@ -104,6 +104,7 @@ void ProgramFeeder::begin_move(motion::Move& next, int line) {
   next.sync = sync_;
   sync_ = {};
   next.tcp = tcp_;
+  next.tool_length = tool_length_;
   end_ = next.end;
 }
 
@@ -227,6 +228,10 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
           },
           [&](const in::SetTcp& c) {
             switch_tcp(c.on, m.line);
+            return false;
+          },
+          [&](const in::UseToolLengthOffset&) {
+            change_tool_length(m.line);
             return false;
           },
           [&](const in::SetFeedMode& c) {

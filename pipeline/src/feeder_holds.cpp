@@ -7,7 +7,6 @@
 #include <utility>
 #include <vector>
 
-#include "cncd/motion/kinematics.hpp"
 #include "cncd/pipeline/feeder.hpp"
 #include "number_text.hpp"
 
@@ -163,39 +162,6 @@ void ProgramFeeder::restore_io_state() {
   }
   need_at_speed_ = false;
   pending_.insert(pending_.begin(), front.begin(), front.end());
-}
-
-void ProgramFeeder::switch_tcp(bool on, int line) {
-  if (unsupported_) return;
-  const std::string code = on ? "M428" : "M429";
-  if (machine_ != nullptr && !motion::make_kinematics(*machine_)->has_tcp()) {
-    unsupported_ = Unsupported{line, code + " switches tool centre point control, which needs " +
-                                         "xyzac-trt-kins or xyzbc-trt-kins; [KINS] KINEMATICS " +
-                                         "is " + machine_->kinematics};
-    return;
-  }
-  if (on == tcp_) return;
-  // The tool stays where it is; the program goes on in the other frame (the interpreter has
-  // made the same change to its position, through tcp_switched()).
-  end_ = tcp_switched(end_, on);
-  tcp_ = on;
-}
-
-motion::AxisPose ProgramFeeder::tcp_switched(const motion::AxisPose& machine, bool on) const {
-  return on == tcp_ ? machine : in_frame(machine, on);
-}
-
-motion::AxisPose ProgramFeeder::in_frame(const motion::AxisPose& machine, bool on) const {
-  if (machine_ == nullptr) return machine;
-  const auto kins = motion::make_kinematics(*machine_);
-  if (!kins->has_tcp()) return machine;
-  motion::AxisPose moved = machine;
-  if (on) {
-    kins->tcp_forward(machine, moved);
-  } else {
-    kins->tcp_inverse(machine, moved);
-  }
-  return moved;
 }
 
 }  // namespace cncd::pipeline

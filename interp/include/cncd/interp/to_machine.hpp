@@ -23,6 +23,8 @@ class MachineTracker {
   // Last SET_FEED_RATE in machine units per minute (units per revolution under G95),
   // converted with the program units in force when it was set.
   double feed_per_minute() const { return feed_; }
+  // The tool length offset in force (G43 ... G49), machine units.
+  const Pose& tool_offset() const { return tool_; }
   Units program_units() const { return program_units_; }
   Units machine_units() const { return machine_units_; }
   // Program units -> machine units.

@@ -228,6 +228,13 @@ class ProgramFeeder final : public interp::CanonSink {
   // `machine` in the part's frame (`tcp`) or in the joints' from the other one.
   motion::AxisPose in_frame(const motion::AxisPose& machine, bool tcp) const;
   bool tcp_ = false;
+  // G43, G43.1, G43.2, G49: the tool length offset's Z in force (machine units) goes with every
+  // move (Move::tool_length); under TCP a change is refused where it would move a joint.
+  void change_tool_length(int line);
+  double tool_length_ = 0;
+  // Under TCP the tool offset has no X or Y (the tip is turned about Z alone); false with
+  // unsupported_ set (`what` at `line`) when it has.
+  bool tcp_tool_offset_fits(int line, const std::string& what);
 
   // Path control mode and G64 P tolerance (machine units) as the interpreter last set them
   // (it starts in G64 and keeps its modes from one program to the next, as this feeder does).
