@@ -134,7 +134,11 @@ TEST_F(PipelineAgreementTest, EveryPathGivesTheSameVerdictAtTheSameLine) {
 // 201.2 mm from the C axis, beyond X 200 between C -20 and C -33); the ends of the move are
 // within them. Refused at that line three ways; a program that keeps its joints within
 // their limits runs, and so does M428 with a rotary off 0. A rigid tap with the table tilted
-// runs; a thread that turns A, and a probing move, are refused at their line.
+// runs; a thread that turns A, and a probing move, are refused at their line. The G43 length
+// in force is the tool's under TCP, for the joint limits too, and it changes only level.
+const std::string kTrunnionHead = "G21 G90 G94\n";
+const std::string kTilt = "G0 X0 Y-50 Z0 A0 C0\nM428\nG1 A-90 F600\nG0 A0\nM429\nM2\n";
+
 class TrunnionAgreementTest : public PipelineAgreementTest {
  protected:
   std::string example() const override { return "sim_xyzac_trt"; }
@@ -152,6 +156,18 @@ TEST_F(TrunnionAgreementTest, AJointSwungPastItsLimitIsRefusedAtItsLine) {
        false},
       {"thread_turning_a", head + "G0 X5 Y5 Z5\nS600 M3\nG33 Z-5 A20 K1.25\nM429\nM2\n", 6, false},
       {"probe_under_tcp", head + "G0 X5 Y5 Z5\nG38.2 Z-5 F100\nM429\nM2\n", 5, false},
+      // The tip at Y -50 tilted to A -90 takes the Z joint to 80 + the tool's length: past its
+      // 120 with a 50 mm tool, within it with none.
+      {"tool_length_past_joint_z", kTrunnionHead + "G43.1 Z50\n" + kTilt, 5, false},
+      {"no_tool_length_within_joint_z", kTrunnionHead + "G49\n" + kTilt, 0, false},
+      // A length change tilted would make the joints jump; level, it moves none.
+      {"tool_length_change_tilted",
+       kTrunnionHead + "G43.1 Z50\nG0 X0 Y0 Z0 A0 C0\nM428\nG1 A-30 F600\nG43.1 Z30\nG1 X5\nM2\n",
+       6, false},
+      {"tool_length_change_level",
+       kTrunnionHead + "G43.1 Z30\nG0 X0 Y0 Z0 A0 C0\nM428\nG1 C90 F1800\nG43.1 Z50\nG1 A-30\n"
+                       "G0 A0 C0\nM429\nM2\n",
+       0, false},
   };
   expect_same_verdicts(cases);
 }
