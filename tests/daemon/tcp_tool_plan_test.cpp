@@ -173,6 +173,25 @@ TEST_F(TcpToolPlan, AToolLengthChangeWithTheTableTiltedIsRefusedAtItsLine) {
   EXPECT_TRUE(same.complete()) << (same.error ? same.error->to_string() : "");
 }
 
+TEST_F(TcpToolPlan, AToolOffsetInXOrYIsRefusedUnderTcp) {
+  // The kinematics turn the tip about the tool's length along Z alone.
+  std::vector<motion::AxisPose> joints;
+  const auto given =
+      simulate("G21 G90 G94\nG0 X30 Y40 Z20 A0 C0\nM428\nG43.1 X2 Z50\nG1 A-30 F600\nM2\n", joints);
+  ASSERT_TRUE(given.error);
+  EXPECT_EQ(given.error->line, 4);
+  EXPECT_EQ(given.error->message,
+            "a tool length offset (G43, G43.1, G43.2) with a tool offset of X2.0000 Y0.0000: "
+            "under TCP (M428) the tool is turned about its length along Z only; give the tool "
+            "no X or Y offset");
+  const auto switched = simulate(
+      "G21 G90 G94\nG43.1 Y-1 Z50\nG0 X30 Y40 Z20 A0 C0\nM428\nG1 A-30 F600\nM2\n", joints);
+  ASSERT_TRUE(switched.error);
+  EXPECT_EQ(switched.error->line, 4);
+  EXPECT_EQ(switched.error->message.rfind("M428 with a tool offset of X0.0000 Y-1.0000: ", 0), 0u)
+      << switched.error->message;
+}
+
 TEST_F(TcpToolPlan, TheJointLimitCheckUsesTheLengthInForce) {
   // The tip at Y -50, Z 0 tilted to A -90: the Z joint at 80 + the tool's length, past its 120
   // with the 50 mm tool, within it with the 30 mm one. program.open's check sees it.
