@@ -84,11 +84,16 @@ TEST(TableRotaryKinsTest, KnownPosesOfXyzac) {
   expect_pose(m, pose(0, 30, 0, 90, 0, 90));
 }
 
-TEST(TableRotaryKinsTest, KnownPosesOfXyzbcAndTheToolOffset) {
+// xyzbc with the B axis 5 mm left of the C axis (X -5) and `tool_offset`.
+std::unique_ptr<const motion::Kinematics> xyzbc(double tool_offset) {
   config::TableRotaryConfig g;
   g.x_offset = -5;
-  g.tool_offset = 50;
-  const auto kins = motion::make_kinematics(trunnion("xyzbc-trt-kins", g));
+  g.tool_offset = tool_offset;
+  return motion::make_kinematics(trunnion("xyzbc-trt-kins", g));
+}
+
+TEST(TableRotaryKinsTest, KnownPosesOfXyzbcAndTheToolOffset) {
+  const auto kins = xyzbc(50);
   AxisPose m{};
   // B 90 about the B axis (X -5, Z 0): the tool tip at (5, 0, 0) in the part (the controlled
   // point 50 above it) goes to 10 mm below the axis, the controlled point 50 above that.
@@ -102,14 +107,13 @@ TEST(TableRotaryKinsTest, KnownPosesOfXyzbcAndTheToolOffset) {
 TEST(TableRotaryKinsTest, TheG43LengthInForceIsTheToolsLengthElseToolOffset) {
   // LinuxCNC nets motion.tooloffset.z to the module's tool-offset pin: the G43 length in force
   // is the length the tip is turned with; [KINS] TOOL_OFFSET only stands in while none is.
-  config::TableRotaryConfig g;
-  g.x_offset = -5;
-  g.tool_offset = 80;
-  const auto kins = motion::make_kinematics(trunnion("xyzbc-trt-kins", g));
+  const auto kins = xyzbc(80);
   AxisPose m{};
-  // G43 with 50 mm: as TOOL_OFFSET 50 above, the tip (5, 0, 0) 10 mm below the B axis.
+  AxisPose as_offset{};
+  // G43 with 50 mm: as TOOL_OFFSET 50 without G43, the tip (5, 0, 0) 10 mm below the B axis.
   kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 50, m);
-  expect_pose(m, pose(-5, 0, 40, 0, 90, 0));
+  xyzbc(50)->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 0, as_offset);
+  expect_pose(m, as_offset);
   // G49: TOOL_OFFSET's 80 mm; the tip at (5, 0, -30), 10 mm right of and 30 below the axis,
   // turned to 30 mm left of it and 10 below.
   kins->tcp_inverse(pose(5, 0, 50, 0, 90, 0), 0, m);
