@@ -28,8 +28,9 @@ constexpr std::array kKinsKeys{
                  "xyzac/xyzbc-trt-kins: Z from the C axis's point to the tilting axis (z-offset)"),
     position_key("KINS", "TOOL_OFFSET", "0",
                  "xyzac/xyzbc-trt-kins: length along the spindle from the tool tip, which TCP "
-                 "keeps on the programmed path, to the controlled point; the G43 length of the "
-                 "tool in use (LinuxCNC wires the tool-offset pin to motion.tooloffset.z)"),
+                 "keeps on the programmed path, to the controlled point while no G43 length is "
+                 "in force; a G43 length replaces it (LinuxCNC nets the tool-offset pin to "
+                 "motion.tooloffset.z)"),
     positive_key("TRAJ", "TCP_TOLERANCE", "0.005", "units",
                  "Under TCP (M428), how far the tool tip may leave a programmed line while the "
                  "rotary axes turn; moves are cut into joint-space pieces this close"),
