@@ -147,7 +147,6 @@ std::optional<std::string> tcp_refusal(const Move& move, const AxisPose& start) 
   return std::nullopt;
 }
 
-
 bool Planner::same_joints_with_length(const AxisPose& part_start, double tool_length,
                                       std::string& error) const {
   if (!tcp_tool_length_ || *tcp_tool_length_ == tool_length) return true;

@@ -166,8 +166,8 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
                 motion::AxisPose from = end_, to = move.end;
                 if (tcp_) {
                   const auto kins = motion::make_kinematics(*machine_);
-                  kins->tcp_inverse(end_, from);
-                  kins->tcp_inverse(move.end, to);
+                  kins->tcp_inverse(end_, tool_length_, from);
+                  kins->tcp_inverse(move.end, tool_length_, to);
                 }
                 if (auto why = thread_too_fast(*machine_, from, to, per_rev_, rpm,
                                                spindle_direction_, spindle_speed_))

@@ -54,7 +54,7 @@ class TcpPlan : public ::testing::Test {
       TcpSample s;
       s.t = t;
       s.joints = joints;
-      kins_->tcp_forward(joints, s.tip);
+      kins_->tcp_forward(joints, 0.0, s.tip);
       s.revolutions = revolutions;
       run.samples.push_back(s);
     };
@@ -71,7 +71,7 @@ class TcpPlan : public ::testing::Test {
   motion::AxisPose joints_at(double x, double y, double z, double a) const {
     const motion::AxisPose part{x, y, z, a, 0, 0, 0, 0, 0};
     motion::AxisPose machine{};
-    kins_->tcp_inverse(part, machine);
+    kins_->tcp_inverse(part, 0.0, machine);
     return machine;
   }
 

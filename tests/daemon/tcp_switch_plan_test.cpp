@@ -118,13 +118,13 @@ TEST_F(TcpSwitchPlanTest, ATiltedTableSwitchesWithoutAJump) {
   const auto kins = motion::make_kinematics(config_);
   motion::AxisPose start_joints{10, 5, 20, -30, 0, 45};
   motion::AxisPose start_tip{};
-  kins->tcp_forward(start_joints, start_tip);
+  kins->tcp_forward(start_joints, 0.0, start_tip);
   // Under TCP the tip keeps X and Y in the part's frame and goes 5 mm down its Z.
   double tip_x = 0, tip_y = 0, lowest = 1e9;
   for (const auto& j : run.joints) {
     if (std::abs(j[3] + 30) > 1e-9 || std::abs(j[5] - 45) > 1e-9) continue;
     motion::AxisPose tip{};
-    kins->tcp_forward(j, tip);
+    kins->tcp_forward(j, 0.0, tip);
     if (j[0] != 0 && std::abs(j[0] - 10) < 1e-9 && std::abs(j[1] - 5) > 1e-9) {
       tip_x = std::max(tip_x, std::abs(tip[0] - start_tip[0]));
       tip_y = std::max(tip_y, std::abs(tip[1] - start_tip[1]));

@@ -293,7 +293,7 @@ TEST(TcpTest, ATapWithTheRotariesStillIsOneJointLineOfTheSameLength) {
   const auto kins = motion::make_kinematics(config);
   motion::Planner planner(config);
   AxisPose start{};
-  kins->tcp_inverse(pose(10, 5, 5, -30, 0), start);
+  kins->tcp_inverse(pose(10, 5, 5, -30, 0), 0.0, start);
   planner.reset(start);
   Move tap = tcp_move(Move::Kind::feed, pose(10, 5, -10, -30, 0), 12.5);
   tap.path_mode = Move::PathMode::exact_stop;
@@ -305,7 +305,7 @@ TEST(TcpTest, ATapWithTheRotariesStillIsOneJointLineOfTheSameLength) {
   ASSERT_EQ(planner.output().size(), 1u);
   const motion::Segment& line = planner.output().front();
   AxisPose bottom{};
-  kins->tcp_inverse(pose(10, 5, -10, -30, 0), bottom);
+  kins->tcp_inverse(pose(10, 5, -10, -30, 0), 0.0, bottom);
   for (int i = 0; i < motion::kAxes; ++i) {
     EXPECT_NEAR(line.start[i], start[i], 1e-12) << i;
     EXPECT_NEAR(line.end[i], bottom[i], 1e-12) << i;
