@@ -2,6 +2,7 @@
 // pass along the profile, with or without its pockets.
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "g7x_profile.hpp"
 
@@ -43,35 +44,56 @@ void pass(const Path& path, double level, double from, double retract, Move::Kin
   add(out, back, {level, from});
 }
 
-// The path with each arc that bulges above both its ends cut in two at its highest u.
-Path split_at_peaks(const Path& path) {
-  Path out;
+// A piece of the path as the pockets see it; `joined` when it is the first part of an arc cut
+// at its lowest point, which goes on in the next piece.
+struct Piece {
+  Seg seg;
+  bool joined = false;
+};
+
+// The path with each arc that bulges above both its ends cut in two at its highest u, and each
+// that dips below both at its lowest: u turns there.
+std::vector<Piece> split_where_u_turns(const Path& path) {
+  std::vector<Piece> out;
   for (const Seg& seg : path) {
+    const double top = std::fmax(seg.a.u, seg.b.u), low = std::fmin(seg.a.u, seg.b.u);
     const std::optional<Pt> peak = seg.arc ? arc_peak(seg) : std::nullopt;
-    if (peak && peak->u > std::fmax(seg.a.u, seg.b.u) + kEps) {
-      out.push_back(head(seg, *peak));
-      out.push_back(tail(seg, *peak));
+    const std::optional<Pt> valley = seg.arc ? arc_valley(seg) : std::nullopt;
+    if (peak && peak->u > top + kEps) {
+      out.push_back({head(seg, *peak)});
+      out.push_back({tail(seg, *peak)});
+    } else if (valley && valley->u < low - kEps) {
+      out.push_back({head(seg, *valley), true});
+      out.push_back({tail(seg, *valley)});
     } else {
-      out.push_back(seg);
+      out.push_back({seg});
     }
   }
   return out;
 }
 
-// The pockets of a falling piece: passes at origin, origin - step, ... between its ends.
-void pocket(const Path& path, const Seg& seg, double origin, double step, double retract,
-            Moves& out) {
+// The pockets of a falling piece: passes at origin, origin - step, ... between its ends. Returns
+// the rest of the piece, below the last pass. The lowest point of an arc (`valley`) that a pass
+// level reaches is cut to, though the pass there has no length.
+Seg pocket(const Path& path, const Seg& seg, bool valley, double origin, double step,
+           double retract, Moves& out) {
   Seg rest = seg;
   for (int k = 0;; ++k) {
     const double level = origin - k * step;
-    if (level <= seg.b.u + kEps) break;
+    if (level <= seg.b.u + kEps) {
+      if (valley && level > seg.b.u - 1e-6) {
+        add_piece(out, rest);
+        rest = tail(rest, rest.b);
+      }
+      break;
+    }
     if (level > seg.a.u + kEps) continue;
     const Pt at = point_at(rest, level);
     add_piece(out, head(rest, at));
     rest = tail(rest, at);
     pass(path, level, at.v, retract, Move::Kind::feed, out);
   }
-  add_piece(out, rest);
+  return rest;
 }
 
 // Each piece at or above the highest u met so far, up to where u starts to fall: a line fed
@@ -84,7 +106,9 @@ void follow_monotonic(const Path& path, Moves& out) {
     const bool end_in = seg.b.u >= top - kEps;
     if (!start_in && !end_in) continue;
     Seg piece = seg;
-    if (!start_in) {
+    // An arc that dips below that height between its ends is taken up where it comes back.
+    const std::optional<Pt> valley = seg.arc ? arc_valley(seg) : std::nullopt;
+    if (!start_in || (end_in && valley && valley->u < top - kEps)) {
       piece = tail(seg, point_at(seg, top, true));
     } else if (!end_in) {
       piece = head(seg, point_at(seg, top));
@@ -121,17 +145,31 @@ void follow(const Path& path, Follow how, double step, double retract, double gr
     follow_monotonic(path, out);
     return;
   }
+  if (how == Follow::plain) {
+    for (const Seg& seg : path)
+      add_piece(out, seg);
+    return;
+  }
   double peak = 0;
   bool falling = false;
-  for (const Seg& seg : how == Follow::pockets ? split_at_peaks(path) : path) {
-    if (how == Follow::pockets && descends(seg)) {
+  std::optional<Pt> carried;  // where the arc cut at its lowest point was left
+  for (Piece piece : split_where_u_turns(path)) {
+    Seg& seg = piece.seg;
+    if (carried) seg.a = *carried;
+    carried.reset();
+    if (descends(seg)) {
       if (!falling) peak = seg.a.u;
       falling = true;
-      pocket(path, seg, std::isnan(grid) ? peak : grid, step, retract, out);
-      continue;
+      seg = pocket(path, seg, piece.joined, std::isnan(grid) ? peak : grid, step, retract, out);
+    } else {
+      falling = false;
     }
-    falling = false;
-    add_piece(out, seg);
+    // Below the last pass, an arc cut at its lowest point is cut on in one move.
+    if (piece.joined) {
+      carried = seg.a;
+    } else {
+      add_piece(out, seg);
+    }
   }
 }
 

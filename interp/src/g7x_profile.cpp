@@ -289,14 +289,18 @@ std::optional<Pt> arc_peak(const Seg& seg) {
   return std::nullopt;
 }
 
+std::optional<Pt> arc_valley(const Seg& seg) {
+  const Pt bottom{seg.c.u - radius(seg), seg.c.v};
+  if (on_arc(seg, bottom)) return bottom;
+  return std::nullopt;
+}
+
 double lowest_u(const Path& path) {
   double low = path.empty() ? 0.0 : path.front().a.u;
   for (const Seg& seg : path) {
     low = std::min({low, seg.a.u, seg.b.u});
-    if (seg.arc) {
-      const Pt left{seg.c.u - radius(seg), seg.c.v};
-      if (on_arc(seg, left)) low = std::min(low, left.u);
-    }
+    if (const std::optional<Pt> bottom = seg.arc ? arc_valley(seg) : std::nullopt)
+      low = std::min(low, bottom->u);
   }
   return low;
 }

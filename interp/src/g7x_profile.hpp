@@ -64,6 +64,9 @@ bool descends(const Seg& seg);
 // The point of highest u on the arc `seg`, when its sweep reaches it.
 std::optional<Pt> arc_peak(const Seg& seg);
 
+// The point of lowest u on the arc `seg`, when its sweep reaches it.
+std::optional<Pt> arc_valley(const Seg& seg);
+
 // The lowest u on `path`.
 double lowest_u(const Path& path);
 
