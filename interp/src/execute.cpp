@@ -170,7 +170,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
       emit(StopSpindleTurning{});
       modal_.spindle = SpindleDir::stopped;
     }
-    emit(ChangeTool{tool});
+    emit(ChangeTool{tool, tools_.slot(tool)});
     tool_in_spindle_ = tool;
   } else if (change == 61) {
     if (!block_.has('q') || block_.get('q') < 0) {
@@ -178,7 +178,7 @@ void Interpreter::Impl::do_tool_and_spindle() {
     }
     const int tool = to_int(block_.get('q'));
     tool_in_spindle_ = tool;
-    emit(ChangeToolNumber{tool});
+    emit(ChangeToolNumber{tool, tools_.slot(tool)});
   }
   switch (block_.m_code(MGroup::spindle)) {
     case 3:

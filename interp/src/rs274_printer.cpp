@@ -178,8 +178,8 @@ void append_rs274(std::string& out, const CanonOp& op, int axes) {
           [&](const FloodOn&) { out += "FLOOD_ON()"; },
           [&](const FloodOff&) { out += "FLOOD_OFF()"; },
           [&](const SelectTool& c) { append_call(out, "SELECT_TOOL(", c.tool); },
-          [&](const ChangeTool& c) { append_call(out, "CHANGE_TOOL(", c.tool); },
-          [&](const ChangeToolNumber& c) { append_call(out, "CHANGE_TOOL_NUMBER(", c.tool); },
+          [&](const ChangeTool& c) { append_call(out, "CHANGE_TOOL(", c.slot); },
+          [&](const ChangeToolNumber& c) { append_call(out, "CHANGE_TOOL_NUMBER(", c.slot); },
           [&](const SetTcp& c) { out += c.on ? "TCP_ON()" : "TCP_OFF()"; },
           [&](const SetFeedOverrideEnable& c) {
             out += c.on ? "ENABLE_FEED_OVERRIDE()" : "DISABLE_FEED_OVERRIDE()";

@@ -131,7 +131,7 @@ void Interpreter::Impl::set_tool_data(int l, int tool) {
     emit(SetToolTableEntry{pocket, entry.number, entry.offset, entry.front_angle, entry.back_angle,
                            entry.orientation});
   };
-  report(entry.pocket);
+  report(tools_.slot(tool));
   if (tool == tool_in_spindle_) report(0);  // the spindle is pocket 0
 }
 

@@ -19,6 +19,8 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) return "Unable to open tool table: " + path.string();
   std::map<int, ToolEntry> loaded;
+  std::map<int, int> slots;
+  int lines = 0;  // a tool line takes the next slot even when its number came before
   std::string text;
   int line_number = 0;
   while (std::getline(in, text)) {
@@ -95,15 +97,24 @@ std::optional<std::string> ToolTable::load(const std::filesystem::path& path) {
     if (!has_tool) return where + "no T word: a tool line is 'T<number> P<pocket> ... ;comment'";
     if (auto problem = tool_entry_problem(entry)) return where + *problem;
     loaded[entry.number] = entry;
+    slots.emplace(entry.number, ++lines);
   }
   tools_ = std::move(loaded);
+  lines_ = lines;
+  slots_ = std::move(slots);
   return std::nullopt;
 }
 
 std::optional<std::string> ToolTable::set(const ToolEntry& entry) {
   if (auto problem = tool_entry_problem(entry)) return problem;
   tools_[entry.number] = entry;
+  if (slots_.emplace(entry.number, lines_ + 1).second) ++lines_;
   return std::nullopt;
+}
+
+int ToolTable::slot(int number) const {
+  const auto it = slots_.find(number);
+  return it == slots_.end() ? number : it->second;
 }
 
 const ToolEntry* ToolTable::find(int number) const {

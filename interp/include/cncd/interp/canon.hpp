@@ -121,11 +121,15 @@ struct FloodOff {};
 struct SelectTool {  // T: the tool prepared
   int tool = 0;
 };
+// M6 and M61 name the tool by its number; `slot` is where it sits in the tool table (its line
+// as loaded, from 1; 0 for no tool), which rs274 prints instead.
 struct ChangeTool {  // M6
   int tool = 0;
+  int slot = 0;
 };
 struct ChangeToolNumber {  // M61
   int tool = 0;
+  int slot = 0;
 };
 // M428 (on) and M429 (off), as LinuxCNC's table-rotary sample configs remap them: tool
 // centre point control, the programmed X Y Z the tool tip in the part's frame.
@@ -238,7 +242,7 @@ struct RigidTap {
   double scale = 1.0;  // LinuxCNC's spindle speed scale for the way out
 };
 struct SetToolTableEntry {
-  int pocket = 0;
+  int pocket = 0;  // the tool's slot in the table (ChangeTool), 0 for the spindle
   int tool = 0;
   Pose offset{};  // tool table units
   double front_angle = 0;
