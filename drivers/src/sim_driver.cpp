@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "cncd/drivers/fault_reason.hpp"
-#include "cncd/motion/kinematics.hpp"
 
 #include "ini_lookup.hpp"
 #include "panel_wiring.hpp"
@@ -76,18 +75,17 @@ std::string SimDriver::configure(const config::MachineConfig& machine,
   for (std::size_t k = 0; k < signal_count_; ++k)
     signals_[k].name = names[k];
 
-  // The probe model, for the driver that has a joint of Z: the tool where the kinematics put
-  // it (corexy's X and Y come from both belt motors).
+  // The probe model, for the driver that has the Z joint.
   probe_model_ = false;
-  probe_kins_.reset();
-  joint_count_ = static_cast<int>(joints.size());
-  for (std::size_t i = 0; i < joints.size(); ++i)
-    machine_joint_[i] = joints[i];
+  probe_joint_ = {-1, -1, -1};
   if (ini.has("SIM", "PROBE_SURFACE_Z")) {
-    probe_kins_ = motion::make_kinematics(machine);
-    const std::uint32_t of_z = probe_kins_->joints_of_axis(2);
-    for (const int j : joints)
-      probe_model_ = probe_model_ || (j < kMaxJoints && ((of_z >> j) & 1u) != 0);
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      const char axis = machine.joints[static_cast<std::size_t>(joints[i])].axis;
+      const int k = axis == 'X' ? 0 : axis == 'Y' ? 1 : axis == 'Z' ? 2 : -1;
+      if (k >= 0 && probe_joint_[static_cast<std::size_t>(k)] < 0)
+        probe_joint_[static_cast<std::size_t>(k)] = static_cast<int>(i);
+    }
+    probe_model_ = probe_joint_[2] >= 0;
     probe_top_ = ini.real("SIM", "PROBE_SURFACE_Z");
     const auto bound = [&](const char* key, double& value) {
       if (ini.has("SIM", key)) value = ini.real("SIM", key);
@@ -147,15 +145,13 @@ void SimDriver::read_inputs(MachineInputs& inputs) noexcept {
   }
   if (probe_signal_ >= 0 && load(probe_signal_) != 0) inputs.probe = true;
   if (!probe_model_) return;
-  motion::JointArray joints{};
-  for (int i = 0; i < joint_count_; ++i)
-    joints[static_cast<std::size_t>(machine_joint_[static_cast<std::size_t>(i)])] =
-        position_[static_cast<std::size_t>(i)];
-  motion::AxisPose axes{};
-  probe_kins_->forward(joints, axes);
-  const double x = axes[0];
-  const double y = axes[1];
-  const double z = axes[2];
+  const auto at = [&](int k, double otherwise) {
+    const int i = probe_joint_[static_cast<std::size_t>(k)];
+    return i >= 0 ? position_[static_cast<std::size_t>(i)] : otherwise;
+  };
+  const double x = at(0, 0);
+  const double y = at(1, 0);
+  const double z = at(2, 0);
   const bool inside = z <= probe_top_ && x >= probe_x_min_ && x <= probe_x_max_ &&
                       y >= probe_y_min_ && y <= probe_y_max_;
   if (inside) inputs.probe = true;

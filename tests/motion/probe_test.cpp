@@ -20,9 +20,10 @@ using motion::Move;
 using motion::ProbeMode;
 using motion::RtEvent;
 
-// `machine` with the simulated block of `sim_keys` ([SIM] PROBE_SURFACE_Z, its top, and
-// PROBE_X_MIN .. PROBE_Y_MAX, its sides).
-config::MachineConfig with_block(config::MachineConfig c, const std::string& sim_keys) {
+// The small mill with a simulated block whose top is at Z -3.2 ([SIM] PROBE_SURFACE_Z), and
+// optionally its X extent.
+config::MachineConfig probing_mill(const std::string& sim_keys = "PROBE_SURFACE_Z = -3.2\n") {
+  config::MachineConfig c = small_mill();
   const auto path = std::filesystem::temp_directory_path() /
                     ("cncd-probe-" + std::to_string(::getpid()) + ".ini");
   {
@@ -34,11 +35,6 @@ config::MachineConfig with_block(config::MachineConfig c, const std::string& sim
   std::filesystem::remove(path);
   EXPECT_TRUE(problems.empty());
   return c;
-}
-
-// The small mill with a simulated block whose top is at Z -3.2, and optionally its X extent.
-config::MachineConfig probing_mill(const std::string& sim_keys = "PROBE_SURFACE_Z = -3.2\n") {
-  return with_block(small_mill(), sim_keys);
 }
 
 Move traverse(double x, double y, double z) {
@@ -156,42 +152,6 @@ TEST_F(Probing, TheBlocksSideIsFoundAlongX) {
   EXPECT_TRUE(s.probe.tripped);
   EXPECT_NEAR(s.probe.position[0], 50, 0.002);
   EXPECT_GE(s.probe.position[0], 50);
-}
-
-TEST_F(Probing, OnCorexyTheBlockIsWhereTheToolIsNotWhereAMotorIs) {
-  // sim_corexy.ini: motor 0 = X + Y, motor 1 = X - Y. A block from X 100 to 150 and Y 50 to
-  // 100 whose top is at Z -3.2, approached at Z -5 along a diagonal that turns both motors,
-  // (40, 40) toward (140, 90): it meets the side X 100 at Y 70.
-  const auto loaded =
-      config::load_machine_config(std::string(CNCD_SOURCE_DIR) + "/config/examples/sim_corexy.ini");
-  ASSERT_TRUE(loaded.ok());
-  const config::MachineConfig corexy =
-      with_block(*loaded.config,
-                 "PROBE_SURFACE_Z = -3.2\nPROBE_X_MIN = 100\nPROBE_X_MAX = 150\n"
-                 "PROBE_Y_MIN = 50\nPROBE_Y_MAX = 100\n");
-  machine_ = std::make_unique<VirtualMachine>(corexy);
-  machine_->ready();
-  // Beside the block, below its top: the motors at 80 and 0 put the tool at X 40, Y 40.
-  machine_->queue(traverse(40, 40, -5));
-  machine_->run_until_idle();
-  ASSERT_EQ(machine_->status().path_errors, 0U);
-  auto s = run(probe(140, 90, -5, ProbeMode::toward_or_error, 100));
-  EXPECT_EQ(s.path_errors, 0U);
-  ASSERT_TRUE(s.probe.tripped);
-  std::printf("corexy G38.2 from (40, 40) toward (140, 90): latched at X %.4f Y %.4f Z %.4f\n",
-              s.probe.position[0], s.probe.position[1], s.probe.position[2]);
-  EXPECT_NEAR(s.probe.position[0], 100, 0.002);
-  EXPECT_GE(s.probe.position[0], 100);
-  EXPECT_NEAR(s.probe.position[1], 70, 0.002);
-  EXPECT_NEAR(s.probe.position[2], -5, 1e-9);
-  // Along Y 30 up to X 95 the tool stays beside the block, though its motors (X + Y, X - Y)
-  // pass 110 and 50 on the way: no contact.
-  machine_->queue(traverse(40, 30, -5));
-  machine_->run_until_idle();
-  s = run(probe(95, 30, -5, ProbeMode::toward, 3000));
-  EXPECT_EQ(s.path_errors, 0U);
-  EXPECT_FALSE(s.probe.tripped);
-  EXPECT_NEAR(s.commanded[0], 95, 1e-9);
 }
 
 TEST_F(Probing, AbortEndsTheProbeWithoutAnOutcome) {

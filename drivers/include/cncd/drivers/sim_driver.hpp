@@ -19,10 +19,6 @@
 #include "cncd/drivers/rt.hpp"
 #include "cncd/drivers/spindle_model.hpp"
 
-namespace cncd::motion {
-class Kinematics;
-}
-
 namespace cncd::drivers {
 
 class SimDriver final : public Driver {
@@ -55,10 +51,9 @@ class SimDriver final : public Driver {
   // configure()'s list, out-of-range indexes are ignored.
 
   // The simulated probe ([SIM] PROBE_SURFACE_Z and PROBE_X_MIN .. PROBE_Y_MAX): a block of
-  // work whose top is at that Z; the probe input is asserted while the tool's X, Y and Z, which
-  // the machine's kinematics give from this driver's joints (the others at 0), are inside it.
-  // The model lives in the driver that has a joint of Z. A forced level overrides the model
-  // (any thread): 1 asserted, 0 released, -1 the model again.
+  // work whose top is at that Z; the probe input is asserted while the point the joints of
+  // X, Y and Z put the tool at (motor positions) is inside it. A forced level overrides the
+  // model (any thread): 1 asserted, 0 released, -1 the model again.
   void force_probe(int level) noexcept { probe_forced_.store(level); }
 
   // Feedback of every joint lags the command with this time constant in seconds (0 = exact
@@ -113,12 +108,9 @@ class SimDriver final : public Driver {
   double period_s_ = 0.001;
   std::array<std::atomic<double>, kMaxJoints> lag_s_{};
   std::atomic<bool> estop_{false};
-  // The probe model: the machine's kinematics, the machine joint of each of this driver's
-  // joints, and the block.
+  // The probe model: which of this driver's joints drive X, Y and Z (-1: none) and the block.
   bool probe_model_ = false;
-  std::shared_ptr<const motion::Kinematics> probe_kins_;
-  std::array<int, kMaxJoints> machine_joint_{};
-  int joint_count_ = 0;
+  std::array<int, 3> probe_joint_{-1, -1, -1};
   double probe_top_ = 0;
   double probe_x_min_ = -1e300, probe_x_max_ = 1e300, probe_y_min_ = -1e300, probe_y_max_ = 1e300;
   std::atomic<int> probe_forced_{-1};
