@@ -165,9 +165,8 @@ void ProgramFeeder::emit(const interp::CanonCommand& command) {
                 // Under TCP the joints move along the line the tip's makes in their space.
                 motion::AxisPose from = end_, to = move.end;
                 if (tcp_) {
-                  const auto kins = motion::make_kinematics(*machine_);
-                  kins->tcp_inverse(end_, tool_length_, from);
-                  kins->tcp_inverse(move.end, tool_length_, to);
+                  kins_->tcp_inverse(end_, tool_length_, from);
+                  kins_->tcp_inverse(move.end, tool_length_, to);
                 }
                 if (auto why = thread_too_fast(*machine_, from, to, per_rev_, rpm,
                                                spindle_direction_, spindle_speed_))

@@ -19,7 +19,7 @@ constexpr double kSameJoint = 1e-6;
 void ProgramFeeder::switch_tcp(bool on, int line) {
   if (unsupported_) return;
   const std::string code = on ? "M428" : "M429";
-  if (machine_ != nullptr && !motion::make_kinematics(*machine_)->has_tcp()) {
+  if (kins_ && !kins_->has_tcp()) {
     unsupported_ = Unsupported{line, code + " switches tool centre point control, which needs " +
                                          "xyzac-trt-kins or xyzbc-trt-kins; [KINS] KINEMATICS " +
                                          "is " + machine_->kinematics};
@@ -38,14 +38,12 @@ motion::AxisPose ProgramFeeder::tcp_switched(const motion::AxisPose& machine, bo
 }
 
 motion::AxisPose ProgramFeeder::in_frame(const motion::AxisPose& machine, bool on) const {
-  if (machine_ == nullptr) return machine;
-  const auto kins = motion::make_kinematics(*machine_);
-  if (!kins->has_tcp()) return machine;
+  if (!kins_ || !kins_->has_tcp()) return machine;
   motion::AxisPose moved = machine;
   if (on) {
-    kins->tcp_forward(machine, tool_length_, moved);
+    kins_->tcp_forward(machine, tool_length_, moved);
   } else {
-    kins->tcp_inverse(machine, tool_length_, moved);
+    kins_->tcp_inverse(machine, tool_length_, moved);
   }
   return moved;
 }
@@ -67,15 +65,14 @@ void ProgramFeeder::change_tool_length(int line) {
   tool_length_ = tracker_.tool_offset()[2];
   if (unsupported_ || !tcp_) return;
   if (!tcp_tool_offset_fits(line, "a tool length offset (G43, G43.1, G43.2)")) return;
-  if (tool_length_ == before || machine_ == nullptr) return;
+  if (tool_length_ == before || !kins_) return;
   // LinuxCNC applies a new tool length at rest, and its kinematics then put the joints where
   // the new tool's tip is on the part's point: with the table tilted that is elsewhere, a
   // jump no program line asked for. At the tilting axis's 0 every joint stays where it is.
-  const auto kins = motion::make_kinematics(*machine_);
   motion::AxisPose was{};
   motion::AxisPose now{};
-  kins->tcp_inverse(end_, before, was);
-  kins->tcp_inverse(end_, tool_length_, now);
+  kins_->tcp_inverse(end_, before, was);
+  kins_->tcp_inverse(end_, tool_length_, now);
   bool jumps = false;
   for (std::size_t i = 0; i < was.size(); ++i)
     jumps = jumps || std::abs(now[i] - was[i]) > kSameJoint;

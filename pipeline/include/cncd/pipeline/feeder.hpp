@@ -8,6 +8,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -15,6 +16,7 @@
 #include "cncd/config/machine_config.hpp"
 #include "cncd/interp/canon.hpp"
 #include "cncd/interp/to_machine.hpp"
+#include "cncd/motion/kinematics.hpp"
 #include "cncd/motion/move_queue.hpp"
 #include "cncd/motion/types.hpp"
 
@@ -63,7 +65,10 @@ class ProgramFeeder final : public interp::CanonSink {
   // `machine` (which must outlive the feeder) gives the tool change position; null: none.
   explicit ProgramFeeder(interp::Units machine_units, MessageHandler on_message = {},
                          const config::MachineConfig* machine = nullptr)
-      : tracker_(machine_units), on_message_(std::move(on_message)), machine_(machine) {}
+      : tracker_(machine_units),
+        on_message_(std::move(on_message)),
+        machine_(machine),
+        kins_(machine != nullptr ? motion::make_kinematics(*machine) : nullptr) {}
   void emit(const interp::CanonCommand& command) override;
   // Receives warnings about the program (an S the spindle's limits clamp), with their line.
   void on_warning(MessageHandler handler) { on_warning_ = std::move(handler); }
@@ -197,6 +202,8 @@ class ProgramFeeder final : public interp::CanonSink {
   // The spindle as the program sets it now.
   motion::IoAction spindle_action() const;
   const config::MachineConfig* machine_ = nullptr;
+  // The machine's kinematics (null without a machine): TCP's frames, made once.
+  std::shared_ptr<const motion::Kinematics> kins_;
   MessageHandler on_warning_;
   // Warns when the spindle's limits clamp the speed the program sets (once per speed).
   void check_speed(int line);
